@@ -1,0 +1,67 @@
+"""The ``cablelab`` command line (CONTRACT section 5).
+
+Each verb is one module in :mod:`cablelab.commands` with ``HELP``, ``add_arguments(parser)`` and
+``run(args) -> int``. User errors (:class:`CablelabError`) print one line on stderr and exit 2;
+with ``--json`` nothing but the one JSON object goes to stdout.
+"""
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+from .errors import CablelabError
+
+#: verb -> module under cablelab.commands
+VERBS = {
+    "estimate": "estimate",
+    "compare": "compare",
+    "diagnose": "diagnose",
+    "identify": "identify",
+    "report": "report",
+    "import": "import_",
+    "record": "record",
+    "replay": "replay",
+    "info": "info",
+}
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="cablelab",
+        description="Compare cable-robot and crane models with measurements, find the missing "
+        "physical effect, add it and watch the error fall. Every verb reads a rosbag2 directory "
+        "(or its .mcap file) and the /plant_description in it unless --description is given.",
+    )
+    sub = parser.add_subparsers(dest="verb", metavar="VERB")
+    for verb, module in VERBS.items():
+        try:
+            mod = importlib.import_module(f"cablelab.commands.{module}")
+        except ModuleNotFoundError as exc:
+            if exc.name != f"cablelab.commands.{module}":
+                raise
+            continue  # verb not built yet
+        p = sub.add_parser(verb, help=mod.HELP, description=getattr(mod, "DESCRIPTION", mod.HELP))
+        mod.add_arguments(p)
+        p.set_defaults(_run=mod.run)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if not getattr(args, "_run", None):
+        parser.print_help()
+        return 2
+    try:
+        return int(args._run(args) or 0)
+    except CablelabError as exc:
+        print(f"cablelab {args.verb}: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"cablelab {args.verb}: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

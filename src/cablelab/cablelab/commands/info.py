@@ -1,0 +1,26 @@
+"""``cablelab info BAG``: topics, types, message counts and the plant description of a bag."""
+from __future__ import annotations
+
+import json
+
+HELP = "show a bag's topics, message counts, duration and plant description"
+
+
+def add_arguments(p) -> None:
+    p.add_argument("bag", help="rosbag2 directory or its .mcap file")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+
+
+def run(args) -> int:
+    from ..bags import bag_info
+
+    info = bag_info(args.bag)
+    if args.json:
+        print(json.dumps(info))
+    else:
+        print(f"bag:      {info['path']}\nduration: {info['duration']:.3f} s\nmessages: {info['messages']}")
+        for t in info["topics"]:
+            print(f"  {t['name']:<40} {t['type']:<40} {t['count']:>9}")
+        if info.get("plant"):
+            print(f"plant:    {info['plant']}")
+    return 0

@@ -1,0 +1,1 @@
+"""payload_estimator: a thin ROS 2 adapter over the cablelab core."""

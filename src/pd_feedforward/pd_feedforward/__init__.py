@@ -1,0 +1,1 @@
+"""pd_feedforward: a thin ROS 2 adapter over the cablelab core."""
