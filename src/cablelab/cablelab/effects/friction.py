@@ -1,0 +1,56 @@
+"""Joint / actuator friction, generic over plants through the actuator -> channel map.
+
+Per actuator j with velocity v_j (rad/s or m/s), the friction force/torque at the actuator is
+``Fv_j v_j + Fc_j sign(v_j)`` (001 eq. 15 for the CDPR winches, 002 sec. 3 joint friction for the
+crane, the EMPS reference model force = M qdd + Fv qd + Fc sign(qd) + OF). It reaches the output
+channels through ``Dataset.act_map`` (identity for an axis or the crane joints).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..model import Dataset, Effect, Param
+from . import register
+
+#: velocities below this magnitude (in the actuator's unit/s) count as "at rest" for sign(v):
+#: sign(v) = 0 there. Zero keeps the textbook sign function.
+COULOMB_DEADBAND = 0.0
+
+
+def coulomb_sign(v: np.ndarray, deadband: float = COULOMB_DEADBAND) -> np.ndarray:
+    """sign(v) with a dead band |v| <= deadband -> 0 (dimension of v)."""
+    s = np.sign(v)
+    if deadband > 0:
+        s = np.where(np.abs(v) <= deadband, 0.0, s)
+    return s
+
+
+def _viscous(ds: Dataset) -> np.ndarray:
+    return ds.actuator_block(ds.require_actuators("joint_viscous_friction"))
+
+
+def _coulomb(ds: Dataset) -> np.ndarray:
+    return ds.actuator_block(coulomb_sign(ds.require_actuators("joint_coulomb_friction")))
+
+
+JOINT_VISCOUS_FRICTION = register(Effect(
+    id="joint_viscous_friction",
+    plants=("axis", "crane"),
+    params=(Param("Fv", "N s/m or N m s/rad", 0.0, 0.0, np.inf, "viscous friction coefficient"),),
+    explanation="a force opposing motion in proportion to the actuator velocity",
+    signature="residual grows in proportion to velocity",
+    reference="001 eq. 15; 002 sec. 3",
+    regressor=_viscous,
+    per_actuator=True,
+))
+
+JOINT_COULOMB_FRICTION = register(Effect(
+    id="joint_coulomb_friction",
+    plants=("axis", "crane"),
+    params=(Param("Fc", "N or N m", 0.0, 0.0, np.inf, "Coulomb (dry) friction level"),),
+    explanation="a constant force opposing motion, changing sign with the velocity",
+    signature="residual jumps at velocity reversals",
+    reference="001 eq. 15; EMPS reference model",
+    regressor=_coulomb,
+    per_actuator=True,
+))

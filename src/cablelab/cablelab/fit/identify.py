@@ -1,0 +1,215 @@
+"""Identify a model's free parameters from a dataset (inverse model, separable least squares).
+
+The free linear parameters come from :func:`~cablelab.fit.linear.solve_linear`. Nonlinear
+parameters (a time delay, an unknown pulley radius, ...) are searched outside it (variable
+projection / separable least squares): a coarse grid over the box bounds picks the start, then
+:func:`mujoco.minimize.least_squares` refines the bounded outer problem whose residual is the
+inner linear LS residual. The joint covariance comes from the Jacobian ``[Phi, dr/dtheta_nl]`` at
+the optimum, so every parameter has a standard error.
+"""
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass, field
+from typing import Mapping
+
+import numpy as np
+
+from ..errors import CablelabError
+from ..model import Dataset, Model, Param
+from .linear import LinearFit, solve_linear
+
+#: grid points per nonlinear parameter for the start of the outer search
+OUTER_GRID = 21
+
+
+@dataclass
+class Identification:
+    """Identified model.
+
+    Attributes:
+        model: the model.
+        params: every parameter by name (free linear, nonlinear, fixed).
+        stderr: standard error by name (0 for fixed).
+        units: unit by name.
+        fixed: names of the known (not fitted) parameters.
+        linear: the inner :class:`LinearFit` (rank, condition, unidentifiable directions).
+        y_hat, residual: (N, C) model output and measured - model on the dataset (NaN where not
+            valid); valid: (N,) mask.
+        channels: channel names.
+    """
+
+    model: Model
+    params: dict
+    stderr: dict
+    units: dict
+    fixed: tuple
+    linear: LinearFit
+    y_hat: np.ndarray
+    residual: np.ndarray
+    valid: np.ndarray
+    channels: tuple = ()
+    extra: dict = field(default_factory=dict)
+
+    def table(self) -> list[dict]:
+        """[{name, value, stderr, unit, fixed}] in model order."""
+        return [{"name": k, "value": float(v), "stderr": float(self.stderr.get(k, 0.0)),
+                 "unit": self.units.get(k, ""), "fixed": k in self.fixed}
+                for k, v in self.params.items()]
+
+    def effect_params(self, effect_id: str, ds: Dataset) -> dict:
+        """The parameters belonging to one effect, by name."""
+        from ..effects import get_effect
+
+        eff = get_effect(effect_id)
+        names = [p.name for p in eff.columns(ds)] + [p.name for p in eff.nonlinear]
+        return {k: self.params[k] for k in names if k in self.params}
+
+
+def _linear_system(model: Model, ds: Dataset):
+    phi, cols, y_known = model.regressor(ds)
+    return phi, cols, ds.y - y_known, ds.valid
+
+
+def _inner(model: Model, ds: Dataset, nl: Mapping[str, float], valid: np.ndarray,
+           on_deficient: str) -> tuple[LinearFit, np.ndarray, np.ndarray, list[Param], Dataset]:
+    ds2 = model.apply_nonlinear(ds, nl)
+    phi, cols, lhs, _ = _linear_system(model, ds2)
+    fit = solve_linear(phi, lhs, cols, valid=valid, on_deficient=on_deficient)
+    return fit, phi, lhs, cols, ds2
+
+
+def _weighted_residual(fit: LinearFit, phi, lhs, valid) -> np.ndarray:
+    w = fit.channel_scale
+    r = (lhs - phi @ fit.theta) * w[None, :] if fit.base == [] else None
+    if r is None:  # regrouped fit: residual through lstsq of the independent columns is in rss
+        raise CablelabError("nonlinear parameters with a rank-deficient linear part; fix a "
+                            "parameter (--fix NAME=VALUE) or drop an effect")
+    r = np.where(valid[:, None], r, 0.0)
+    return r.reshape(-1)
+
+
+def identify(model: Model, ds: Dataset, *, on_deficient: str = "raise",
+             outer_grid: int = OUTER_GRID) -> Identification:
+    """Fit the model's free parameters to the dataset.
+
+    Args:
+        model: plant + effects + fixed parameters.
+        ds: conditioned dataset of the same plant.
+        on_deficient: ``"raise"`` (default) or ``"base"`` (regroup to base parameters).
+        outer_grid: grid points per nonlinear parameter for the outer search start.
+    Raises:
+        CablelabError: too few samples, rank-deficient regressor (names the directions).
+    """
+    if ds.plant != model.plant:
+        raise CablelabError(f"dataset of plant {ds.plant} given to a {model.plant} model")
+    nl_params = model.nonlinear_params()
+    nl_values: dict[str, float] = {}
+    valid = ds.valid.copy()
+    jac_nl = None
+    if nl_params:
+        # samples valid at every corner of the box: the residual keeps a fixed length
+        for corner in itertools.product(*[(p.lower, p.nominal, p.upper) for p in nl_params]):
+            valid &= model.apply_nonlinear(ds, dict(zip([p.name for p in nl_params], corner))).valid
+        names = [p.name for p in nl_params]
+        lo = np.array([p.lower for p in nl_params])
+        hi = np.array([p.upper for p in nl_params])
+
+        def cost(x):
+            f, phi, lhs, _, _ = _inner(model, ds, dict(zip(names, x)), valid, on_deficient)
+            return f.rss
+
+        grid = [np.linspace(a, b, outer_grid) for a, b in zip(lo, hi)]
+        if len(nl_params) > 2:  # keep the grid small: nominal start
+            x0 = np.array([p.nominal for p in nl_params])
+        else:
+            pts = np.array(list(itertools.product(*grid)))
+            x0 = pts[int(np.argmin([cost(x) for x in pts]))]
+
+        def residual(xs):
+            xs = np.asarray(xs).reshape(len(names), -1)
+            cols = []
+            for k in range(xs.shape[1]):
+                f, phi, lhs, _, _ = _inner(model, ds, dict(zip(names, xs[:, k])), valid, "raise")
+                cols.append(_weighted_residual(f, phi, lhs, valid))
+            return np.stack(cols, axis=1)
+
+        import mujoco.minimize as mjmin
+
+        step = np.array([(b - a) / (outer_grid - 1) for a, b in zip(lo, hi)])
+        x_best, _ = mjmin.least_squares(x0, residual, bounds=[lo, hi], verbose=0,
+                                        x_scale=step, max_iter=50)
+        x_best = np.clip(np.asarray(x_best).reshape(-1), lo, hi)
+        if cost(x_best) > cost(x0):
+            x_best = x0
+        nl_values = dict(zip(names, map(float, x_best)))
+        # Jacobian of the residual w.r.t. the nonlinear parameters (theta held) for the covariance
+        f0, phi0, lhs0, _, _ = _inner(model, ds, nl_values, valid, "raise")
+        cols_j = []
+        for i, p in enumerate(nl_params):
+            h = 0.1 * step[i]
+            xp, xm = dict(nl_values), dict(nl_values)
+            xp[p.name] = min(nl_values[p.name] + h, hi[i])
+            xm[p.name] = max(nl_values[p.name] - h, lo[i])
+            rp = _fixed_theta_residual(model, ds, xp, f0, valid)
+            rm = _fixed_theta_residual(model, ds, xm, f0, valid)
+            cols_j.append((rp - rm) / (xp[p.name] - xm[p.name]))
+        jac_nl = np.stack(cols_j, axis=1)
+
+    fit, phi, lhs, cols, ds2 = _inner(model, ds, nl_values, valid, on_deficient)
+    params: dict[str, float] = {}
+    stderr: dict[str, float] = {}
+    units: dict[str, str] = {}
+    if fit.base:
+        for k, v, s, u in zip(fit.names, fit.theta, fit.stderr, fit.units):
+            params[k], stderr[k], units[k] = float(v), float(s), u
+    else:
+        for c, v, s in zip(cols, fit.theta, fit.stderr):
+            params[c.name], stderr[c.name], units[c.name] = float(v), float(s), c.unit
+    for p in nl_params:
+        params[p.name], stderr[p.name], units[p.name] = nl_values[p.name], 0.0, p.unit
+    if jac_nl is not None and not fit.base:
+        w = fit.channel_scale
+        a = np.where(valid[:, None, None], phi * w[None, :, None], 0.0).reshape(-1, phi.shape[2])
+        jac = np.concatenate([-a, jac_nl], axis=1)
+        jtj = jac.T @ jac
+        try:
+            cov = fit.sigma2 * np.linalg.pinv(jtj)
+            se = np.sqrt(np.clip(np.diag(cov), 0, None))
+            for name, s in zip([c.name for c in cols] + [p.name for p in nl_params], se):
+                stderr[name] = float(s)
+        except np.linalg.LinAlgError:
+            pass
+    # known parameters
+    all_units = {p.name: p.unit for e in model.effect_units() for p in list(e.columns(ds)) + list(e.nonlinear)}
+    for k, v in model.fixed.items():
+        params[k], stderr[k], units[k] = float(v), 0.0, all_units.get(k, "")
+    if fit.base:  # regrouped: predict with the independent columns only
+        y_hat = np.full_like(ds.y, np.nan)
+    else:
+        y_hat, _ = model.predict(ds, params)
+    resid = np.where(valid[:, None], ds2.y - y_hat, np.nan)
+    return Identification(model, params, stderr, units, tuple(model.fixed), fit, y_hat, resid,
+                          valid, tuple(ds.channels))
+
+
+def _fixed_theta_residual(model: Model, ds: Dataset, nl: Mapping[str, float], fit: LinearFit,
+                          valid: np.ndarray) -> np.ndarray:
+    ds2 = model.apply_nonlinear(ds, nl)
+    phi, _, lhs, _ = _linear_system(model, ds2)
+    return _weighted_residual(fit, phi, lhs, valid)
+
+
+def evaluate(model: Model, ds: Dataset, params: Mapping[str, float]
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Measured output aligned with the model, model output, and valid mask on a dataset.
+
+    Returns:
+        ``(y_meas (N, C), y_hat (N, C), valid (N,))``: ``y_meas`` is the measurement after the
+        model's data transforms (e.g. shifted by an identified delay); compare it with ``y_hat``
+        where ``valid``.
+    """
+    ds2 = model.apply_nonlinear(ds, params)
+    phi, cols, y_known = model.regressor(ds2)
+    theta = np.array([params[c.name] for c in cols]) if cols else np.zeros(0)
+    return ds2.y, phi @ theta + y_known, ds2.valid & np.isfinite(ds2.y).all(axis=1)

@@ -1,0 +1,198 @@
+"""Linear-in-the-parameters least squares with the lessons of 002 sec. 5.2-5.3.
+
+``solve_linear(phi, y, params)`` solves ``y = phi @ theta`` over N samples and C channels with:
+
+* channel weighting (each channel divided by its RMS so torques and forces weigh alike),
+* column scaling, SVD rank and condition number on the scaled regressor,
+* unidentifiable directions named as parameter combinations (null space of the scaled regressor)
+  instead of returning nonsense; optionally base parameters by QR with column pivoting
+  (002 sec. 5.3: dependent columns regrouped into the independent ones),
+* bounded least squares (:func:`scipy.optimize.lsq_linear`) when the unconstrained solution leaves
+  the physical bounds of a parameter,
+* the LS covariance ``sigma^2 (Phi^T Phi)^-1`` with ``sigma^2 = RSS / (n - p)`` for standard errors.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Sequence
+
+import numpy as np
+import scipy.linalg
+import scipy.optimize
+
+from ..errors import CablelabError
+from ..model import Param
+
+#: singular values below RANK_TOL * largest (of the column-scaled regressor) count as zero
+RANK_TOL = 1e-8
+
+
+@dataclass
+class LinearFit:
+    """Result of :func:`solve_linear`.
+
+    Attributes:
+        names, units: the free parameters (or base-parameter combinations when regrouped).
+        theta: (p,) estimates; stderr (p,) standard errors; cov (p, p) covariance.
+        rank, cond: rank and condition number (2-norm) of the column-scaled regressor.
+        n: equations used (valid samples x channels); rss: weighted residual sum of squares;
+        sigma2: residual variance estimate (weighted units).
+        unidentifiable: named null-space directions (empty when full rank).
+        base: for a regrouped fit, the base-parameter definitions (``"M + 0.5 Fc"``).
+        active_bounds: names of parameters held at a bound by bounded LS.
+        channel_scale: (C,) weights applied to the channels.
+    """
+
+    names: tuple[str, ...]
+    units: tuple[str, ...]
+    theta: np.ndarray
+    stderr: np.ndarray
+    cov: np.ndarray
+    rank: int
+    cond: float
+    n: int
+    rss: float
+    sigma2: float
+    unidentifiable: list[str] = field(default_factory=list)
+    base: list[str] = field(default_factory=list)
+    active_bounds: list[str] = field(default_factory=list)
+    channel_scale: np.ndarray | None = None
+
+    @property
+    def params(self) -> dict[str, float]:
+        """name -> estimate."""
+        return {k: float(v) for k, v in zip(self.names, self.theta)}
+
+    def table(self) -> list[dict]:
+        """[{name, value, stderr, unit}] for JSON / reports."""
+        return [{"name": k, "value": float(v), "stderr": float(s), "unit": u}
+                for k, v, s, u in zip(self.names, self.theta, self.stderr, self.units)]
+
+
+def _combo(names: Sequence[str], vec: np.ndarray, tol: float = 0.05) -> str:
+    """A readable linear combination ``"M - 0.5 Fc"`` of the significant entries of ``vec``."""
+    vec = np.asarray(vec, dtype=float)
+    k = int(np.argmax(np.abs(vec)))
+    vec = vec / vec[k]
+    terms = []
+    for name, c in zip(names, vec):
+        if abs(c) < tol:
+            continue
+        mag = "" if abs(abs(c) - 1) < 1e-3 else f"{abs(c):.3g} "
+        sign = "-" if c < 0 else "+"
+        terms.append((sign, f"{mag}{name}"))
+    text = ""
+    for i, (sign, term) in enumerate(terms):
+        text += (("- " if sign == "-" else "") if i == 0 else f" {sign} ") + term
+    return text
+
+
+def solve_linear(phi: np.ndarray, y: np.ndarray, params: Sequence[Param], *,
+                 valid: np.ndarray | None = None, channel_scale: np.ndarray | str | None = "rms",
+                 bounded: bool = True, rank_tol: float = RANK_TOL,
+                 on_deficient: str = "raise") -> LinearFit:
+    """Least squares ``y ~ phi @ theta`` with rank check, bounds and covariance.
+
+    Args:
+        phi: (N, C, p) regressor (or (N, p) for one channel).
+        y: (N, C) (or (N,)) left-hand side (known contributions already subtracted).
+        params: the p :class:`Param` (names, units, bounds).
+        valid: (N,) mask of usable samples (non-finite rows are dropped too).
+        channel_scale: ``"rms"`` (divide each channel by its RMS), None (no weighting) or (C,)
+            weights.
+        bounded: enforce the parameters' box bounds with bounded LS.
+        rank_tol: relative singular-value threshold for the rank.
+        on_deficient: ``"raise"`` -> CablelabError naming the unidentifiable directions;
+            ``"base"`` -> regroup into base parameters (QR with column pivoting).
+    Raises:
+        CablelabError: too few samples, or a rank-deficient regressor with ``on_deficient="raise"``.
+    """
+    phi = np.asarray(phi, dtype=float)
+    y = np.asarray(y, dtype=float)
+    if phi.ndim == 2:
+        phi = phi[:, None, :]
+    if y.ndim == 1:
+        y = y[:, None]
+    n_s, n_c, p = phi.shape
+    names = tuple(pp.name for pp in params)
+    units = tuple(pp.unit for pp in params)
+    if len(names) != p:
+        raise ValueError(f"{len(names)} params for {p} regressor columns")
+    mask = np.ones(n_s, dtype=bool) if valid is None else np.asarray(valid, dtype=bool).copy()
+    mask &= np.isfinite(y).all(axis=1) & np.isfinite(phi).all(axis=(1, 2))
+    if isinstance(channel_scale, str):
+        if channel_scale != "rms":
+            raise ValueError(f"channel_scale {channel_scale!r}")
+        rms = np.sqrt(np.mean(y[mask] ** 2, axis=0)) if mask.any() else np.ones(n_c)
+        w = 1.0 / np.where(rms > 0, rms, 1.0) if n_c > 1 else np.ones(1)
+    elif channel_scale is None:
+        w = np.ones(n_c)
+    else:
+        w = np.asarray(channel_scale, dtype=float).reshape(n_c)
+    a = (phi[mask] * w[None, :, None]).reshape(-1, p)
+    b = (y[mask] * w[None, :]).reshape(-1)
+    n = a.shape[0]
+    if n <= p:
+        raise CablelabError(f"too few valid samples for the fit: {n} equations for {p} parameters "
+                            "(record a longer run or use fewer effects)")
+    if p == 0:
+        rss = float(b @ b)
+        return LinearFit((), (), np.zeros(0), np.zeros(0), np.zeros((0, 0)), 0, 1.0, n, rss,
+                         rss / n, channel_scale=w)
+
+    s = np.linalg.norm(a, axis=0)
+    s_safe = np.where(s > 0, s, 1.0)
+    a_s = a / s_safe
+    u, sv, vt = np.linalg.svd(a_s, full_matrices=False)
+    rank = int(np.sum(sv > sv[0] * rank_tol)) if sv[0] > 0 else 0
+    cond = float(sv[0] / sv[-1]) if sv[-1] > 0 else float("inf")
+    if rank < p:
+        dirs = [_combo(names, vt[i] / s_safe) for i in range(rank, p)]
+        if on_deficient == "raise":
+            raise CablelabError(
+                f"rank-deficient fit (rank {rank} of {p}, condition {cond:.3g}): "
+                f"{'; '.join(dirs)} cannot be identified from this data; fix a parameter "
+                "(--fix NAME=VALUE), drop an effect (--effects), or record motion that excites it")
+        return _solve_base(a, b, s_safe, names, units, rank, cond, dirs, w)
+
+    theta_s = vt.T @ ((u.T @ b) / sv)
+    theta = theta_s / s_safe
+    lo = np.array([pp.lower for pp in params])
+    hi = np.array([pp.upper for pp in params])
+    active: list[str] = []
+    if bounded and (np.any(theta < lo) or np.any(theta > hi)):
+        res = scipy.optimize.lsq_linear(a_s, b, bounds=(lo * s_safe, hi * s_safe), method="bvls")
+        theta = res.x / s_safe
+        active = [names[i] for i in range(p) if res.active_mask[i] != 0]
+    r = b - a @ theta
+    rss = float(r @ r)
+    sigma2 = rss / (n - p)
+    cov_s = (vt.T / sv**2) @ vt
+    cov = sigma2 * cov_s / np.outer(s_safe, s_safe)
+    stderr = np.sqrt(np.clip(np.diag(cov), 0, None))
+    return LinearFit(names, units, theta, stderr, cov, rank, cond, n, rss, sigma2,
+                     active_bounds=active, channel_scale=w)
+
+
+def _solve_base(a, b, s, names, units, rank, cond, dirs, w) -> LinearFit:
+    """Base parameters (002 sec. 5.3): keep ``rank`` independent columns (QR, column pivoting),
+    regroup the dependent ones: A_dep = A_ind B, base_i = theta_i + sum_j B_ij theta_j."""
+    a_s = a / s
+    _, r_mat, piv = scipy.linalg.qr(a_s, mode="economic", pivoting=True)
+    ind, dep = piv[:rank], piv[rank:]
+    b_s = scipy.linalg.solve_triangular(r_mat[:rank, :rank], r_mat[:rank, rank:])
+    bmat = b_s / s[ind][:, None] * s[dep][None, :]
+    base_names = []
+    for i, k in enumerate(ind):
+        terms = [names[k]] + [f"{bmat[i, j]:+.3g} {names[d]}" for j, d in enumerate(dep)
+                              if abs(bmat[i, j]) > 1e-9]
+        base_names.append(" ".join(terms).replace("+-", "-"))
+    a_ind = a[:, ind]
+    theta, *_ = np.linalg.lstsq(a_ind, b, rcond=None)
+    r = b - a_ind @ theta
+    rss = float(r @ r)
+    sigma2 = rss / (a.shape[0] - rank)
+    cov = sigma2 * np.linalg.inv(a_ind.T @ a_ind)
+    return LinearFit(tuple(base_names), tuple(units[k] for k in ind), theta,
+                     np.sqrt(np.clip(np.diag(cov), 0, None)), cov, rank, cond, a.shape[0], rss,
+                     sigma2, unidentifiable=dirs, base=base_names, channel_scale=w)
