@@ -67,6 +67,8 @@ class Dataset:
         act_vel: (N, n_act) actuator velocities (rad/s or m/s), for friction effects.
         act_map: (N, C, n_act) map from an actuator-level force/torque to the output channels;
             ``None`` means identity (C == n_act, channel i is actuator i).
+        act_units: per actuator ``(effort unit, position unit)``, e.g. ``("N m", "rad")``; fills
+            the ``{effort}`` / ``{position}`` placeholders of effect parameter units.
         valid: (N,) bool, samples usable in a fit (False at borders, after a delay shift, ...).
         regimes: name -> (N,) label array (str) for residual-by-regime analysis (plant extras;
             velocity/acceleration regimes are derived from ``act_vel`` by the diagnosis).
@@ -84,6 +86,7 @@ class Dataset:
     actuators: tuple[str, ...] = ()
     act_vel: np.ndarray | None = None
     act_map: np.ndarray | None = None
+    act_units: tuple = ()
     valid: np.ndarray | None = None
     regimes: dict = field(default_factory=dict)
     inputs: dict = field(default_factory=dict)
@@ -224,13 +227,20 @@ class Effect:
         return "*" in self.plants or plant in self.plants
 
     def columns(self, ds: Dataset) -> list[Param]:
-        """The expanded linear parameters for this dataset (names unique per actuator)."""
-        if not self.per_actuator:
-            return list(self.params)
+        """The expanded linear parameters for this dataset (names unique per actuator, unit
+        placeholders ``{effort}``, ``{position}``, ``{inertia}`` filled from ``ds.act_units``)."""
+        def unit(p: Param, j: int) -> Param:
+            if "{" not in p.unit:
+                return p
+            eu, pu = ds.act_units[j] if j < len(ds.act_units) else ("", "")
+            inertia = "kg m^2" if pu == "rad" else "kg"
+            return dataclasses.replace(p, unit=p.unit.format(effort=eu or "?", position=pu or "?",
+                                                             inertia=inertia))
+
         acts = ds.actuators or ds.channels
-        if len(acts) <= 1:
-            return list(self.params)
-        return [p.renamed(f"{p.name}[{a}]") for p in self.params for a in acts]
+        if not self.per_actuator or len(acts) <= 1:
+            return [unit(p, 0) for p in self.params]
+        return [unit(p, j).renamed(f"{p.name}[{a}]") for p in self.params for j, a in enumerate(acts)]
 
     def block(self, ds: Dataset) -> np.ndarray:
         """(N, C, p) regressor block, shape-checked."""

@@ -24,7 +24,7 @@ def _gravity(ds: Dataset) -> np.ndarray:
 AXIS_INERTIA = register(Effect(
     id="axis_inertia",
     plants=("axis",),
-    params=(Param("M", "kg or kg m^2", 0.0, 0.0, np.inf, "moving mass / inertia at the joint"),),
+    params=(Param("M", "{inertia}", 0.0, 0.0, np.inf, "moving mass / inertia at the joint"),),
     explanation="the force needed to accelerate the moving mass (Newton: M qdd)",
     signature="residual follows the acceleration",
     reference="EMPS reference model (IDIM); 002 eq. 4.2 inertial parameters",

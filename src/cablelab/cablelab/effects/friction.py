@@ -36,7 +36,7 @@ def _coulomb(ds: Dataset) -> np.ndarray:
 JOINT_VISCOUS_FRICTION = register(Effect(
     id="joint_viscous_friction",
     plants=("axis", "crane"),
-    params=(Param("Fv", "N s/m or N m s/rad", 0.0, 0.0, np.inf, "viscous friction coefficient"),),
+    params=(Param("Fv", "{effort} s/{position}", 0.0, 0.0, np.inf, "viscous friction coefficient"),),
     explanation="a force opposing motion in proportion to the actuator velocity",
     signature="residual grows in proportion to velocity",
     reference="001 eq. 15; 002 sec. 3",
@@ -47,7 +47,7 @@ JOINT_VISCOUS_FRICTION = register(Effect(
 JOINT_COULOMB_FRICTION = register(Effect(
     id="joint_coulomb_friction",
     plants=("axis", "crane"),
-    params=(Param("Fc", "N or N m", 0.0, 0.0, np.inf, "Coulomb (dry) friction level"),),
+    params=(Param("Fc", "{effort}", 0.0, 0.0, np.inf, "Coulomb (dry) friction level"),),
     explanation="a constant force opposing motion, changing sign with the velocity",
     signature="residual jumps at velocity reversals",
     reference="001 eq. 15; EMPS reference model",

@@ -20,7 +20,7 @@ def _offset(ds: Dataset) -> np.ndarray:
 TORQUE_SENSOR_OFFSET = register(Effect(
     id="torque_sensor_offset",
     plants=("*",),
-    params=(Param("OF", "N or N m", 0.0, -np.inf, np.inf, "constant bias of the measured effort"),),
+    params=(Param("OF", "{effort}", 0.0, -np.inf, np.inf, "constant bias of the measured effort"),),
     explanation="the measured effort carries a constant bias",
     signature="residual has a non-zero mean, also at rest",
     reference="002 sec. 6.5; EMPS reference model",

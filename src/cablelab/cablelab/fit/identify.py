@@ -115,9 +115,11 @@ def identify(model: Model, ds: Dataset, *, on_deficient: str = "raise",
         lo = np.array([p.lower for p in nl_params])
         hi = np.array([p.upper for p in nl_params])
 
+        outer = _OuterProblem(model, ds, valid, names)
+
         def cost(x):
-            f, phi, lhs, _, _ = _inner(model, ds, dict(zip(names, x)), valid, on_deficient)
-            return f.rss
+            r = outer.residual(x)
+            return float(r @ r)
 
         grid = [np.linspace(a, b, outer_grid) for a, b in zip(lo, hi)]
         if len(nl_params) > 2:  # keep the grid small: nominal start
@@ -128,11 +130,7 @@ def identify(model: Model, ds: Dataset, *, on_deficient: str = "raise",
 
         def residual(xs):
             xs = np.asarray(xs).reshape(len(names), -1)
-            cols = []
-            for k in range(xs.shape[1]):
-                f, phi, lhs, _, _ = _inner(model, ds, dict(zip(names, xs[:, k])), valid, "raise")
-                cols.append(_weighted_residual(f, phi, lhs, valid))
-            return np.stack(cols, axis=1)
+            return np.stack([outer.residual(xs[:, k]) for k in range(xs.shape[1])], axis=1)
 
         import mujoco.minimize as mjmin
 
@@ -191,6 +189,36 @@ def identify(model: Model, ds: Dataset, *, on_deficient: str = "raise",
     resid = np.where(valid[:, None], ds2.y - y_hat, np.nan)
     return Identification(model, params, stderr, units, tuple(model.fixed), fit, y_hat, resid,
                           valid, tuple(ds.channels))
+
+
+class _OuterProblem:
+    """Variable-projection residual of the outer (nonlinear) search: for given nonlinear values,
+    the residual of the inner linear LS. When the transforms leave the regressor inputs untouched
+    (e.g. a delay shifts only the measurement) the regressor is factorised once (QR) and every
+    evaluation is a projection; otherwise the inner LS is solved afresh."""
+
+    def __init__(self, model: Model, ds: Dataset, valid: np.ndarray, names: list[str]):
+        self.model, self.ds, self.valid, self.names = model, ds, valid, names
+        nominal = {p.name: p.nominal for p in model.nonlinear_params()}
+        ds0 = model.apply_nonlinear(ds, nominal)
+        self.constant = (ds0.signals is ds.signals and ds0.act_map is ds.act_map
+                         and ds0.act_vel is ds.act_vel)
+        phi, self.cols, self.y_known = model.regressor(ds0)
+        fit0 = solve_linear(phi, ds0.y - self.y_known, self.cols, valid=valid, bounded=False)
+        self.w = fit0.channel_scale
+        if self.constant:
+            a = (phi[valid] * self.w[None, :, None]).reshape(-1, phi.shape[2])
+            self.q = np.linalg.qr(a, mode="reduced")[0] if a.shape[1] else np.zeros((a.shape[0], 0))
+
+    def residual(self, x) -> np.ndarray:
+        ds2 = self.model.apply_nonlinear(self.ds, dict(zip(self.names, np.ravel(x))))
+        if self.constant:
+            b = ((ds2.y - self.y_known)[self.valid] * self.w[None, :]).reshape(-1)
+            return b - self.q @ (self.q.T @ b)
+        phi, cols, lhs, _ = _linear_system(self.model, ds2)
+        fit = solve_linear(phi, lhs, cols, valid=self.valid, channel_scale=self.w, bounded=False)
+        r = (lhs - phi @ fit.theta) * self.w[None, :]
+        return r[self.valid].reshape(-1)
 
 
 def _fixed_theta_residual(model: Model, ds: Dataset, nl: Mapping[str, float], fit: LinearFit,

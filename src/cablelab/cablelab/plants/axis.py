@@ -42,7 +42,7 @@ def dataset_from_arrays(t, q, effort, description, options: dict | None = None, 
     return Dataset(
         plant="axis", t=c["t"], y=c["effort"].reshape(-1, 1), channels=("joint",), units=(unit,),
         signals={"q": c["q"].reshape(-1), "qd": qd_c, "qdd": c["qdd"].reshape(-1)},
-        actuators=("joint",), act_vel=qd_c[:, None],
+        actuators=("joint",), act_vel=qd_c[:, None], act_units=((unit, "rad" if revolute else "m"),),
         inputs={"velocity": qd_c, "acceleration": c["qdd"].reshape(-1)},
         regimes={"position": _position_bins(c["q"].reshape(-1))},
         description=description, source=source,
