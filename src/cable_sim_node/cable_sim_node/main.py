@@ -1,13 +1,16 @@
-"""Entry point of the cable_sim_node node (filled by the foundation work)."""
-import argparse
+"""``cable_sim_node --plant {cdpr,crane,axis}``: the MuJoCo simulator node of a plant.
+
+The plant's adapter is the module ``cable_sim_node.<plant>`` (``make_node(args)``); see
+:func:`cablelab.ros.runner.plant_main` and docs/nodes.md.
+"""
 import sys
+
+from cablelab.ros.runner import plant_main
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="cable_sim_node")
-    parser.add_argument("--plant", choices=["cdpr", "crane", "axis"], required=True)
-    parser.parse_known_args(argv)
-    return 0
+    return plant_main("cable_sim_node", argv, "MuJoCo simulator of a cablelab plant: publishes "
+                      "its joint states, sensors, /clock and /plant_description.")
 
 
 if __name__ == "__main__":

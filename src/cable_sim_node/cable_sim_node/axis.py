@@ -1,0 +1,77 @@
+"""Axis simulator node: MuJoCo single axis driven by ``/axis/effort_command``.
+
+Publishes ``/axis/joint_states`` (name ``joint``: position, velocity, effort = applied command +
+sensor offset), ``/axis/ground_truth/joint_states`` (effort = true applied force), ``/clock``
+and ``/plant_description`` (transient-local). Physics: :mod:`cablelab.plants.axis_sim`.
+
+ROS parameters: ``description`` (YAML file or text; default a prismatic 2 kg axis),
+``inertia``, ``viscous``, ``coulomb``, ``offset`` (true values, SI), ``timestep`` (s),
+``rate`` (Hz of publishing = command sampling), ``command_timeout`` (s wall; a stale command
+falls back to 0 and the node reports WARN).
+"""
+from __future__ import annotations
+
+import time
+
+from rclpy.node import Node
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import JointState
+from std_msgs.msg import Float64MultiArray, String
+
+from cablelab.description import load_description
+from cablelab.plants.axis_sim import AxisSim, AxisTruth
+from cablelab.ros import convert
+from cablelab.ros.diagnostics import Diagnostics
+from cablelab.ros.inputs import InputMonitor
+from cablelab.ros.qos import DESCRIPTION_QOS, stream_qos
+
+DEFAULT_DESCRIPTION = ("plant: axis\nname: simulated linear axis\ngravity: 9.81\n"
+                       "axis:\n  joint_type: prismatic\n  inertia: 2.0\n")
+
+
+class AxisSimNode(Node):
+    def __init__(self):
+        super().__init__("cable_sim_node")
+        p = self.declare_parameter
+        text = p("description", "").value or DEFAULT_DESCRIPTION
+        self.description = load_description(text)
+        nominal = self.description.axis.inertia if self.description.axis else None
+        truth = AxisTruth(inertia=p("inertia", float(nominal or 2.0)).value,
+                          viscous=p("viscous", 5.0).value, coulomb=p("coulomb", 1.0).value,
+                          offset=p("offset", 0.0).value, timestep=p("timestep", 0.001).value)
+        self.rate = float(p("rate", 200.0).value)
+        self.sim = AxisSim(self.description, truth)
+        self.u = 0.0
+        self.inputs = InputMonitor()
+        self.inputs.add("effort_command", timeout=float(p("command_timeout", 0.5).value), length=1)
+
+        self.pub_js = self.create_publisher(JointState, "/axis/joint_states", stream_qos())
+        self.pub_truth = self.create_publisher(JointState, "/axis/ground_truth/joint_states", stream_qos())
+        self.pub_clock = self.create_publisher(Clock, "/clock", stream_qos(10))
+        self.pub_desc = self.create_publisher(String, "/plant_description", DESCRIPTION_QOS)
+        self.pub_desc.publish(convert.string_msg(self.description.to_yaml()))
+        self.create_subscription(Float64MultiArray, "/axis/effort_command", self.on_command, stream_qos())
+        self.diag = Diagnostics(self, update=lambda: self.inputs.status(time.monotonic()))
+        self.timer = self.create_timer(1.0 / self.rate, self.tick)
+        self.publish_state()
+
+    def on_command(self, msg: Float64MultiArray) -> None:
+        values = convert.float_array(msg)
+        if self.inputs.accept("effort_command", values, time.monotonic()):
+            self.u = float(values[0])
+
+    def tick(self) -> None:
+        if not self.inputs.fresh("effort_command", time.monotonic()):
+            self.u = 0.0  # no (fresh) command: the drive is switched off
+        self.sim.advance(self.u, 1.0 / self.rate)
+        self.publish_state()
+
+    def publish_state(self) -> None:
+        t, q, qd = self.sim.state()
+        self.pub_clock.publish(convert.clock_msg(t))
+        self.pub_js.publish(convert.joint_state_msg(t, ["joint"], [q], [qd], [self.sim.measured_effort(self.u)]))
+        self.pub_truth.publish(convert.joint_state_msg(t, ["joint"], [q], [qd], [self.u]))
+
+
+def make_node(args) -> Node:
+    return AxisSimNode()

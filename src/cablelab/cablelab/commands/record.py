@@ -1,0 +1,54 @@
+"""``cablelab record -o BAG (--plant P | --topics a,b)``: record contract topics into a bag.
+
+A real ROS 2 node (see :mod:`cablelab.ros.recorder`); stops on SIGINT/SIGTERM or after
+``--duration`` and closes the bag.
+"""
+from __future__ import annotations
+
+HELP = "record a plant's contract topics (or --topics) into a rosbag2 MCAP bag"
+
+
+def add_arguments(p) -> None:
+    p.add_argument("-o", "--output", required=True, help="bag directory to create")
+    p.add_argument("--plant", choices=["cdpr", "crane", "axis"],
+                   help="record this plant's contract topics (+ /clock, /plant_description)")
+    p.add_argument("--topics", help="comma-separated topics to record (types discovered)")
+    p.add_argument("--duration", type=float, default=0.0, help="stop after this many s (0: on signal)")
+    p.add_argument("--overwrite", action="store_true", help="replace an existing bag")
+    p.add_argument("--flush-period", type=float, default=1.0,
+                   help="s between flushes to disk (bounds what a SIGKILL loses)")
+    p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
+
+
+def topic_set(args) -> dict:
+    from ..errors import CablelabError
+    from ..topics import plant_topics
+
+    topics: dict = {}
+    if args.plant:
+        topics.update(plant_topics(args.plant))
+    if args.topics:
+        for name in args.topics.split(","):
+            name = name.strip()
+            if not name.startswith("/"):
+                raise CablelabError(f"--topics: topic names start with '/', got {name!r}")
+            topics.setdefault(name, None)
+    if not topics:
+        raise CablelabError("record: give --plant or --topics")
+    return topics
+
+
+def run(args) -> int:
+    from ..bags import BagWriter
+    from ..ros.runner import run_node
+
+    topics = topic_set(args)
+    writer = BagWriter(args.output, overwrite=args.overwrite)  # refuses an existing path first
+
+    def factory(_args):
+        from ..ros.recorder import RecorderNode
+
+        return RecorderNode(writer, topics, duration=args.duration,
+                            flush_period=args.flush_period, quiet=args.quiet)
+
+    return run_node(factory, args, [], "cablelab record")

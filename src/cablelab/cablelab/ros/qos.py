@@ -1,0 +1,34 @@
+"""QoS profiles of the contract topics (CONTRACT section 2).
+
+* ``/plant_description``: reliable, transient-local, keep-last depth 1 (a late joiner gets it);
+* streams (joint states, poses, commands, estimates): reliable, volatile, keep-last ``depth``;
+* recorder subscriptions: reliable keep-all, so a briefly busy recorder delays rather than drops.
+"""
+from __future__ import annotations
+
+from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+
+DESCRIPTION_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1,
+                             reliability=ReliabilityPolicy.RELIABLE,
+                             durability=DurabilityPolicy.TRANSIENT_LOCAL)
+
+
+def stream_qos(depth: int = 100) -> QoSProfile:
+    """Reliable, volatile, keep-last ``depth``: the contract's data streams."""
+    return QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=depth,
+                      reliability=ReliabilityPolicy.RELIABLE,
+                      durability=DurabilityPolicy.VOLATILE)
+
+
+def recorder_qos(transient_local: bool = False) -> QoSProfile:
+    """Reliable keep-all (depth 1 transient-local for /plant_description)."""
+    if transient_local:
+        return DESCRIPTION_QOS
+    return QoSProfile(history=HistoryPolicy.KEEP_ALL, depth=1000,
+                      reliability=ReliabilityPolicy.RELIABLE,
+                      durability=DurabilityPolicy.VOLATILE)
+
+
+def qos_for(topic: str, depth: int = 100) -> QoSProfile:
+    """The publisher/subscriber QoS of a contract topic."""
+    return DESCRIPTION_QOS if topic == "/plant_description" else stream_qos(depth)

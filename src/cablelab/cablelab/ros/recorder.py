@@ -1,0 +1,112 @@
+"""The bag recorder node behind ``cablelab record``.
+
+Subscribes to a topic set with serialised (raw) callbacks and matching QoS (transient-local for
+/plant_description, reliable keep-all for streams), writes every message as received into a
+rosbag2 MCAP bag (log time = receive time, wall clock ns) and flushes a complete MCAP chunk to
+disk every ``flush_period`` s. Topics whose type is not known in advance (``--topics``) are
+subscribed as soon as they appear in the ROS graph.
+
+Shutdown (SIGINT/SIGTERM, ``--duration`` elapsed): the bag is closed: MCAP summary + footer and
+metadata.yaml written. SIGKILL: nothing can run; the .mcap holds every chunk flushed so far
+(at most ``flush_period`` s is lost), without footer and without metadata.yaml; ``open_bag(...,
+recover=True)`` / ``cablelab info --recover`` read that complete part (see docs/bags.md).
+"""
+from __future__ import annotations
+
+import sys
+import time
+
+from rclpy.node import Node
+
+from ..bags import BagWriter
+from ..errors import CablelabError
+from .convert import message_class
+from .qos import recorder_qos
+
+
+class RecorderNode(Node):
+    """Args: output bag path, topics (name -> type or None to discover), overwrite, duration
+    (s, 0 = until stopped), flush_period (s)."""
+
+    def __init__(self, output, topics: dict[str, str | None], *, overwrite: bool = False,
+                 duration: float = 0.0, flush_period: float = 1.0, quiet: bool = False):
+        super().__init__("cablelab_recorder")
+        writer = output if isinstance(output, BagWriter) else BagWriter(output, overwrite=overwrite)
+        self.writer = writer.open()
+        self.wanted = dict(topics)
+        self.subs = {}
+        self.counts = {t: 0 for t in topics}
+        self.quiet = quiet
+        self.duration = float(duration)
+        self.t_start = time.monotonic()
+        self.done = False
+        self.closed = False
+        for topic, msgtype in self.wanted.items():
+            if msgtype:
+                self._subscribe(topic, msgtype)
+        self.mismatch_reported = set()
+        self.create_timer(0.2, self._discover)
+        self.create_timer(flush_period, self._flush)
+        if self.duration > 0:
+            self.create_timer(0.05, self._check_duration)
+        self.create_timer(5.0, self._progress)
+
+    def _subscribe(self, topic: str, msgtype: str) -> None:
+        try:
+            cls = message_class(msgtype)
+        except ValueError:
+            raise CablelabError(f"record: topic {topic}: unknown message type {msgtype}") from None
+        write = self.writer.write_raw
+        counts = self.counts
+        transient = topic == "/plant_description"
+        registered = []
+
+        def callback(data: bytes) -> None:
+            if not registered:
+                self.writer.add_topic(topic, msgtype, transient_local=transient)
+                registered.append(True)
+            write(topic, time.time_ns(), data)
+            counts[topic] += 1
+
+        self.subs[topic] = self.create_subscription(cls, topic, callback, recorder_qos(transient),
+                                                    raw=True)
+
+    def _discover(self) -> None:
+        types = dict(self.get_topic_names_and_types())
+        for topic, msgtype in self.wanted.items():
+            if topic not in types:
+                continue
+            found = [t for t in types[topic] if msgtype is None or t == msgtype]
+            others = [t for t in types[topic] if msgtype is not None and t != msgtype]
+            if others and topic not in self.mismatch_reported:
+                self.mismatch_reported.add(topic)
+                self.get_logger().error(f"topic {topic} is published with type {others[0]}, "
+                                        f"expected {msgtype}: those messages are not recorded")
+            if topic not in self.subs and found:
+                self._subscribe(topic, found[0])
+
+    def _flush(self) -> None:
+        if not self.closed:
+            self.writer.flush()
+
+    def _check_duration(self) -> None:
+        if time.monotonic() - self.t_start >= self.duration:
+            self.done = True
+
+    def _progress(self) -> None:
+        if self.quiet:
+            return
+        elapsed = time.monotonic() - self.t_start
+        total = sum(self.counts.values())
+        eta = f", {max(0.0, self.duration - elapsed):.0f} s left" if self.duration > 0 else ""
+        print(f"record: {elapsed:.0f} s, {total} messages on {sum(1 for c in self.counts.values() if c)}"
+              f"/{len(self.counts)} topics{eta}", file=sys.stderr, flush=True)
+
+    def shutdown(self) -> None:
+        """Close the bag (MCAP footer + metadata.yaml)."""
+        if not self.closed:
+            self.closed = True
+            self.writer.close()
+            if not self.quiet:
+                print(f"record: wrote {sum(self.counts.values())} messages to {self.writer.path}",
+                      file=sys.stderr, flush=True)

@@ -1,0 +1,104 @@
+"""Axis PD + feedforward controller node.
+
+On every ``/axis/joint_states`` message (event-driven, in the measurement's own time base) it
+computes ``u = M_ff qdd_ref + Kp (q_ref - q) + Kd (qd_ref - qd)``
+(:func:`cablelab.plants.axis_control.pd_feedforward`) and publishes it on
+``/axis/effort_command``. The reference is the latest ``/axis/reference`` (``reference_source:
+topic``, default) or a built-in sine evaluated at the measurement stamp (``reference_source:
+sine``, also published on ``/axis/reference`` so recordings hold it).
+
+ROS parameters: ``kp`` (N/m), ``kd`` (N s/m), ``inertia`` (feedforward M_ff; default the
+description's ``axis.inertia`` from /plant_description, else 0), ``reference_source``,
+``amplitude``, ``frequency`` (Hz), ``offset``, ``reference_timeout`` (s wall).
+"""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+from rclpy.node import Node
+from sensor_msgs.msg import JointState
+from std_msgs.msg import Float64MultiArray, String
+from trajectory_msgs.msg import JointTrajectory
+
+from cablelab.description import load_description
+from cablelab.errors import CablelabError
+from cablelab.plants.axis_control import pd_feedforward, sine_reference
+from cablelab.ros import convert
+from cablelab.ros.diagnostics import Diagnostics
+from cablelab.ros.inputs import InputMonitor
+from cablelab.ros.qos import DESCRIPTION_QOS, stream_qos
+
+
+class AxisController(Node):
+    def __init__(self):
+        super().__init__("pd_feedforward")
+        p = self.declare_parameter
+        self.kp = float(p("kp", 400.0).value)
+        self.kd = float(p("kd", 40.0).value)
+        self.inertia_param = float(p("inertia", float("nan")).value)
+        self.inertia = 0.0 if np.isnan(self.inertia_param) else self.inertia_param
+        self.source = str(p("reference_source", "topic").value)
+        if self.source not in ("topic", "sine"):
+            raise CablelabError(f"pd_feedforward: parameter reference_source: expected 'topic' or "
+                                f"'sine', got {self.source!r}")
+        self.amplitude = float(p("amplitude", 0.2).value)
+        self.frequency = float(p("frequency", 0.5).value)
+        self.offset = float(p("offset", 0.0).value)
+        self.ref = None  # (q, qd, qdd) from the topic
+        self.inputs = InputMonitor()
+        self.inputs.add("joint_states", timeout=0.5, length=1)
+        self.inputs.add("reference", timeout=float(p("reference_timeout", 0.5).value), length=1,
+                        required=self.source == "topic")
+
+        self.pub_cmd = self.create_publisher(Float64MultiArray, "/axis/effort_command", stream_qos())
+        self.pub_ref = self.create_publisher(JointTrajectory, "/axis/reference", stream_qos()) \
+            if self.source == "sine" else None
+        self.create_subscription(JointState, "/axis/joint_states", self.on_state, stream_qos())
+        if self.source == "topic":
+            self.create_subscription(JointTrajectory, "/axis/reference", self.on_reference, stream_qos())
+        self.create_subscription(String, "/plant_description", self.on_description, DESCRIPTION_QOS)
+        self.diag = Diagnostics(self, update=self.status)
+
+    def status(self):
+        level, msg, values = self.inputs.status(time.monotonic())
+        values["feedforward inertia"] = f"{self.inertia:g}"
+        return level, msg, values
+
+    def on_description(self, msg: String) -> None:
+        try:
+            desc = load_description(msg.data)
+        except CablelabError as exc:
+            self.get_logger().error(f"/plant_description: {exc}")
+            return
+        if np.isnan(self.inertia_param) and desc.axis is not None and desc.axis.inertia:
+            self.inertia = float(desc.axis.inertia)
+
+    def on_reference(self, msg: JointTrajectory) -> None:
+        _, _, q, qd, qdd = convert.joint_trajectory_point(msg)
+        if self.inputs.accept("reference", q, time.monotonic()):
+            zero = np.zeros(1)
+            self.ref = (float(q[0]), float((qd if qd is not None else zero)[0]),
+                        float((qdd if qdd is not None else zero)[0]))
+
+    def on_state(self, msg: JointState) -> None:
+        t, _names, q, qd, _eff = convert.joint_state_arrays(msg)
+        now = time.monotonic()
+        if not self.inputs.accept("joint_states", q, now):
+            return
+        if qd is None or qd.size != q.size or not np.isfinite(qd).all():
+            qd = np.zeros_like(q)
+        if self.source == "sine":
+            q_ref, qd_ref, qdd_ref = (float(v) for v in sine_reference(t, self.amplitude, self.frequency,
+                                                                        self.offset))
+            self.pub_ref.publish(convert.joint_trajectory_msg(t, ["joint"], [q_ref], [qd_ref], [qdd_ref]))
+        elif self.ref is not None and self.inputs.fresh("reference", now):
+            q_ref, qd_ref, qdd_ref = self.ref
+        else:
+            return  # no reference: command nothing, the simulator's command timeout stops the drive
+        u = pd_feedforward(q[0], qd[0], q_ref, qd_ref, qdd_ref, self.kp, self.kd, self.inertia)
+        self.pub_cmd.publish(convert.float_array_msg([u]))
+
+
+def make_node(args) -> Node:
+    return AxisController()
