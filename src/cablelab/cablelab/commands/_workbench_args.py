@@ -1,0 +1,63 @@
+"""Options shared by the workbench verbs (compare, diagnose, identify, report)."""
+from __future__ import annotations
+
+import json
+import math
+
+
+def add_common(p, *, effects_required: bool = False) -> None:
+    p.add_argument("bag", help="rosbag2 directory or its .mcap file")
+    p.add_argument("--description", metavar="FILE",
+                   help="plant description YAML (default: /plant_description in the bag)")
+    p.add_argument("--effects", metavar="A,B", default="", required=effects_required,
+                   help="effects added to the plant's nominal model (ids of CONTRACT section 4)")
+    p.add_argument("--baseline", metavar="A,B", default=None,
+                   help="replace the plant's nominal effects ('none' = empty model)")
+    p.add_argument("--fix", metavar="NAME=VALUE", action="append", default=[],
+                   help="known parameter moved to the left-hand side (repeatable)")
+    p.add_argument("--tensions", choices=("dynamometer", "motor"), default="dynamometer",
+                   help="CDPR: tensions from the dynamometers or from motor torques")
+    p.add_argument("--cutoff", type=float, metavar="HZ", default=None,
+                   help="zero-phase Butterworth cut-off for positions (default fs/10)")
+    p.add_argument("--decimate", type=int, metavar="K", default=None,
+                   help="keep every K-th sample after filtering")
+    p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
+
+
+def add_folds(p) -> None:
+    p.add_argument("--folds", type=int, default=5, metavar="K",
+                   help="blocked k-fold cross-validation over time (default 5)")
+
+
+def load_from_args(args):
+    """(plant, description, dataset, model) from the shared options."""
+    from ..model import parse_effect_list, parse_fixed
+    from ..workbench import build_model, conditioning_from_args, load
+
+    options = {"conditioning": conditioning_from_args(args), "tensions": args.tensions}
+    plant, desc, ds = load(args.bag, args.description, options)
+    baseline = None
+    if args.baseline is not None:
+        baseline = () if args.baseline.strip() in ("", "none") else parse_effect_list(args.baseline)
+    model = build_model(plant, desc, parse_effect_list(args.effects), baseline, parse_fixed(args.fix))
+    return plant, desc, ds, model
+
+
+def _clean(o):
+    if isinstance(o, float):
+        return o if math.isfinite(o) else None
+    if isinstance(o, dict):
+        return {str(k): _clean(v) for k, v in o.items()}
+    if isinstance(o, (list, tuple)):
+        return [_clean(v) for v in o]
+    if hasattr(o, "item") and not isinstance(o, (str, bytes)):
+        try:
+            return _clean(o.item())
+        except (ValueError, AttributeError):
+            pass
+    return o
+
+
+def dump_json(obj) -> str:
+    """Strict JSON (non-finite numbers as null)."""
+    return json.dumps(_clean(obj), allow_nan=False)

@@ -1,0 +1,31 @@
+"""``cablelab compare BAG [--effects a,b] --json``: measured vs model per channel."""
+from __future__ import annotations
+
+from ._workbench_args import add_common, dump_json, load_from_args
+
+HELP = "compare the model (nominal effects + --effects, fitted) with the measurement per channel"
+
+
+def add_arguments(p) -> None:
+    add_common(p)
+    p.add_argument("--segments", type=int, default=5, help="number of worst segments to list")
+
+
+def run(args) -> int:
+    from ..workbench import compare
+
+    _, _, ds, model = load_from_args(args)
+    out = compare(ds, model, segments=args.segments)
+    if args.json:
+        print(dump_json(out))
+        return 0
+    print(f"plant {out['plant']}, model {' + '.join(out['effects'])}, {out['samples']} samples")
+    for ch, m in out["channels"].items():
+        print(f"  {ch}: NRMSE {100 * m['nrmse']:.2f} %  fit {m['fit_percent']:.1f} %  pearson "
+              f"{m['pearson']:.4f}  MAE {m['mae']:.4g}  max {m['max_abs']:.4g}")
+    for name, v in out["params"].items():
+        print(f"  {name:>12} = {v['value']:.6g} +- {v['stderr']:.2g} {v['unit']}")
+    print("worst segments:")
+    for s in out["worst_segments"]:
+        print(f"  {s['channel']}: {s['t_start']:.3f}-{s['t_end']:.3f} s  NRMSE {100 * s['error']:.1f} %")
+    return 0

@@ -1,0 +1,43 @@
+"""``cablelab diagnose BAG [--effects a,b] [--greedy] --json``: which effect is missing."""
+from __future__ import annotations
+
+from ._workbench_args import add_common, add_folds, dump_json, load_from_args
+
+HELP = "rank the missing physical effects by held-out error (blocked k-fold), --greedy adds them"
+
+
+def add_arguments(p) -> None:
+    add_common(p)
+    add_folds(p)
+    p.add_argument("--candidates", metavar="A,B", default=None,
+                   help="effects to try (default: every effect applicable to the plant)")
+    p.add_argument("--greedy", action="store_true",
+                   help="add the best significant effect until none helps (the waterfall)")
+    p.add_argument("--alpha", type=float, default=0.01, help="family-wise significance level")
+    p.add_argument("--min-gain", type=float, default=0.05,
+                   help="minimum relative held-out error reduction of a significant effect")
+
+
+def run(args) -> int:
+    from ..model import parse_effect_list
+    from ..workbench import diagnose
+
+    plant, desc, ds, model = load_from_args(args)
+    cands = parse_effect_list(args.candidates) if args.candidates else plant.candidates(desc)
+    out = diagnose(ds, model, cands, folds=args.folds, alpha=args.alpha, min_gain=args.min_gain,
+                   greedy_mode=args.greedy, quiet=args.json)
+    if args.json:
+        print(dump_json(out))
+        return 0
+    b = out["baseline"]
+    print(f"plant {out['plant']}: model {' + '.join(b['effects'])}, held-out NRMSE "
+          f"{100 * b['error']:.2f} % ({out['folds']} folds)")
+    for i, r in enumerate(out["ranking"], 1):
+        after = "-" if r["error_after"] is None else f"{100 * r['error_after']:.2f} %"
+        mark = "*" if r["significant"] else " "
+        print(f" {mark}{i}. {r['effect']:<26} -> {after:>9}  {r['explanation']}")
+    for s in out.get("greedy", [])[1:]:
+        print(f"  + {s['added']:<26} held-out NRMSE {100 * s['error']:.2f} %")
+    if "final" in out:
+        print("final: " + ", ".join(f"{k} = {v:.6g}" for k, v in out["final"]["params"].items()))
+    return 0

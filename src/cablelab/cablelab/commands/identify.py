@@ -1,0 +1,29 @@
+"""``cablelab identify BAG --effects a,b --json``: parameters with uncertainty and fit."""
+from __future__ import annotations
+
+from ._workbench_args import add_common, add_folds, dump_json, load_from_args
+
+HELP = "identify the parameters of the nominal model + --effects, with standard errors"
+
+
+def add_arguments(p) -> None:
+    add_common(p)
+    add_folds(p)
+
+
+def run(args) -> int:
+    from ..workbench import identify
+
+    _, _, ds, model = load_from_args(args)
+    out = identify(ds, model, folds=args.folds)
+    if args.json:
+        print(dump_json(out))
+        return 0
+    f = out["fit"]
+    print(f"plant {out['plant']}, model {' + '.join(out['effects'])}: NRMSE {100 * f['nrmse']:.2f} % "
+          f"(held-out {100 * f['cv_nrmse']:.2f} %, {f['folds']} folds), rank {f['rank']}, "
+          f"condition {f['condition']:.3g}")
+    for name, v in out["params"].items():
+        tag = " (fixed)" if v["fixed"] else ""
+        print(f"  {name:>12} = {v['value']:.6g} +- {v['stderr']:.2g} {v['unit']}{tag}")
+    return 0

@@ -1,0 +1,170 @@
+"""``cablelab import FILE --plant P --map SPEC [--description YAML] -o BAG``.
+
+Turns a CSV (header row of column names) or MATLAB .mat time series into a contract bag with the
+plant's joint-state topic and ``/plant_description``. SPEC maps contract fields to columns with an
+optional scale: ``time=t,position=qm,effort=35.15*vir`` (factors joined by ``*`` or ``/``; a
+factor is a number, a column, or a scalar variable of the file such as ``gtau``). Single-joint
+plants use ``time, position, velocity, effort``; multi-joint plants ``position.<joint>`` etc.
+"""
+from __future__ import annotations
+
+import os
+import re
+
+import numpy as np
+
+from ..errors import CablelabError
+
+HELP = "import a CSV or MAT time series into a contract bag (with /plant_description)"
+
+#: plant -> (joint-state topic, joint names)
+JOINT_TOPICS = {
+    "axis": ("/axis/joint_states", ("joint",)),
+    "crane": ("/crane/joint_states", ("slew", "luff", "hoist")),
+    "cdpr": ("/cdpr/joint_states", tuple(f"winch_{i}" for i in range(1, 9))),
+}
+FIELDS = ("position", "velocity", "effort")
+
+
+def add_arguments(p) -> None:
+    p.add_argument("file", help="CSV (header row) or MATLAB .mat file")
+    p.add_argument("--plant", required=True, choices=sorted(JOINT_TOPICS))
+    p.add_argument("--map", required=True, metavar="SPEC",
+                   help="e.g. time=t,position=qm,effort=35.15*vir (multi-joint: position.slew=...)")
+    p.add_argument("--description", metavar="YAML",
+                   help="plant description file or YAML text (required for the workbench)")
+    p.add_argument("-o", "--out", required=True, metavar="BAG", help="bag directory to write")
+    p.add_argument("--overwrite", action="store_true", help="replace an existing bag")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+
+
+def read_table(path: str) -> dict[str, np.ndarray]:
+    """Variables of a .mat file or columns of a CSV with a header row, as float arrays."""
+    if not os.path.exists(path):
+        raise CablelabError(f"{path}: file not found")
+    if path.lower().endswith(".mat"):
+        import scipy.io
+
+        try:
+            raw = scipy.io.loadmat(path)
+        except Exception as exc:  # scipy raises several types for a bad file
+            raise CablelabError(f"{path}: cannot read MAT file ({exc})") from None
+        out = {}
+        for k, v in raw.items():
+            if k.startswith("__"):
+                continue
+            try:
+                out[k] = np.asarray(v, dtype=float).reshape(-1)
+            except (TypeError, ValueError):
+                continue
+        return out
+    try:
+        with open(path, encoding="utf-8") as fh:
+            header = fh.readline()
+        delim = ";" if header.count(";") > header.count(",") else ","
+        names = [h.strip().strip('"') for h in header.strip().split(delim)]
+        data = np.genfromtxt(path, delimiter=delim, skip_header=1, dtype=float, ndmin=2)
+    except (OSError, ValueError, UnicodeDecodeError) as exc:
+        raise CablelabError(f"{path}: cannot read CSV ({exc})") from None
+    if data.shape[1] != len(names):
+        raise CablelabError(f"{path}: header has {len(names)} names but rows have {data.shape[1]} values")
+    return {n: data[:, i] for i, n in enumerate(names)}
+
+
+def parse_spec(spec: str) -> dict[str, list[tuple[str, str]]]:
+    """``"time=t,effort=35.15*vir"`` -> ``{"time": [("*", "t")], "effort": [("*", "35.15"), ("*", "vir")]}``."""
+    out = {}
+    for part in spec.split(","):
+        if not part.strip():
+            continue
+        if "=" not in part:
+            raise CablelabError(f"--map {part!r}: expected FIELD=EXPRESSION (e.g. effort=35.15*vir)")
+        field, expr = (s.strip() for s in part.split("=", 1))
+        tokens = re.split(r"([*/])", expr.replace(" ", ""))
+        factors = [("*", tokens[0])] + [(tokens[i], tokens[i + 1]) for i in range(1, len(tokens) - 1, 2)]
+        if any(not f for _, f in factors):
+            raise CablelabError(f"--map {part!r}: empty factor in {expr!r}")
+        out[field] = factors
+    return out
+
+
+def evaluate(field: str, factors, table: dict[str, np.ndarray], source: str) -> np.ndarray:
+    """Product/quotient of numbers, scalar variables and exactly one column."""
+    value: np.ndarray | float = 1.0
+    series = 0
+    for op, name in factors:
+        try:
+            x: np.ndarray | float = float(name)
+        except ValueError:
+            if name not in table:
+                raise CablelabError(f"{source}: --map {field}: no column {name!r} (have: "
+                                    f"{', '.join(sorted(table))})") from None
+            x = table[name]
+            if x.size == 1:
+                x = float(x[0])
+            else:
+                series += 1
+        value = value * x if op == "*" else value / x
+    if series != 1:
+        raise CablelabError(f"{source}: --map {field}: expected exactly one column in the expression, "
+                            f"found {series}")
+    return np.asarray(value, dtype=float)
+
+
+def import_series(path: str, plant: str, spec: str) -> dict:
+    """Read ``path`` and evaluate ``spec`` into ``{"t", "names", "position", "velocity", "effort"}``
+    arrays (N, k) (None for an unmapped field)."""
+    table = read_table(path)
+    fields = parse_spec(spec)
+    topic, joints = JOINT_TOPICS[plant]
+    if "time" not in fields:
+        raise CablelabError(f"--map: missing 'time=' (e.g. time=t)")
+    t = evaluate("time", fields.pop("time"), table, path)
+    n = t.size
+    arrays = {f: None for f in FIELDS}
+    for key, factors in fields.items():
+        base, _, joint = key.partition(".")
+        if base not in FIELDS:
+            raise CablelabError(f"--map {key}: unknown field (allowed: time, {', '.join(FIELDS)})")
+        if not joint:
+            if len(joints) != 1:
+                raise CablelabError(f"--map {key}: plant {plant} has joints {', '.join(joints)}; "
+                                    f"write {base}.<joint>")
+            joint = joints[0]
+        if joint not in joints:
+            raise CablelabError(f"--map {key}: unknown joint {joint!r} (plant {plant}: {', '.join(joints)})")
+        v = evaluate(key, factors, table, path)
+        if v.size != n:
+            raise CablelabError(f"{path}: --map {key} has {v.size} samples, time has {n}")
+        if arrays[base] is None:
+            arrays[base] = np.full((n, len(joints)), np.nan)
+        arrays[base][:, joints.index(joint)] = v
+    if arrays["position"] is None and arrays["effort"] is None:
+        raise CablelabError("--map: map at least position and effort")
+    if not np.all(np.diff(t) > 0):
+        raise CablelabError(f"{path}: time column is not strictly increasing")
+    return {"topic": topic, "t": t, "names": list(joints), **arrays}
+
+
+def run(args) -> int:
+    from ..bags import BagWriter
+    from ..description import load_description
+    from ._workbench_args import dump_json
+
+    if not args.description:
+        raise CablelabError(f"import --plant {args.plant}: give --description FILE or YAML text "
+                            f"(e.g. \"{{plant: axis, axis: {{joint_type: prismatic}}}}\")")
+    desc = load_description(args.description)
+    if desc.plant != args.plant:
+        raise CablelabError(f"--description is for plant {desc.plant}, not --plant {args.plant}")
+    s = import_series(args.file, args.plant, args.map)
+    with BagWriter(args.out, overwrite=args.overwrite) as w:
+        w.write_description(desc.to_yaml(), t=float(s["t"][0]))
+        w.write_joint_states(s["topic"], s["t"], s["names"], s["position"], s["velocity"], s["effort"])
+    info = {"bag": args.out, "plant": args.plant, "topic": s["topic"], "samples": int(s["t"].size),
+            "duration": float(s["t"][-1] - s["t"][0])}
+    if args.json:
+        print(dump_json(info))
+    else:
+        print(f"wrote {args.out}: {info['samples']} {s['topic']} messages over {info['duration']:.3f} s")
+    return 0

@@ -1,0 +1,149 @@
+"""The workbench verbs as library functions (what ``cablelab compare/diagnose/identify`` print).
+
+Each takes a plant :class:`~cablelab.model.Dataset` and a :class:`~cablelab.model.Model` and
+returns a JSON-ready dict in the shape of CONTRACT section 5; :func:`load` turns a bag (+ optional
+description file) into (plant, description, dataset), :func:`build_model` a plant's baseline plus
+``--effects`` into a model.
+"""
+from __future__ import annotations
+
+from typing import Sequence
+
+import numpy as np
+
+from .conditioning import Conditioning
+from .diagnose import (channel_metrics, cv_error, derived_regimes, greedy, rank_candidates,
+                       residual_by_regime, whiteness, worst_segments)
+from .diagnose.ranking import ALPHA, FOLDS, MIN_GAIN
+from .errors import CablelabError
+from .fit import identify as _identify
+from .model import Dataset, Model
+
+
+def load(bag_path, description_path=None, options: dict | None = None):
+    """Open a bag, read its description (or the given file), check the plant's topics and build
+    the plant's dataset.
+
+    Returns:
+        ``(plant, description, dataset)``.
+    Raises:
+        CablelabError: unreadable bag, no description, missing topics (one line each).
+    """
+    from .bags import open_bag
+    from .description import load_description
+    from .plants import get_plant
+
+    bag = open_bag(bag_path)
+    if description_path:
+        desc = load_description(description_path)
+    else:
+        desc = bag.description
+        if desc is None:
+            raise CablelabError(f"{bag_path}: no /plant_description in the bag; give --description FILE")
+    plant = get_plant(desc.plant)
+    for topic, msgtype in plant.topics:
+        if not bag.has(topic):
+            have = ", ".join(sorted(bag.topics)) or "none"
+            raise CablelabError(f"{bag_path}: topic {topic} needed by plant {plant.name} is not in the "
+                                f"bag (topics: {have})")
+        bag.require(topic, msgtype)
+    ds = plant.dataset(bag, desc, dict(options or {}))
+    return plant, desc, ds
+
+
+def build_model(plant, desc, effects: Sequence[str] = (), baseline: Sequence[str] | None = None,
+                fixed: dict | None = None) -> Model:
+    """``baseline`` (default: the plant's nominal effects) + ``effects``, with known parameters."""
+    base = tuple(plant.baseline(desc)) if baseline is None else tuple(baseline)
+    effs = base + tuple(e for e in effects if e not in base)
+    return Model(plant.name, effs, dict(fixed or {}))
+
+
+def _effect_table(ident) -> dict:
+    return {row["name"]: {"value": row["value"], "stderr": row["stderr"], "unit": row["unit"],
+                          "fixed": row["fixed"]} for row in ident.table()}
+
+
+def compare(ds: Dataset, model: Model, *, segments: int = 5) -> dict:
+    """Inverse-model comparison: fit on the whole record, metrics per channel, worst segments,
+    residual by regime and whiteness. JSON of CONTRACT section 5 (``compare``) + extras."""
+    ident = _identify(model, ds)
+    y_meas = np.where(ident.valid[:, None], ident.residual + ident.y_hat, np.nan)
+    mets = channel_metrics(y_meas, ident.y_hat, ident.valid)
+    out: dict = {"plant": ds.plant, "effects": list(model.effects), "samples": int(ident.valid.sum())}
+    out["channels"] = {}
+    for ch, m in zip(ds.channels, mets):
+        out["channels"][ch] = m
+        out.setdefault(ch, m)
+    out["worst_segments"] = worst_segments(ds.t, ident.residual, y_meas, ds.channels, count=segments)
+    out["params"] = _effect_table(ident)
+    out["regimes"] = residual_by_regime(ident.residual, y_meas, derived_regimes(ds), ds.channels)
+    out["whiteness"] = {ch: _whiteness_summary(ident.residual[:, c], ds.inputs)
+                        for c, ch in enumerate(ds.channels)}
+    out["rank"], out["condition"] = ident.linear.rank, ident.linear.cond
+    return out
+
+
+def _whiteness_summary(res, inputs) -> dict:
+    w = whiteness(res, inputs)
+    return {"band": w["band"], "white": w["white"], "autocorr_outside": w["outside"],
+            "autocorr_lag1": w["autocorr"][1] if len(w["autocorr"]) > 1 else None,
+            "cross": {k: {"outside": v["outside"], "uncorrelated": v["uncorrelated"],
+                          "max_abs": float(np.max(np.abs(v["xcorr"])))} for k, v in w["cross"].items()}}
+
+
+def identify(ds: Dataset, model: Model, *, folds: int = FOLDS) -> dict:
+    """Identified parameters with standard errors, rank/condition, in-sample and held-out fit."""
+    ident = _identify(model, ds)
+    y_meas = np.where(ident.valid[:, None], ident.residual + ident.y_hat, np.nan)
+    mets = channel_metrics(y_meas, ident.y_hat, ident.valid)
+    cv = cv_error(model, ds, folds)[0] if folds else None
+    return {
+        "plant": ds.plant, "effects": list(model.effects), "samples": int(ident.valid.sum()),
+        "params": _effect_table(ident),
+        "fit": {"nrmse": float(np.mean([m["nrmse"] for m in mets])), "cv_nrmse": cv, "folds": folds,
+                "channels": dict(zip(ds.channels, mets)), "rank": ident.linear.rank,
+                "parameters": len(ident.linear.names), "condition": ident.linear.cond,
+                "unidentifiable": ident.linear.unidentifiable,
+                "active_bounds": ident.linear.active_bounds},
+    }
+
+
+def diagnose(ds: Dataset, model: Model, candidates: Sequence[str], *, folds: int = FOLDS,
+             alpha: float = ALPHA, min_gain: float = MIN_GAIN, greedy_mode: bool = False,
+             quiet: bool = True) -> dict:
+    """Rank the missing effects (CONTRACT section 5 ``diagnose``); with ``greedy_mode`` also the
+    waterfall of significant effects added one at a time."""
+    cands = [c for c in candidates if c not in model.effects]
+    if greedy_mode:
+        steps = greedy(model, ds, cands, folds=folds, alpha=alpha, min_gain=min_gain, quiet=quiet)
+        first = steps[0]
+        out = {"plant": ds.plant, "baseline": {"effects": first["effects"], "error": first["error"]},
+               "ranking": [_row(r) for r in first["ranking"]], "folds": folds,
+               "greedy": [{"effects": s["effects"], "added": s["added"], "error": s["error"],
+                           "params": s["params"], "stderr": s["stderr"], "units": s["units"],
+                           "ranking": [_row(r) for r in s["ranking"]]} for s in steps]}
+        out["final"] = {"effects": steps[-1]["effects"], "error": steps[-1]["error"],
+                        "params": steps[-1]["params"], "stderr": steps[-1]["stderr"]}
+        return out
+    d = rank_candidates(model, ds, cands, folds=folds, alpha=alpha, min_gain=min_gain, quiet=quiet)
+    return {"plant": ds.plant, "baseline": {"effects": list(model.effects), "error": d.error},
+            "ranking": [_row(r) for r in d.ranking], "folds": folds}
+
+
+def _row(r: dict) -> dict:
+    keys = ("effect", "error_before", "error_after", "params", "significant", "stderr", "units",
+            "p_value", "delta_bic", "n_eff", "gain", "explanation")
+    return {k: r[k] for k in keys if k in r}
+
+
+def conditioning_from_args(args) -> Conditioning:
+    """Build :class:`Conditioning` from the shared CLI options."""
+    kw = {}
+    if getattr(args, "cutoff", None) is not None:
+        kw["cutoff_hz"] = args.cutoff
+    if getattr(args, "decimate", None):
+        kw["decimate"] = args.decimate
+    if getattr(args, "border", None) is not None:
+        kw["border"] = args.border
+    return Conditioning(**kw)
