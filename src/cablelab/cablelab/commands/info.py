@@ -9,18 +9,22 @@ HELP = "show a bag's topics, message counts, duration and plant description"
 def add_arguments(p) -> None:
     p.add_argument("bag", help="rosbag2 directory or its .mcap file")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--recover", action="store_true",
+                   help="read an unfinished bag (recorder killed) up to its last complete chunk")
 
 
 def run(args) -> int:
     from ..bags import bag_info
 
-    info = bag_info(args.bag)
+    info = bag_info(args.bag, recover=args.recover)
     if args.json:
         print(json.dumps(info))
     else:
         print(f"bag:      {info['path']}\nduration: {info['duration']:.3f} s\nmessages: {info['messages']}")
         for t in info["topics"]:
             print(f"  {t['name']:<40} {t['type']:<40} {t['count']:>9}")
+        if info.get("recovered"):
+            print("note:     unfinished bag, read up to its last complete chunk")
         if info.get("plant"):
             print(f"plant:    {info['plant']}")
     return 0

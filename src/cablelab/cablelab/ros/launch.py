@@ -132,9 +132,9 @@ class Launcher:
         return {name: self.stop(name, grace) for name in reversed(list(self.procs))}
 
     def check_alive(self) -> None:
-        """CablelabError naming a process that died, with the end of its log."""
+        """CablelabError naming a process that failed (exit code != 0), with the end of its log."""
         for proc in self.procs.values():
-            if not proc.alive():
+            if not proc.alive() and proc.popen.returncode != 0:
                 tail = " | ".join(proc.log().strip().splitlines()[-5:])
                 raise CablelabError(f"process {proc.name} exited with {proc.popen.returncode}: {tail}")
 
