@@ -9,7 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .cdpr_geometry import CableGeometry, cable_wrench
+from .cdpr_geometry import CableGeometry, cable_wrench, cross
 
 __all__ = ["MassCom", "mass_com", "mass_com_from_wrench", "tensions_from_torques",
            "torques_from_tensions", "winch_friction"]
@@ -53,6 +53,15 @@ def mass_com_from_wrench(wrench: np.ndarray, gravity: float = 9.81,
     """
     w = np.atleast_2d(np.asarray(wrench, dtype=float))
     F, M = w[:, :3], w[:, 3:]
+    if acceleration is None and rotation is None:
+        # static, level platform: 001 eq. 13 as printed (z_G drops out, its moment is zero)
+        m = F[:, 2] / gravity
+        mg = F[:, 2]
+        com = np.empty((len(m), 2))
+        com[:, 0] = -M[:, 1] / mg
+        com[:, 1] = M[:, 0] / mg
+        res = np.sqrt(F[:, 0] ** 2 + F[:, 1] ** 2 + M[:, 2] ** 2)
+        return MassCom(m, com, res)
     f = np.zeros_like(F)
     f[:, 2] = gravity
     if acceleration is not None:
@@ -64,9 +73,9 @@ def mass_com_from_wrench(wrench: np.ndarray, gravity: float = 9.81,
     else:
         Rm = np.broadcast_to(np.asarray(rotation, dtype=float), (len(m), 3, 3))
     # moment = m (c_w x f), c_w = x_G R e_x + y_G R e_y + z_G R e_z: linear in (x_G, y_G)
-    Mr = M / np.where(np.abs(m) > 1e-9, m, np.nan)[:, None] - com_z * np.cross(Rm[:, :, 2], f)
-    a1 = np.cross(Rm[:, :, 0], f)
-    a2 = np.cross(Rm[:, :, 1], f)
+    Mr = M / np.where(np.abs(m) > 1e-9, m, np.nan)[:, None] - com_z * cross(Rm[:, :, 2], f)
+    a1 = cross(Rm[:, :, 0], f)
+    a2 = cross(Rm[:, :, 1], f)
     a11 = np.einsum("ti,ti->t", a1, a1)
     a22 = np.einsum("ti,ti->t", a2, a2)
     a12 = np.einsum("ti,ti->t", a1, a2)
@@ -76,7 +85,7 @@ def mass_com_from_wrench(wrench: np.ndarray, gravity: float = 9.81,
     xg = (a22 * r1 - a12 * r2) / det
     yg = (a11 * r2 - a12 * r1) / det
     c = np.stack([xg, yg], -1)
-    model_M = m[:, None] * (xg[:, None] * a1 + yg[:, None] * a2 + com_z * np.cross(Rm[:, :, 2], f))
+    model_M = m[:, None] * (xg[:, None] * a1 + yg[:, None] * a2 + com_z * cross(Rm[:, :, 2], f))
     res = np.sqrt(np.sum((F - m[:, None] * f) ** 2, 1) + np.sum((M - model_M) ** 2, 1))
     return MassCom(m, c, res)
 

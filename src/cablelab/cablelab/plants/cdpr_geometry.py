@@ -23,7 +23,7 @@ import numpy as np
 
 __all__ = [
     "CableGeometry", "cable_geometry", "wrench_matrix", "cable_wrench", "quat_to_matrix",
-    "matrix_to_quat", "swivel_reference",
+    "matrix_to_quat", "cross", "swivel_reference",
 ]
 
 
@@ -52,6 +52,17 @@ class CableGeometry:
     wrap_angles: np.ndarray
     swivel_angles: np.ndarray
     tangent_points: np.ndarray
+
+
+def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Cross product over the last axis (broadcasting), without np.cross's per-call overhead."""
+    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
+    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape))
+    out[..., 0] = a1 * b2 - a2 * b1
+    out[..., 1] = a2 * b0 - a0 * b2
+    out[..., 2] = a0 * b1 - a1 * b0
+    return out
 
 
 def quat_to_matrix(q: np.ndarray) -> np.ndarray:
@@ -125,7 +136,7 @@ def cable_geometry(exit_points: np.ndarray, anchor_points: np.ndarray, position:
     h = np.sqrt(np.einsum("tni,tni->tn", dh, dh))
     xp = dh / np.maximum(h, 1e-12)[..., None]                # x_p of 001 eq. 6
     ref = swivel_reference(z)
-    swivel = np.arctan2(np.einsum("tni,ni->tn", xp, np.cross(z, ref)), np.einsum("tni,ni->tn", xp, ref))
+    swivel = np.arctan2(np.einsum("tni,ni->tn", xp, cross(z, ref)), np.einsum("tni,ni->tn", xp, ref))
     r = float(pulley_radius)
     if r <= 0.0:
         L = np.sqrt(h * h + dz * dz)
@@ -152,7 +163,7 @@ def wrench_matrix(geom: CableGeometry) -> np.ndarray:
     """(N, 6, n) wrench matrix W of 001 eq. 4 (Model I) or eq. 7 (Model II): columns
     [d_i; (R b_i) x d_i], forces in N and moments in N m about the platform origin, world axes."""
     d = geom.directions
-    return np.concatenate([d, np.cross(geom.anchors, d)], axis=-1).transpose(0, 2, 1)
+    return np.concatenate([d, cross(geom.anchors, d)], axis=-1).transpose(0, 2, 1)
 
 
 def cable_wrench(geom: CableGeometry, tensions: np.ndarray) -> np.ndarray:
@@ -163,4 +174,4 @@ def cable_wrench(geom: CableGeometry, tensions: np.ndarray) -> np.ndarray:
         tensions: (N, n) cable tensions, N.
     """
     f = geom.directions * np.asarray(tensions, dtype=float)[..., None]
-    return np.concatenate([f.sum(1), np.cross(geom.anchors, f).sum(1)], axis=-1)
+    return np.concatenate([f.sum(1), cross(geom.anchors, f).sum(1)], axis=-1)
