@@ -59,16 +59,22 @@ class Layout:
         strings: path -> text of every string field (``"name[2]"``, ``"header.frame_id"``)
         seqlen: path -> number of elements of every sequence
         size: total length in bytes
+        end: where the message's last field ends (bytes after it are padding, possibly
+            uninitialised: rmw_fastrtps sizes a message with 8 bytes of alignment per empty
+            float64 sequence that the serialiser does not write)
     """
 
     spans: dict[str, tuple[int, int, str]] = field(default_factory=dict)
     strings: dict[str, str] = field(default_factory=dict)
     seqlen: dict[str, int] = field(default_factory=dict)
     size: int = 0
+    end: int = 0
 
     def numeric_mask(self) -> np.ndarray:
-        """Boolean mask (size,) that is True on bytes holding numeric leaf values."""
+        """Boolean mask (size,) that is True on bytes that do not determine the layout: numeric
+        leaf values and the trailing padding."""
         mask = np.zeros(self.size, dtype=bool)
+        mask[self.end:] = True
         for off, count, dt in self.spans.values():
             mask[off:off + count * int(dt[-1])] = True
         return mask
@@ -150,10 +156,11 @@ def walk(msgtype: str, buf: bytes) -> Layout:
     """
     w = _Walker(buf)
     w.message(msgtype)
-    # trailing padding up to 4 bytes is allowed (rmw pads messages to a multiple of 4)
-    if not (w.pos <= len(buf) <= w.pos + 8):
+    # trailing padding: rmw_fastrtps reserves 8 bytes per empty sequence (see Layout.end)
+    if not (w.pos <= len(buf) <= w.pos + 8 * (1 + len(w.out.seqlen))):
         raise ValueError(f"message has {len(buf)} bytes, layout of {msgtype} needs {w.pos}")
     w.out.size = len(buf)
+    w.out.end = w.pos
     return w.out
 
 
