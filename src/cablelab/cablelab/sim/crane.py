@@ -13,9 +13,8 @@ Tree (qpos = [alpha, beta, psi, phi, d]):
 
 Truth switches: base tilt (gravity rotated in the base frame, 002 sec. 6.5), joint viscous
 (``damping``) and Coulomb (``frictionloss``) friction, torque sensor offset, motion-capture noise
-and dropouts. Actuators are general actuators ``force = ctrl - kp q - kd qd`` (kp = kd = 0: a pure
-torque/force motor); with gains the open-loop ``ctrl = kp q_ref + kd qd_ref + tau_ff`` makes the
-PD + feedforward of 002 sec. 5.3.1 run inside :func:`mujoco.rollout`.
+and dropouts. Actuators are torque/force motors (``ctrl`` = slew N m, luff N m, hoist N);
+:func:`simulate` closes the loop of 002 sec. 5.3.1 around them.
 """
 from __future__ import annotations
 
@@ -28,7 +27,8 @@ from ..plants.crane_kinematics import gimbal_rates_to_swing, gimbal_to_swing, sw
 from ..plants.crane_model import CraneParams, gravity_vector, mass_matrix
 
 __all__ = ["CraneTruth", "build_model", "set_state", "gravity_in_base", "simulate", "SimResult",
-           "reference_trajectory", "QPOS"]
+           "reference_trajectory", "QPOS", "contract_acceleration", "truth_accelerations",
+           "contract_to_qpos", "qpos_to_contract", "DEFAULT_KP", "DEFAULT_KD"]
 
 QPOS = ("slew", "luff", "swing_y", "swing_x", "hoist")
 
@@ -229,8 +229,11 @@ def simulate(truth: CraneTruth, duration: float, *, decimate: int = 10, seed: in
              kp=DEFAULT_KP, kd=DEFAULT_KD) -> SimResult:
     """Closed-loop run of the crane tracking ``reference`` under PD + gravity/acceleration FF.
 
-    The control loop runs inside :func:`mujoco.rollout` (PD in the actuator bias, feedforward
-    ``G_a(q_ref) + M_aa(q_ref) qdd_ref`` of 002 sec. 5.3.1 from ``model_params`` precomputed).
+    The controller of 002 sec. 5.3.1 (``Kp e + Kd e_dot + G_a(q_ref) + M_aa(q_ref) qdd_ref``, the
+    feedforward precomputed along the reference from ``model_params``) runs at every MuJoCo step
+    with a zero-order hold, so the recorded effort is exactly the force the joint felt. (A PD in
+    the actuator bias would let MuJoCo integrate the velocity-dependent part differently from the
+    force it reports, which shows up as a spurious viscous friction in identification.)
 
     Args:
         truth: simulated crane and truth effects.
@@ -249,22 +252,27 @@ def simulate(truth: CraneTruth, duration: float, *, decimate: int = 10, seed: in
     q5[:, :3] = q_ref
     G = gravity_vector(q5, mp)[:, :3]
     M = mass_matrix(q5, mp)[:, :3, :3]
-    ff = G + np.einsum("nij,nj->ni", M, qdd_ref)
     kp, kd = np.asarray(kp, float), np.asarray(kd, float)
-    ctrl = kp * q_ref + kd * qd_ref + ff
-    model = build_model(truth, kp, kd)
+    u0 = G + np.einsum("nij,nj->ni", M, qdd_ref) + kp * q_ref + kd * qd_ref
+    model = build_model(truth)
     data = mujoco.MjData(model)
     set_state(model, data, [q_ref[0, 0], q_ref[0, 1], q_ref[0, 2], 0.0, 0.0])
-    spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
-    x0 = np.empty(mujoco.mj_stateSize(model, spec))
-    mujoco.mj_getState(model, data, x0, spec)
-    from mujoco import rollout
-    state, sens = rollout.rollout(model, data, x0[None], ctrl[None])
-    sens = sens[0][::decimate]
-    # state row k is after step k: the state whose sensors are row k+1
-    st = np.concatenate([x0[None], state[0][:-1]])[::decimate]
-    qpos, qvel = st[:, 1:1 + model.nq], st[:, 1 + model.nq:1 + model.nq + model.nv]
-    tt = t[::decimate]
+    idx = np.array([0, 1, 4])
+    rec = np.arange(0, n, decimate)
+    m = rec.shape[0]
+    qpos, qvel = np.empty((m, model.nq)), np.empty((m, model.nv))
+    sens = np.empty((m, model.nsensordata))
+    j = 0
+    for k in range(n):  # the control loop (feedback at every step, zero-order hold)
+        u = u0[k] - kp * data.qpos[idx] - kd * data.qvel[idx]
+        data.ctrl[:] = u
+        if k % decimate == 0:
+            qpos[j], qvel[j] = data.qpos, data.qvel
+        mujoco.mj_step(model, data)
+        if k % decimate == 0:
+            sens[j] = data.sensordata  # computed at the state before the step
+            j += 1
+    tt = t[rec]
     q, qd = qpos_to_contract(qpos, qvel)
     rng = np.random.default_rng(seed)
     motor = sens[:, 6:9]
@@ -278,5 +286,35 @@ def simulate(truth: CraneTruth, duration: float, *, decimate: int = 10, seed: in
         tip[lost] = np.nan
         pay[lost] = np.nan
     return SimResult(t=tt, q=q, qd=qd, effort=effort, motor=motor, tip=tip, payload=pay,
-                     tip_quat=tipq, payload_quat=payq, q_ref=q_ref[::decimate],
-                     qd_ref=qd_ref[::decimate], qdd_ref=qdd_ref[::decimate], qpos=qpos, qvel=qvel)
+                     tip_quat=tipq, payload_quat=payq, q_ref=q_ref[rec],
+                     qd_ref=qd_ref[rec], qdd_ref=qdd_ref[rec], qpos=qpos, qvel=qvel)
+
+
+def contract_acceleration(qpos, qvel, qacc, step: float = 1e-6) -> np.ndarray:
+    """(N, 5) contract qdd = J qacc + Jdot qvel of the gimbal -> swing map (vectorised).
+
+    J a is :func:`gimbal_rates_to_swing` (exact, linear in the rates); Jdot v is its directional
+    derivative along v by a central difference of step ``step`` (relative error ~1e-10).
+    """
+    qpos, qvel, qacc = (np.atleast_2d(np.asarray(x, dtype=float)) for x in (qpos, qvel, qacc))
+
+    def rates(x, v):
+        return np.stack(gimbal_rates_to_swing(x[:, 1], x[:, 2], x[:, 3], v[:, 1], v[:, 2], v[:, 3]), 1)
+
+    ja = rates(qpos, qacc)
+    jdv = (rates(qpos + step * qvel, qvel) - rates(qpos - step * qvel, qvel)) / (2 * step)
+    sw = ja + jdv
+    return np.stack([qacc[:, 0], qacc[:, 1], qacc[:, 4], sw[:, 0], sw[:, 1]], axis=1)
+
+
+def truth_accelerations(truth: CraneTruth, res: SimResult) -> np.ndarray:
+    """(N, 5) exact contract accelerations of a :class:`SimResult` (MuJoCo forward dynamics at
+    each recorded state with the recorded motor efforts; ground truth for tests and benchmarks)."""
+    model = build_model(truth)
+    data = mujoco.MjData(model)
+    qacc = np.empty_like(res.qvel)
+    for k in range(res.qpos.shape[0]):  # MuJoCo has no batched mj_forward; ground truth only
+        data.qpos[:], data.qvel[:], data.ctrl[:] = res.qpos[k], res.qvel[k], res.motor[k]
+        mujoco.mj_forward(model, data)
+        qacc[k] = data.qacc
+    return contract_acceleration(res.qpos, res.qvel, qacc)
