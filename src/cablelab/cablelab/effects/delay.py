@@ -1,11 +1,14 @@
 """Constant delay between actuation and measurement (any plant); a nonlinear parameter.
 
 Convention: the effort the model computes from the motion at time t appears in the measurement
-at t + tau, i.e. ``y_meas(t) = y_model(t - tau)``. The effect compares ``y_meas(t + tau)`` (linear
-interpolation) with ``y_model(t)``; samples whose shifted time leaves the record or falls in a gap
-of the time axis are marked invalid. tau < 0 means the measurement leads the motion (typical when
-the "effort" is a controller command). tau is found by a bounded outer search around the linear
-least squares (separable least squares, see :mod:`cablelab.fit.identify`).
+at t + tau, i.e. ``y_meas(t) = y_model(t - tau)``. The effect evaluates the model on the motion
+signals shifted to ``t - tau`` (linear interpolation of every time-indexed signal, actuator
+velocity and map); samples whose shifted time leaves the record or crosses a gap of the time axis
+are marked invalid. The measurement itself is never interpolated: interpolating a noisy signal
+at a fractional shift averages neighbouring samples and would "explain" white noise as a delay.
+tau < 0 means the measurement leads the motion (typical when the "effort" is a controller
+command). tau is found by a bounded outer search around the linear least squares (separable least
+squares, see :mod:`cablelab.fit.identify`).
 """
 from __future__ import annotations
 
@@ -20,37 +23,41 @@ from . import register
 DELAY_BOUNDS = (-0.05, 0.05)
 
 
-def shift_time(t: np.ndarray, y: np.ndarray, tau: float) -> tuple[np.ndarray, np.ndarray]:
-    """``y(t + tau)`` by linear interpolation, and the mask where it is defined.
-
-    Args:
-        t: (N,) increasing times, s (gaps allowed: more than 1.5 median periods).
-        y: (N, C) samples.
-        tau: shift, s.
-    Returns:
-        (y_shift (N, C), ok (N,) bool).
-    """
+def shift_weights(t: np.ndarray, tau: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Interpolation of samples at ``t - tau``: indices i, weights w (value = (1-w) x[i] + w x[i+1])
+    and the mask where it is defined (inside the record, not across a gap)."""
     n = t.shape[0]
-    ts = t + tau
+    ts = t - tau
     i = np.clip(np.searchsorted(t, ts, side="right") - 1, 0, n - 2)
     t0, t1 = t[i], t[i + 1]
-    w = (ts - t0) / np.where(t1 > t0, t1 - t0, 1.0)
-    ys = y[i] * (1.0 - w)[:, None] + y[i + 1] * w[:, None]
+    w = np.clip((ts - t0) / np.where(t1 > t0, t1 - t0, 1.0), 0.0, 1.0)
     dt = np.median(np.diff(t)) if n > 1 else 1.0
     ok = (ts >= t[0]) & (ts <= t[-1]) & ((t1 - t0) <= 1.5 * dt)
-    # the shift must not jump over a gap between t and t + tau either
-    # (with no gap the index distance matches the time shift)
-    k = np.arange(n)
-    ok &= np.abs(i - k) * dt >= abs(tau) - 2.0 * dt
-    return ys, ok
+    # with no gap between t and t - tau the index distance matches the time shift
+    ok &= np.abs(i - np.arange(n)) * dt >= abs(tau) - 2.0 * dt
+    return i, w, ok
+
+
+def shift_array(x: np.ndarray, i: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """Linear interpolation of an (N, ...) array with :func:`shift_weights` along axis 0."""
+    wb = w.reshape((-1,) + (1,) * (x.ndim - 1))
+    return x[i] * (1.0 - wb) + x[i + 1] * wb
 
 
 def _transform(ds: Dataset, values: Mapping[str, float]) -> Dataset:
     tau = float(values.get("tau", 0.0))
-    if tau == 0.0:
+    if tau == 0.0 or ds.n < 2:
         return ds
-    ys, ok = shift_time(ds.t, ds.y, tau)
-    return ds.replace(y=ys, valid=ds.valid & ok)
+    i, w, ok = shift_weights(ds.t, tau)
+    n = ds.n
+
+    def sh(v):
+        if isinstance(v, np.ndarray) and v.ndim >= 1 and v.shape[0] == n and v.dtype.kind == "f":
+            return shift_array(v, i, w)
+        return v
+
+    return ds.replace(signals={k: sh(v) for k, v in ds.signals.items()}, act_vel=sh(ds.act_vel),
+                      act_map=sh(ds.act_map), valid=ds.valid & ok)
 
 
 TIME_DELAY = register(Effect(

@@ -136,7 +136,7 @@ def identify(model: Model, ds: Dataset, *, on_deficient: str = "raise",
 
         step = np.array([(b - a) / (outer_grid - 1) for a, b in zip(lo, hi)])
         x_best, _ = mjmin.least_squares(x0, residual, bounds=[lo, hi], verbose=0,
-                                        x_scale=step, max_iter=50)
+                                        x_scale=step, max_iter=20, xtol=1e-4)
         x_best = np.clip(np.asarray(x_best).reshape(-1), lo, hi)
         if cost(x_best) > cost(x0):
             x_best = x0
@@ -199,10 +199,15 @@ class _OuterProblem:
 
     def __init__(self, model: Model, ds: Dataset, valid: np.ndarray, names: list[str]):
         self.model, self.ds, self.valid, self.names = model, ds, valid, names
-        nominal = {p.name: p.nominal for p in model.nonlinear_params()}
+        nl = model.nonlinear_params()
+        nominal = {p.name: p.nominal for p in nl}
         ds0 = model.apply_nonlinear(ds, nominal)
-        self.constant = (ds0.signals is ds.signals and ds0.act_map is ds.act_map
-                         and ds0.act_vel is ds.act_vel)
+        # probe away from the nominal point: do the transforms touch the regressor inputs?
+        probe = {p.name: (0.5 * (p.nominal + p.upper) if np.isfinite(p.upper) else p.nominal + 1.0)
+                 if p.upper != p.nominal else 0.5 * (p.nominal + p.lower) for p in nl}
+        dsp = model.apply_nonlinear(ds, probe)
+        self.constant = all(dsp.signals.get(k) is v for k, v in ds0.signals.items()) and \
+            dsp.act_map is ds0.act_map and dsp.act_vel is ds0.act_vel
         phi, self.cols, self.y_known = model.regressor(ds0)
         fit0 = solve_linear(phi, ds0.y - self.y_known, self.cols, valid=valid, bounded=False)
         self.w = fit0.channel_scale
