@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import os
 import shutil
+import struct
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -203,18 +204,22 @@ class Bag:
             complete record
     """
 
-    def __init__(self, path, topics: dict[str, str], times: dict[str, np.ndarray],
-                 raws: dict[str, list], recovered: bool = False):
+    def __init__(self, path, topics: dict[str, str], times: dict[str, np.ndarray], buffer,
+                 offsets: dict[str, np.ndarray], lengths: dict[str, np.ndarray],
+                 recovered: bool = False):
         self.path = str(path)
         self.topics = dict(topics)
         self._times = times
-        self._raws = raws
-        self.counts = {name: len(raws.get(name, ())) for name in topics}
+        self._buffer = memoryview(buffer)
+        self._offsets = offsets
+        self._lengths = lengths
+        self._raws: dict[str, list[bytes]] = {}
+        self.counts = {name: int(len(times.get(name, ()))) for name in topics}
         all_t = [a for a in times.values() if len(a)]
         self.start = float(min(a[0] for a in all_t)) * 1e-9 if all_t else 0.0
         self.end = float(max(a[-1] for a in all_t)) * 1e-9 if all_t else 0.0
         self.recovered = recovered
-        self._cache: dict[str, object] = {}
+        self._cache: dict[object, object] = {}
 
     def __repr__(self) -> str:
         return f"Bag({self.path!r}, {len(self.topics)} topics, {sum(self.counts.values())} messages)"
@@ -237,6 +242,10 @@ class Bag:
         """(log times in ns (N,), serialised CDR messages) of a topic, sorted by log time."""
         if topic not in self.topics:
             self.require(topic, "")
+        if topic not in self._raws:
+            buf = self._buffer
+            self._raws[topic] = [bytes(buf[o:o + n]) for o, n in
+                                 zip(self._offsets[topic].tolist(), self._lengths[topic].tolist())]
         return self._times[topic], self._raws[topic]
 
     def messages(self, topic: str) -> list:
@@ -249,7 +258,8 @@ class Bag:
         self.require(topic, msgtype)
         key = (topic, msgtype)
         if key not in self._cache:
-            self._cache[key] = cdr.decode(msgtype, self._raws[topic], topic=topic)
+            self._cache[key] = cdr.decode_buffer(msgtype, self._buffer, self._offsets[topic],
+                                                 self._lengths[topic], topic=topic)
         return self._cache[key]
 
     def _log_s(self, topic: str) -> np.ndarray:
@@ -454,6 +464,20 @@ def open_bag(path, *, recover: bool = False) -> Bag:
                                         "read its complete part with --recover")
         topics, times, raws = _read_stream(mcap_file)
         return _make_bag(given, topics, times, raws, recovered=True)
+    if target.is_dir():
+        _check_metadata(target)
+    if mcap_file is not None:
+        from .mcap_index import read_index
+
+        try:
+            index = read_index(mcap_file)
+        except (struct.error, ValueError, IndexError, OSError):
+            index = None
+        if index is not None:
+            ti = index.topics
+            return Bag(given, {k: v.msgtype for k, v in ti.items()},
+                       {k: v.log_time for k, v in ti.items()}, index.buffer,
+                       {k: v.offset for k, v in ti.items()}, {k: v.length for k, v in ti.items()})
 
     from rosbags.rosbag2 import Reader
 
@@ -474,16 +498,34 @@ def open_bag(path, *, recover: bool = False) -> Bag:
     return _make_bag(given, topics, times, raws)
 
 
+def _check_metadata(bag_dir: Path) -> None:
+    """metadata.yaml must be a rosbag2 bag description (one-line error otherwise)."""
+    import yaml
+
+    meta = bag_dir / "metadata.yaml"
+    try:
+        data = yaml.safe_load(meta.read_text(encoding="utf-8"))
+    except (OSError, UnicodeError, yaml.YAMLError) as exc:
+        raise _bag_error(meta, f"unreadable metadata ({type(exc).__name__})") from None
+    if not isinstance(data, dict) or "rosbag2_bagfile_information" not in data:
+        raise _bag_error(meta, "not rosbag2 metadata (no rosbag2_bagfile_information)")
+
+
 def _make_bag(path, topics, times, raws, recovered: bool = False) -> Bag:
-    tarr = {}
+    """A Bag from per-topic lists of log times and serialised messages."""
+    tarr, offsets, lengths, chunks = {}, {}, {}, []
+    pos = 0
     for name in topics:
         t = np.asarray(times.get(name, []), dtype=np.int64)
         order = np.argsort(t, kind="stable")
-        if len(order) and np.any(order != np.arange(len(order))):
-            raws[name] = [raws[name][i] for i in order]
-            t = t[order]
-        tarr[name] = t
-    return Bag(path, topics, tarr, raws, recovered=recovered)
+        msgs = [raws[name][i] for i in order] if len(order) else []
+        n = np.fromiter((len(m) for m in msgs), dtype=np.int64, count=len(msgs))
+        offsets[name] = pos + np.concatenate([[0], np.cumsum(n)[:-1]]).astype(np.int64) if len(n) else n
+        lengths[name] = n
+        tarr[name] = t[order]
+        chunks.extend(msgs)
+        pos += int(n.sum())
+    return Bag(path, topics, tarr, b"".join(chunks), offsets, lengths, recovered=recovered)
 
 
 def bag_info(path, *, recover: bool = False) -> dict:

@@ -201,19 +201,30 @@ def decode(msgtype: str, raws: list[bytes], *, topic: str = "", max_layouts: int
     Raises:
         CablelabError: a message is not a valid ``msgtype`` (names the topic and message index).
     """
-    if not raws:
-        return []
     lengths = np.fromiter((len(r) for r in raws), dtype=np.int64, count=len(raws))
+    offsets = np.concatenate([[0], np.cumsum(lengths)[:-1]]).astype(np.int64) if len(raws) else lengths
+    return decode_buffer(msgtype, memoryview(b"".join(raws)), offsets, lengths, topic=topic,
+                         max_layouts=max_layouts)
+
+
+def decode_buffer(msgtype: str, buf, offsets: np.ndarray, lengths: np.ndarray, *, topic: str = "",
+                  max_layouts: int = 64) -> list[Group]:
+    """:func:`decode` of messages stored at ``buf[offsets[i]:offsets[i] + lengths[i]]``."""
+    if len(offsets) == 0:
+        return []
+    buf = memoryview(buf)
     groups: list[Group] = []
     for L in np.unique(lengths):
+        L = int(L)
         idx = np.flatnonzero(lengths == L)
-        mat = np.frombuffer(b"".join([raws[i] for i in idx]), dtype=np.uint8).reshape(len(idx), int(L))
+        joined = b"".join([buf[o:o + L] for o in offsets[idx].tolist()])
+        mat = np.frombuffer(joined, dtype=np.uint8).reshape(len(idx), L)
         remaining = np.arange(len(idx))
         while remaining.size:
             first = remaining[0]
             try:
                 layout = walk(msgtype, bytes(mat[first]))
-            except (ValueError, KeyError, UnicodeError) as exc:
+            except (ValueError, KeyError, UnicodeError, struct.error) as exc:
                 raise CablelabError(f"{topic or msgtype}: message {int(idx[first])} is not a valid "
                                     f"{msgtype} ({exc})") from None
             if len(groups) >= max_layouts:
@@ -221,7 +232,7 @@ def decode(msgtype: str, raws: list[bytes], *, topic: str = "", max_layouts: int
                 match[0] = True
             else:
                 struct_cols = np.flatnonzero(~layout.numeric_mask())
-                sub = mat[remaining][:, struct_cols]
+                sub = (mat if remaining.size == len(mat) else mat[remaining])[:, struct_cols]
                 match = (sub == mat[first, struct_cols]).all(axis=1)
             rows = remaining[match]
             groups.append(Group(rows=idx[rows], layout=layout, mat=mat[rows]))
