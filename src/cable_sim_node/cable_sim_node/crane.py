@@ -1,0 +1,118 @@
+"""Crane simulator node: the MuJoCo boom crane of 002 driven by ``/crane/effort_commands``.
+
+Publishes (CONTRACT sec. 2) ``/crane/joint_states`` (slew, luff, hoist: position, velocity, effort
+= applied command + sensor offset + noise), the motion-capture poses ``/crane/boom_tip_pose`` and
+``/crane/payload_pose`` (noise, NaN dropouts), ``/crane/ground_truth/swing`` (theta1, theta2,
+rope_length), ``/clock`` and ``/plant_description`` (transient-local). Physics:
+:class:`cablelab.sim.crane.CraneSim`.
+
+ROS parameters: ``description`` (YAML file or text; default ``cablelab/data/crane.yaml``),
+``slew_inertia``, ``luff_inertia`` (kg m^2), truth switches ``base_tilt`` [x, y] rad,
+``viscous`` / ``coulomb`` / ``offset`` [slew, luff, hoist], ``mocap_noise`` (m),
+``mocap_dropout`` (probability), ``timestep`` (s), ``rate`` (Hz of publishing = command
+sampling), ``command_timeout`` (s wall). Without a fresh command the drives hold the crane
+(gravity compensation + damping, like a brake) and the node reports WARN on /diagnostics.
+"""
+from __future__ import annotations
+
+import os
+import time
+
+import numpy as np
+from geometry_msgs.msg import PoseStamped
+from rclpy.node import Node
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import JointState
+from std_msgs.msg import Float64MultiArray, String
+
+from cablelab.description import load_description
+from cablelab.errors import CablelabError
+from cablelab.plants.crane_control import hold_command
+from cablelab.plants.crane_model import JOINTS, CraneParams
+from cablelab.ros import convert
+from cablelab.ros.diagnostics import Diagnostics
+from cablelab.ros.inputs import InputMonitor
+from cablelab.ros.qos import DESCRIPTION_QOS, stream_qos
+from cablelab.sim.crane import CraneSim, CraneTruth
+
+DEFAULT_DESCRIPTION = os.path.join(os.path.dirname(__import__("cablelab").__file__), "data", "crane.yaml")
+SWING = ["theta1", "theta2", "rope_length"]
+
+
+def _vec(value, n: int, name: str) -> tuple:
+    v = [float(x) for x in value]
+    if len(v) != n or not np.all(np.isfinite(v)):
+        raise CablelabError(f"cable_sim_node: parameter {name}: expected {n} finite numbers, got {value!r}")
+    return tuple(v)
+
+
+class CraneSimNode(Node):
+    def __init__(self):
+        super().__init__("cable_sim_node")
+        p = self.declare_parameter
+        self.description = load_description(p("description", "").value or DEFAULT_DESCRIPTION)
+        if self.description.crane is None:
+            raise CablelabError("cable_sim_node --plant crane: the description has no crane section")
+        params = CraneParams.from_description(self.description,
+                                              slew_inertia=float(p("slew_inertia", 0.05).value),
+                                              luff_inertia=float(p("luff_inertia", 0.02).value))
+        truth = CraneTruth(params=params,
+                           base_tilt=_vec(p("base_tilt", [0.0, 0.0]).value, 2, "base_tilt"),
+                           viscous=_vec(p("viscous", [0.0, 0.0, 0.0]).value, 3, "viscous"),
+                           coulomb=_vec(p("coulomb", [0.0, 0.0, 0.0]).value, 3, "coulomb"),
+                           torque_offset=_vec(p("offset", [0.0, 0.0, 0.0]).value, 3, "offset"),
+                           mocap_noise=float(p("mocap_noise", 0.0).value),
+                           mocap_dropout=float(p("mocap_dropout", 0.0).value),
+                           timestep=float(p("timestep", 0.001).value))
+        q0 = _vec(p("initial", [0.0, 0.5, 0.6]).value, 3, "initial")
+        self.rate = float(p("rate", 100.0).value)
+        self.sim = CraneSim(truth, q0)
+        self.u = None
+        self.fallbacks = 0
+        self.inputs = InputMonitor()
+        self.inputs.add("effort_commands", timeout=float(p("command_timeout", 0.5).value), length=3)
+
+        self.pub_js = self.create_publisher(JointState, "/crane/joint_states", stream_qos())
+        self.pub_tip = self.create_publisher(PoseStamped, "/crane/boom_tip_pose", stream_qos())
+        self.pub_pay = self.create_publisher(PoseStamped, "/crane/payload_pose", stream_qos())
+        self.pub_truth = self.create_publisher(JointState, "/crane/ground_truth/swing", stream_qos())
+        self.pub_clock = self.create_publisher(Clock, "/clock", stream_qos(10))
+        self.pub_desc = self.create_publisher(String, "/plant_description", DESCRIPTION_QOS)
+        self.pub_desc.publish(convert.string_msg(self.description.to_yaml()))
+        self.create_subscription(Float64MultiArray, "/crane/effort_commands", self.on_command, stream_qos())
+        self.diag = Diagnostics(self, update=self.status)
+        self.timer = self.create_timer(1.0 / self.rate, self.tick)
+        self.publish_state()
+
+    def status(self):
+        level, msg, values = self.inputs.status(time.monotonic())
+        values["fallback (hold) steps"] = str(self.fallbacks)
+        return level, msg, values
+
+    def on_command(self, msg: Float64MultiArray) -> None:
+        values = convert.float_array(msg)
+        if self.inputs.accept("effort_commands", values, time.monotonic()):
+            self.u = values.copy()
+
+    def tick(self) -> None:
+        if self.u is None or not self.inputs.fresh("effort_commands", time.monotonic()):
+            _, q, qd = self.sim.state()
+            u = hold_command(q[None, :3], qd[None, :3], self.sim.truth.params, swing=q[None, 3:])[0]
+            self.fallbacks += 1
+        else:
+            u = self.u
+        self.sim.advance(u, 1.0 / self.rate)
+        self.publish_state()
+
+    def publish_state(self) -> None:
+        t, q, qd = self.sim.state()
+        m = self.sim.measurement()
+        self.pub_clock.publish(convert.clock_msg(t))
+        self.pub_js.publish(convert.joint_state_msg(t, JOINTS, m["joints"], m["joint_rates"], m["effort"]))
+        self.pub_tip.publish(convert.pose_msg(t, m["tip"], m["tip_quat"]))
+        self.pub_pay.publish(convert.pose_msg(t, m["payload"], m["payload_quat"]))
+        self.pub_truth.publish(convert.joint_state_msg(t, SWING, [q[3], q[4], q[2]], [qd[3], qd[4], qd[2]]))
+
+
+def make_node(args) -> Node:
+    return CraneSimNode()
