@@ -316,7 +316,8 @@ class CdprRun:
 
 def simulate(desc: Description, truth: CdprTruth | None = None, *, controller: str = "pdff",
              duration: float = 60.0, rate: float = 100.0, reference=None,
-             controller_config=None, estimator_config=None, progress=None) -> CdprRun:
+             controller_config=None, estimator_config=None, progress=None,
+             settle: float = 2.0) -> CdprRun:
     """Closed-loop simulation of the pick-and-place test (001 sec. II-C) as fast as possible.
 
     Each control period (1/rate s): measure, estimate the payload live (Model II, dynamometers,
@@ -330,7 +331,9 @@ def simulate(desc: Description, truth: CdprTruth | None = None, *, controller: s
         duration: s; rate: control and sample rate, Hz (CAROCA: 100).
         reference: a :class:`~cablelab.plants.cdpr_trajectory.Trajectory` sampled at ``rate``
             (default: the test trajectory for ``duration``).
-        progress: optional callable(fraction) for long runs.
+        progress: optional callable(fraction, elapsed s) for long runs.
+        settle: s of holding the start pose under control before the recorded run starts (the
+            cables are tension-free when the model is built).
     """
     import time as _time
 
@@ -377,6 +380,17 @@ def simulate(desc: Description, truth: CdprTruth | None = None, *, controller: s
         return CableGeometry(*(getattr(g, f)[k:k + 1] for f in g.__dataclass_fields__))
 
     desired = est.config.pose == "desired"
+    # settle: hold the start pose with the controller until the cables carry the platform
+    for _ in range(int(round(settle * rate))):
+        ms = sim.measure()
+        e = est.update(0.0, tensions=ms["tension"], effort=ms["motor_torque"],
+                       motor_velocity=ms["motor_velocity"], position=ref.position[0],
+                       quat=ref.orientation[0], geometry=_one(g_est, 0), condition=cond_est[0])
+        if e is not None and controller == "pdff":
+            ctl.estimate(0.0, *e)
+        sim.step(ctl.update(0.0, ms["motor_angle"], ms["motor_velocity"], ref.position[0],
+                            ref.orientation[0], geometry=_one(g_ctl, 0), pinv=pinv_ctl[:1]), nstep)
+    ctl._t_est = ctl._t_filter = 0.0 if ctl._t_est is not None else None
     t0 = _time.monotonic()
     for k in range(N):
         t = k / rate
@@ -442,3 +456,92 @@ def write_run_bag(run: CdprRun, path, *, overwrite: bool = True, pose: bool = Tr
             w.write_poses("/cdpr/ground_truth/pose", t, A["true_position"], xyzw(A["true_quat"]))
             com = np.broadcast_to(A["true_com"], (len(t), 3))
             w.write_inertia("/cdpr/ground_truth/payload", t, np.full(len(t), A["true_mass"]), com)
+
+
+def main(argv=None) -> int:
+    """``python -m cablelab.sim.cdpr -o BAG``: simulate the 001 test trajectory offline (as fast as
+    possible) and write a contract bag."""
+    import argparse
+    import sys
+    import time as _time
+
+    from ..description import load_description
+    from ..errors import CablelabError
+
+    p = argparse.ArgumentParser(prog="python -m cablelab.sim.cdpr", description=main.__doc__)
+    p.add_argument("-o", "--out", required=True, help="bag directory to write (replaced)")
+    p.add_argument("--description", default=None, help="plant description (default: CAROCA)")
+    p.add_argument("--payload", type=float, default=0.0, help="payload mass, kg (001: 122, 249)")
+    p.add_argument("--controller", choices=("pdff", "pd"), default="pdff")
+    p.add_argument("--duration", type=float, default=60.0, help="s (60 = A->E->A)")
+    p.add_argument("--rate", type=float, default=100.0, help="control and sample rate, Hz")
+    p.add_argument("--no-pulleys", action="store_true", help="truth: point exits (Model I physics)")
+    p.add_argument("--coulomb", type=float, default=None, help="truth winch Coulomb friction, N m")
+    p.add_argument("--viscous", type=float, default=None, help="truth winch viscous friction, N m s/rad")
+    p.add_argument("--bias", type=float, nargs="*", default=None, help="dynamometer biases, N")
+    p.add_argument("--speed", type=float, default=1.0, help="trajectory time scale (2 = twice as fast)")
+    p.add_argument("--strip-pulley-radius", action="store_true",
+                   help="write the description without pulley_radius (pulleys unknown to the analysis)")
+    p.add_argument("--seed", type=int, default=0)
+    a = p.parse_args(argv)
+    try:
+        desc = load_description(a.description or _default_description())
+        kw = {"payload_mass": a.payload, "pulleys": not a.no_pulleys, "seed": a.seed}
+        if a.coulomb is not None:
+            kw["winch_coulomb"] = a.coulomb
+        if a.viscous is not None:
+            kw["winch_viscous"] = a.viscous
+        if a.bias:
+            kw["tension_bias"] = tuple(a.bias)
+        t0 = _time.monotonic()
+        run = simulate(desc, CdprTruth(**kw), controller=a.controller, duration=a.duration / a.speed,
+                       rate=a.rate, reference=_reference(a.duration, a.rate, a.speed),
+                       progress=lambda f, el: print(f"sim: {100 * f:3.0f} %  ETA {el / max(f, 1e-9) - el:5.1f} s",
+                                                    file=sys.stderr))
+        if a.strip_pulley_radius:
+            run = CdprRun(without_pulley_radius(desc), run.truth, run.arrays)
+        write_run_bag(run, a.out)
+        el = _time.monotonic() - t0
+        print(f"wrote {a.out}: {run.t[-1]:.1f} s simulated in {el:.1f} s ({run.t[-1] / el:.0f}x real time)")
+    except CablelabError as exc:
+        print(f"cablelab.sim.cdpr: error: {exc}", file=sys.stderr)
+        return 2
+    return 0
+
+
+def _default_description() -> str:
+    import os
+
+    return os.path.join(os.path.dirname(os.path.dirname(__file__)), "data", "caroca.yaml")
+
+
+def default_description() -> Description:
+    """The shipped CAROCA description (``cablelab/data/caroca.yaml``)."""
+    from ..description import load_description
+
+    return load_description(_default_description())
+
+
+def _reference(duration: float, rate: float, speed: float):
+    from ..plants.cdpr_trajectory import pick_and_place
+
+    t = np.arange(int(round(duration / speed * rate)) + 1) / rate
+    tr = pick_and_place(t * speed)
+    from ..plants.cdpr_trajectory import Trajectory
+    return Trajectory(t, tr.position, tr.velocity * speed, tr.acceleration * speed ** 2)
+
+
+def without_pulley_radius(desc: Description) -> Description:
+    """The description with the pulley radius removed (pulleys unknown to an analysis)."""
+    import dataclasses
+
+    from ..description import dump_description, load_description
+    d2 = dataclasses.replace(desc, cdpr=dataclasses.replace(desc.cdpr, pulley_radius=0.0), yaml_text="")
+    text = dump_description(d2).replace("  pulley_radius: 0.0\n", "")
+    return load_description(text)
+
+
+if __name__ == "__main__":
+    import sys
+
+    sys.exit(main())
