@@ -14,13 +14,14 @@ from dataclasses import dataclass, field
 from typing import Mapping
 
 import numpy as np
+import scipy.linalg
 
 from ..errors import CablelabError
 from ..model import Dataset, Model, Param
 from .linear import LinearFit, solve_linear
 
 #: grid points per nonlinear parameter for the start of the outer search
-OUTER_GRID = 21
+OUTER_GRID = 11
 
 
 @dataclass
@@ -220,10 +221,20 @@ class _OuterProblem:
         if self.constant:
             b = ((ds2.y - self.y_known)[self.valid] * self.w[None, :]).reshape(-1)
             return b - self.q @ (self.q.T @ b)
-        phi, cols, lhs, _ = _linear_system(self.model, ds2)
-        fit = solve_linear(phi, lhs, cols, valid=self.valid, channel_scale=self.w, bounded=False)
-        r = (lhs - phi @ fit.theta) * self.w[None, :]
-        return r[self.valid].reshape(-1)
+        phi, _, y_known = self.model.regressor(ds2)
+        a = (phi[self.valid] * self.w[None, :, None]).reshape(-1, phi.shape[2])
+        b = ((ds2.y - y_known)[self.valid] * self.w[None, :]).reshape(-1)
+        if a.shape[1] == 0:
+            return b
+        # normal equations on scaled columns: cheap for the few parameters of an outer search
+        sc = np.linalg.norm(a, axis=0)
+        sc = np.where(sc > 0, sc, 1.0)
+        a_s = a / sc
+        try:
+            theta = scipy.linalg.solve(a_s.T @ a_s, a_s.T @ b, assume_a="pos")
+        except (np.linalg.LinAlgError, ValueError):
+            theta = np.linalg.lstsq(a_s, b, rcond=None)[0]
+        return b - a_s @ theta
 
 
 def _fixed_theta_residual(model: Model, ds: Dataset, nl: Mapping[str, float], fit: LinearFit,

@@ -25,6 +25,8 @@ from ..model import Param
 
 #: singular values below RANK_TOL * largest (of the column-scaled regressor) count as zero
 RANK_TOL = 1e-8
+#: columns with a norm below ZERO_COLUMN * the largest column norm count as not excited
+ZERO_COLUMN = 1e-7
 
 
 @dataclass
@@ -141,6 +143,10 @@ def solve_linear(phi: np.ndarray, y: np.ndarray, params: Sequence[Param], *,
                          rss / n, channel_scale=w)
 
     s = np.linalg.norm(a, axis=0)
+    # a column at round-off level next to the others (e.g. an acceleration differentiated from a
+    # constant-velocity ramp) carries no information: treat it as zero, not as a scaled-up column
+    s = np.where(s > ZERO_COLUMN * s.max(), s, 0.0) if s.size else s
+    a = np.where(s > 0, a, 0.0)
     s_safe = np.where(s > 0, s, 1.0)
     a_s = a / s_safe
     u, sv, vt = np.linalg.svd(a_s, full_matrices=False)

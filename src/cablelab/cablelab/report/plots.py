@@ -1,0 +1,109 @@
+"""The report's figures (matplotlib, Agg backend), one function per plot, each writing a PNG.
+
+Long records are thinned for drawing only (at most ``MAX_POINTS`` per line); numbers in the
+report always come from the full data.
+"""
+from __future__ import annotations
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+MAX_POINTS = 4000
+DPI = 90
+
+
+def _thin(n: int) -> slice:
+    return slice(None, None, max(1, n // MAX_POINTS))
+
+
+def _save(fig, path) -> None:
+    fig.tight_layout()
+    fig.savefig(path, dpi=DPI)
+    plt.close(fig)
+
+
+def overlay(path, t, y_meas, y_base, y_final, channels, units, labels=("nominal", "final")) -> None:
+    """Measured vs model output per channel (nominal and final model)."""
+    c = len(channels)
+    fig, axes = plt.subplots(c, 1, figsize=(10, 2.6 * c), squeeze=False, sharex=True)
+    s = _thin(t.size)
+    for i, ax in enumerate(axes[:, 0]):
+        ax.plot(t[s], y_meas[s, i], color="k", lw=0.8, label="measured")
+        ax.plot(t[s], y_base[s, i], color="tab:orange", lw=0.8, alpha=0.8, label=labels[0])
+        ax.plot(t[s], y_final[s, i], color="tab:blue", lw=0.8, alpha=0.8, label=labels[1])
+        ax.set_ylabel(f"{channels[i]} [{units[i]}]")
+        ax.legend(loc="upper right", fontsize=8)
+    axes[-1, 0].set_xlabel("time [s]")
+    _save(fig, path)
+
+
+def residual_time(path, t, residual, segments, channels, units, title="") -> None:
+    """Residual over time with the worst segments shaded."""
+    c = len(channels)
+    fig, axes = plt.subplots(c, 1, figsize=(10, 2.4 * c), squeeze=False, sharex=True)
+    s = _thin(t.size)
+    for i, ax in enumerate(axes[:, 0]):
+        ax.plot(t[s], residual[s, i], color="tab:red", lw=0.7)
+        ax.axhline(0, color="k", lw=0.5)
+        for seg in segments:
+            if seg["channel"] == channels[i]:
+                ax.axvspan(seg["t_start"], seg["t_end"], color="gold", alpha=0.35)
+        ax.set_ylabel(f"residual {channels[i]} [{units[i]}]")
+    axes[0, 0].set_title(title)
+    axes[-1, 0].set_xlabel("time [s]")
+    _save(fig, path)
+
+
+def residual_regimes(path, rows_base, rows_final, channel) -> None:
+    """Residual NRMSE per regime label, nominal vs final model (one channel)."""
+    base = [r for r in rows_base if r["channel"] == channel]
+    final = {(r["regime"], r["label"]): r for r in rows_final if r["channel"] == channel}
+    names = [f"{r['regime']}: {r['label']}" for r in base]
+    vb = [100 * (r["nrmse"] or 0) for r in base]
+    vf = [100 * (final.get((r["regime"], r["label"]), {}).get("nrmse") or 0) for r in base]
+    fig, ax = plt.subplots(figsize=(10, 0.32 * len(names) + 1.2))
+    yy = np.arange(len(names))
+    ax.barh(yy - 0.2, vb, height=0.4, color="tab:orange", label="nominal")
+    ax.barh(yy + 0.2, vf, height=0.4, color="tab:blue", label="final")
+    ax.set_yticks(yy, names, fontsize=8)
+    ax.invert_yaxis()
+    ax.set_xlabel(f"residual RMS / channel RMS [%] ({channel})")
+    ax.legend(fontsize=8)
+    _save(fig, path)
+
+
+def waterfall(path, steps) -> None:
+    """Held-out NRMSE at each greedy step: baseline -> +effect 1 -> +effect 2."""
+    labels = ["nominal"] + [f"+ {s['added']}" for s in steps[1:]]
+    vals = [100 * s["error"] for s in steps]
+    fig, ax = plt.subplots(figsize=(1.8 * len(vals) + 3, 3.6))
+    x = np.arange(len(vals))
+    colors = ["tab:orange"] + ["tab:blue"] * (len(vals) - 1)
+    ax.bar(x, vals, color=colors)
+    for xi, v in zip(x, vals):
+        ax.text(xi, v, f"{v:.2f} %", ha="center", va="bottom", fontsize=9)
+    ax.set_xticks(x, labels, rotation=15, fontsize=8)
+    ax.set_ylabel("held-out NRMSE [%]")
+    ax.set_title("adding the missing effects")
+    _save(fig, path)
+
+
+def correlations(path, white: dict, channel: str) -> None:
+    """Residual autocorrelation and cross-correlation with inputs, with the 99 % band."""
+    n_cross = len(white["cross"])
+    fig, axes = plt.subplots(1 + n_cross, 1, figsize=(8, 2.2 * (1 + n_cross)), squeeze=False)
+    band = white["band"]
+    ax = axes[0, 0]
+    ax.stem(white["lags"], white["autocorr"], basefmt=" ")
+    ax.axhspan(-band, band, color="tab:green", alpha=0.2)
+    ax.set_title(f"residual autocorrelation ({channel}), 99 % band")
+    for i, (name, xc) in enumerate(white["cross"].items(), 1):
+        ax = axes[i, 0]
+        ax.stem(xc["lags"], xc["xcorr"], basefmt=" ")
+        ax.axhspan(-band, band, color="tab:green", alpha=0.2)
+        ax.set_title(f"cross-correlation residual x {name}")
+    axes[-1, 0].set_xlabel("lag [samples]")
+    _save(fig, path)
