@@ -87,8 +87,17 @@ class ReplayNode(Node):
             print(f"replay: {self.i}/{n} messages, about {max(left, 0):.0f} s left", file=sys.stderr,
                   flush=True)
         if self.i >= n:
-            self.done = True
-            self.exit_code = 0
+            self.finish()
+
+    def finish(self, timeout: float = 5.0) -> None:
+        """Wait (up to ``timeout`` s) until reliable subscribers acknowledged everything, then
+        stop: exiting right after the last publish would drop what is still in flight."""
+        from rclpy.duration import Duration
+
+        for pub in list(self.pubs.values()) + ([self.clock_pub] if self.own_clock else []):
+            pub.wait_for_all_acked(Duration(seconds=timeout))
+        self.done = True
+        self.exit_code = 0
 
 
 def schedule_times(log_ns: np.ndarray, rate: float) -> np.ndarray:
