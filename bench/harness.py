@@ -5,7 +5,8 @@
     args = bench.parse()
     best = bench.time(lambda: work(), repeat=3)   # seconds, best of repeat
     bench.row(case="write", messages=n, seconds=best, rate=n / best, unit="msg/s", target=">= 100000")
-    bench.done()                             # prints the table (or one JSON object with --json)
+    bench.section("read")                    # optional: later rows go to a second table
+    bench.done()                             # prints the table(s) (or one JSON object with --json)
 
 Progress lines go to stderr so ``--json`` output stays clean.
 """
@@ -45,6 +46,7 @@ class Bench:
     def __init__(self, name: str, description: str | None = None):
         self.name = name
         self.rows: list[dict] = []
+        self.sections: list[tuple[str, list[dict]]] = [("", self.rows)]
         self.parser = argparse.ArgumentParser(prog=f"bench_{name}", description=description,
                                               formatter_class=argparse.RawDescriptionHelpFormatter)
         self.parser.add_argument("--json", action="store_true", help="print one JSON object")
@@ -68,12 +70,19 @@ class Bench:
     def log(msg: str) -> None:
         print(msg, file=sys.stderr, flush=True)
 
+    def section(self, title: str) -> None:
+        """Start a new table (rows with other columns read better apart)."""
+        self.rows = []
+        self.sections.append((title, self.rows))
+
     def row(self, **values) -> None:
         self.rows.append(values)
         self.log(f"[{self.name}] " + ", ".join(f"{k}={fmt(v)}" for k, v in values.items()))
 
     def done(self) -> None:
+        sections = [(title, rows) for title, rows in self.sections if rows]
         if self.args is not None and self.args.json:
-            print(json.dumps({"bench": self.name, "rows": self.rows}))
+            print(json.dumps({"bench": self.name,
+                              "rows": [dict(r, section=t) if t else r for t, rows in sections for r in rows]}))
         else:
-            print(table(self.rows))
+            print("\n\n".join((f"{title}\n" if title else "") + table(rows) for title, rows in sections))
