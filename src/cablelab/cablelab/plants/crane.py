@@ -21,6 +21,8 @@ Butterworth, central differences), and the signal ``Y`` = the 5 x 9 regressor pe
 """
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
 from ..conditioning import Conditioning, condition_motion
@@ -42,6 +44,12 @@ EFFORT_COMMANDS = "/crane/effort_commands"
 JOINT_STATE = "sensor_msgs/msg/JointState"
 POSE = "geometry_msgs/msg/PoseStamped"
 SWING_NAMES = ("theta1", "theta2", "rope_length")
+#: default low-pass cut-off of the crane's positions, Hz (when --cutoff is not given). The payload
+#: swings at sqrt(g / d) / (2 pi) ~ 0.6-1 Hz and the excitation stays below ~0.5 Hz, while
+#: motion-capture noise is differentiated twice for the swing accelerations: the generic fs / 10
+#: (10 Hz at 100 Hz) lets 1 mm of noise become metres per second squared (002 sec. 5.1.3 chose
+#: its filters case by case; this is the case for the crane).
+CRANE_CUTOFF_HZ = 3.0
 
 __all__ = ["CraneParams", "dataset", "dataset_from_arrays", "estimate_bag", "swing_from_bag",
            "write_swing_estimate", "baseline", "candidates", "CRANE"]
@@ -68,6 +76,8 @@ def dataset_from_arrays(t, q_joints, effort, t_mocap, tip, payload, description,
     """
     options = options or {}
     opts = options.get("conditioning") or Conditioning()
+    if opts.cutoff_hz is None:
+        opts = dataclasses.replace(opts, cutoff_hz=CRANE_CUTOFF_HZ)
     t = np.asarray(t, dtype=float)
     q_joints = np.asarray(q_joints, dtype=float).reshape(-1, 3)
     ok = np.isfinite(t) & np.isfinite(q_joints[:, 0])
@@ -119,15 +129,24 @@ def _stats(x: np.ndarray) -> dict:
     return {"mean": float(np.mean(x)), "std": float(np.std(x)), "max_abs": float(np.max(np.abs(x)))}
 
 
-def estimate_bag(bag, args=None) -> dict:
+def estimate_bag(bag, description=None, *, out=None, cutoff_hz: float | None = None,
+                 overwrite: bool = False, **_options) -> dict:
     """``cablelab estimate`` for a crane bag: swing-angle statistics (CONTRACT sec. 5) as JSON.
 
-    With ``args.out`` set, also writes the per-sample estimates as ``/crane/swing_estimate``
-    (stamped like the motion capture) to that bag.
+    Args:
+        bag: bag path or an open :class:`~cablelab.bags.Bag`.
+        description: unused (the swing estimate needs no parameters); kept for the verb's API.
+        out: also write the per-sample estimates as ``/crane/swing_estimate`` (stamped like the
+            motion capture) to this bag.
+        cutoff_hz: optional low-pass of the angles before differentiation.
+    Other options of the verb (``tensions``, ``effects``, ``pose``) do not apply to the crane.
     """
-    cutoff = getattr(args, "cutoff", None) if args is not None else None
-    sw, rep = swing_from_bag(bag, cutoff_hz=cutoff)
-    out = {"plant": "crane", "samples": int(sw.t.shape[0]),
+    if not hasattr(bag, "pose"):
+        from ..bags import open_bag
+
+        bag = open_bag(bag)
+    sw, rep = swing_from_bag(bag, cutoff_hz=cutoff_hz)
+    res = {"plant": "crane", "samples": int(sw.t.shape[0]),
            "theta1": _stats(sw.theta1), "theta2": _stats(sw.theta2),
            "rope_length": _stats(sw.rope_length),
            "theta1_dot": _stats(sw.theta1_dot), "theta2_dot": _stats(sw.theta2_dot),
@@ -136,14 +155,13 @@ def estimate_bag(bag, args=None) -> dict:
         tr = bag.joint_state(SWING_TRUTH, list(SWING_NAMES))
         ok = np.isfinite(tr.t)
         if ok.sum() >= 2:
-            err = {n: float(np.sqrt(np.nanmean((getattr(sw, n) - np.interp(sw.t, tr.t[ok], tr.position[ok, i])) ** 2)))
-                   for i, n in enumerate(("theta1", "theta2", "rope_length"))}
-            out["rms_error_vs_ground_truth"] = err
-    out_path = getattr(args, "out", None) if args is not None else None
-    if out_path:
-        write_swing_estimate(out_path, sw, bag.description_yaml, overwrite=getattr(args, "overwrite", False))
-        out["out"] = str(out_path)
-    return out
+            res["rms_error_vs_ground_truth"] = {
+                n: float(np.sqrt(np.nanmean((getattr(sw, n) - np.interp(sw.t, tr.t[ok], tr.position[ok, i])) ** 2)))
+                for i, n in enumerate(("theta1", "theta2", "rope_length"))}
+    if out:
+        write_swing_estimate(out, sw, bag.description_yaml, overwrite=overwrite)
+        res["out"] = str(out)
+    return res
 
 
 def write_swing_estimate(path, sw: SwingAngles, description_yaml: str | None = None,
