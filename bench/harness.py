@@ -22,9 +22,11 @@ def fmt(value) -> str:
     if isinstance(value, float):
         if value != value:  # NaN
             return "nan"
-        if abs(value) >= 1e5 or (abs(value) < 1e-3 and value != 0):
+        if abs(value) >= 1000:
+            return f"{value:,.0f}"
+        if abs(value) < 1e-3 and value != 0:
             return f"{value:.3g}"
-        return f"{value:,.4g}" if abs(value) < 1000 else f"{value:,.0f}"
+        return f"{value:.4g}"
     return str(value)
 
 
