@@ -81,7 +81,19 @@ def compare(ds: Dataset, model: Model, *, segments: int = 5) -> dict:
     out["whiteness"] = {ch: _whiteness_summary(ident.residual[:, c], ds.inputs)
                         for c, ch in enumerate(ds.channels)}
     out["rank"], out["condition"] = ident.linear.rank, ident.linear.cond
+    plant = _plant_of(ds)
+    if plant is not None and plant.simulate is not None:
+        out["free_run"] = plant.simulate(ds, ident.params)
     return out
+
+
+def _plant_of(ds: Dataset):
+    from .plants import get_plant
+
+    try:
+        return get_plant(ds.plant)
+    except CablelabError:
+        return None
 
 
 def _whiteness_summary(res, inputs) -> dict:
@@ -92,13 +104,16 @@ def _whiteness_summary(res, inputs) -> dict:
                           "max_abs": float(np.max(np.abs(v["xcorr"])))} for k, v in w["cross"].items()}}
 
 
-def identify(ds: Dataset, model: Model, *, folds: int = FOLDS) -> dict:
-    """Identified parameters with standard errors, rank/condition, in-sample and held-out fit."""
+def identify(ds: Dataset, model: Model, *, folds: int = FOLDS, simulation: str | None = None) -> dict:
+    """Identified parameters with standard errors, rank/condition, in-sample and held-out fit.
+
+    With ``simulation`` (``"nmse"`` or ``"pearson"``) the inverse-model result starts a
+    simulation-based fit of the plant (if it offers one), reported under ``"simulation"``."""
     ident = _identify(model, ds)
     y_meas = np.where(ident.valid[:, None], ident.residual + ident.y_hat, np.nan)
     mets = channel_metrics(y_meas, ident.y_hat, ident.valid)
     cv = cv_error(model, ds, folds)[0] if folds else None
-    return {
+    out = {
         "plant": ds.plant, "effects": list(model.effects), "samples": int(ident.valid.sum()),
         "params": _effect_table(ident),
         "fit": {"nrmse": float(np.mean([m["nrmse"] for m in mets])), "cv_nrmse": cv, "folds": folds,
@@ -107,6 +122,15 @@ def identify(ds: Dataset, model: Model, *, folds: int = FOLDS) -> dict:
                 "unidentifiable": ident.linear.unidentifiable,
                 "active_bounds": ident.linear.active_bounds},
     }
+    if simulation:
+        plant = _plant_of(ds)
+        if plant is None or plant.simulation_fit is None:
+            raise CablelabError(f"plant {ds.plant} offers no simulation-based fit")
+        sf = plant.simulation_fit(ds, ident.params, simulation)
+        out["simulation"] = {"objective": sf.objective, "nmse": sf.nmse, "pearson": sf.pearson,
+                             "iterations": sf.iterations, "evaluations": sf.evaluations,
+                             "params": {k: {"value": v, "stderr": sf.stderr[k]} for k, v in sf.params.items()}}
+    return out
 
 
 def diagnose(ds: Dataset, model: Model, candidates: Sequence[str], *, folds: int = FOLDS,

@@ -25,6 +25,10 @@ def run(args) -> int:
               f"{m['pearson']:.4f}  MAE {m['mae']:.4g}  max {m['max_abs']:.4g}")
     for name, v in out["params"].items():
         print(f"  {name:>12} = {v['value']:.6g} +- {v['stderr']:.2g} {v['unit']}")
+    if "free_run" in out:
+        fr = out["free_run"]
+        print(f"  free run ({fr['horizon_s']} s windows): {fr['channel']} NRMSE {100 * fr['nrmse']:.2f} %, "
+              f"max {fr['max_abs']:.4g}")
     print("worst segments:")
     for s in out["worst_segments"]:
         print(f"  {s['channel']}: {s['t_start']:.3f}-{s['t_end']:.3f} s  NRMSE {100 * s['error']:.1f} %")

@@ -29,8 +29,10 @@ class Plant:
         candidates: ``fn(description) -> tuple of effect ids`` that diagnose may try (the model's
             own effects are skipped).
         channels_doc: one line describing the output channels (for docs and reports).
-        simulate: optional free-run simulation ``fn(ds, params, model) -> dict`` of simulated
-            signals (e.g. ``{"q": (N,)}``) for the free-run comparison.
+        simulate: optional free-run comparison ``fn(ds, params) -> dict`` (``{"channel",
+            "nrmse", "max_abs", "pearson", ...}``) shown by ``compare`` next to the inverse model.
+        simulation_fit: optional simulation-based fit ``fn(ds, start_params, objective) ->``
+            :class:`~cablelab.fit.simulation.SimulationFit` (``identify --simulation nmse|pearson``).
     """
 
     name: str
@@ -40,6 +42,7 @@ class Plant:
     candidates: Callable
     channels_doc: str = ""
     simulate: Callable | None = None
+    simulation_fit: Callable | None = None
 
 
 def register_plant(plant: Plant) -> Plant:

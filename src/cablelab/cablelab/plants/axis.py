@@ -103,4 +103,117 @@ AXIS = register_plant(Plant(
     baseline=baseline,
     candidates=candidates,
     channels_doc="joint: measured motor force (N, prismatic) or torque (N m, revolute)",
+    simulate=lambda ds, params: free_run_compare(ds, params),
+    simulation_fit=lambda ds, start, objective: fit_free_run(ds, start, objective=objective),
 ))
+
+
+# ----------------------------------------------------------------------------- free-run simulation
+
+#: free-run horizon: the record is cut into windows of this length, each simulated from the
+#: measured state at its start (a marginally stable axis drifts over a long open-loop run)
+FREE_RUN_HORIZON_S = 0.5
+
+
+def free_run(ds: Dataset, param_sets: list[dict], horizon_s: float = FREE_RUN_HORIZON_S) -> np.ndarray:
+    """Simulate the axis (MuJoCo) driven by the measured effort, window by window.
+
+    Each window of ``horizon_s`` starts at the measured (filtered) q, qd and is driven by the
+    measured effort minus the sensor offset ``OF`` (zero-order hold at the sample period), with
+    M, Fv, Fc (and mc for a revolute joint) from each parameter set. All windows and parameter
+    sets run in one :func:`mujoco.rollout.rollout` batch.
+
+    Args:
+        ds: axis dataset; param_sets: list of ``{"M", "Fv", "Fc", "OF", "mc"}`` (missing = 0).
+    Returns:
+        (k, N, 1) simulated positions (NaN in the tail that does not fill a window).
+    """
+    import dataclasses
+
+    import mujoco
+    import mujoco.rollout
+
+    from .axis_sim import AxisTruth
+    from .axis_truth import build_axis_model, initial_state
+
+    dt = ds.dt
+    w = max(2, int(round(horizon_s / dt)))
+    n_win = ds.n // w
+    if n_win < 1:
+        raise CablelabError(f"{ds.source}: record shorter than one free-run window ({horizon_s} s)")
+    q, qd = ds.signals["q"], ds.signals["qd"]
+    starts = np.arange(n_win) * w
+    desc = ds.description
+    models, x0s, ctrls = [], [], []
+    for ps in param_sets:
+        mc = float(ps.get("mc", 0.0))
+        d2 = desc
+        if desc.axis.joint_type == "revolute":
+            d2 = dataclasses.replace(desc, axis=dataclasses.replace(desc.axis, gravity_moment=max(mc, 0.0)))
+        truth = AxisTruth(inertia=max(float(ps.get("M", 0.0)), 1e-9),
+                          viscous=max(float(ps.get("Fv", 0.0)), 0.0),
+                          coulomb=max(float(ps.get("Fc", 0.0)), 0.0), timestep=dt)
+        m = build_axis_model(d2, truth)
+        u = ds.y[:, 0] - float(ps.get("OF", 0.0))
+        for s in starts:
+            models.append(m)
+            x0s.append(initial_state(m, q[s], qd[s]))
+            ctrls.append(u[s:s + w])
+    data = [mujoco.MjData(models[0]) for _ in range(2)]
+    # sensors are evaluated before each step's integration: sensor row j is sample s + j
+    _, sens = mujoco.rollout.rollout(models, data, np.array(x0s), np.array(ctrls)[:, :, None])
+    out = np.full((len(param_sets), ds.n, 1), np.nan)
+    out[:, : n_win * w, 0] = sens[:, :, 0].reshape(len(param_sets), n_win * w)
+    return out
+
+
+def free_run_compare(ds: Dataset, params: dict, horizon_s: float = FREE_RUN_HORIZON_S) -> dict:
+    """Free-run position error of identified parameters: NRMSE of the position deviation from
+    each window's start (the motion the model must reproduce) and max abs error."""
+    sim = free_run(ds, [params], horizon_s)[0, :, 0]
+    q = ds.signals["q"]
+    w = max(2, int(round(horizon_s / ds.dt)))
+    ok = np.isfinite(sim)
+    idx = np.arange(ds.n)
+    base = q[(idx // w) * w]
+    dq_meas, dq_sim = (q - base)[ok], (sim - base)[ok]
+    e = dq_sim - dq_meas
+    return {"channel": "position", "horizon_s": horizon_s,
+            "nrmse": float(np.sqrt(np.mean(e**2)) / np.sqrt(np.mean(dq_meas**2))),
+            "max_abs": float(np.max(np.abs(e))), "pearson": float(np.corrcoef(dq_meas, dq_sim)[0, 1])}
+
+
+def fit_free_run(ds: Dataset, start: dict, *, objective: str = "nmse",
+                 free: tuple[str, ...] = ("M", "Fv", "Fc"), horizon_s: float = FREE_RUN_HORIZON_S,
+                 max_iter: int = 30):
+    """Simulation-based identification of the axis: free-run windows (:func:`free_run`) matched to
+    the measured motion with :func:`~cablelab.fit.simulation.fit_simulation` (NMSE of 003 eq. 28
+    or Pearson of 000 eq. 3-7). The output is the position deviation from each window's start.
+
+    Args:
+        start: start values by name (e.g. the inverse-model LS result); parameters not in
+            ``free`` are held at their start value.
+        free: parameters to fit, bounded to [start / 5, start * 5] (positive ones).
+    """
+    from ..fit.simulation import fit_simulation
+    from ..model import Param
+
+    w = max(2, int(round(horizon_s / ds.dt)))
+    n_win = ds.n // w
+    q = ds.signals["q"]
+    idx = np.arange(n_win * w)
+    base = q[(idx // w) * w]
+    y_meas = (q[: n_win * w] - base)[:, None]
+    params = []
+    for k in free:
+        v = float(start.get(k, 0.0))
+        if v <= 0:
+            raise CablelabError(f"free-run fit: start value of {k} must be > 0 (got {v:g})")
+        params.append(Param(k, "", v, v / 5.0, v * 5.0))
+
+    def simulate(sets):
+        full = [{**start, **s} for s in sets]
+        sims = free_run(ds, full, horizon_s)[:, : n_win * w, :]
+        return sims - base[None, :, None]
+
+    return fit_simulation(simulate, params, y_meas, objective=objective, max_iter=max_iter)

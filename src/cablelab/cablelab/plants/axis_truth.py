@@ -27,6 +27,56 @@ class AxisRun:
     effort_true: np.ndarray
 
 
+def build_axis_model(description, truth: AxisTruth, servo: tuple[float, float] | None = None):
+    """Compiled MuJoCo axis (:func:`~cablelab.plants.axis_sim.axis_mjcf`) for synthetic data and
+    simulation-based fits, with sensors ``[q, actuator force]``.
+
+    Integration is explicit semi-implicit Euler with Euler damping off, so the force a sensor reports
+    is the force applied over the step (implicit integrators fold dt * (damping + servo kv) into
+    the inertia; RK4 re-evaluates a servo inside the step; both bias the "true" M and Fv by a few %
+    against u = M qdd + ...). The friction-loss constraint is stiff (Fc sign(qd) down to ~1e-4 m/s
+    instead of the default soft ramp that looks like extra viscous friction near reversals).
+
+    Args:
+        servo: ``(kp, kv)``: the actuator is a position servo whose control is the reference
+            position; None: a force/torque motor whose control is the effort.
+    """
+    import mujoco
+
+    ax = description.axis
+    spec = mujoco.MjSpec.from_string(axis_mjcf(ax.joint_type, truth, ax.gravity_moment,
+                                               description.gravity))
+    spec.option.integrator = mujoco.mjtIntegrator.mjINT_EULER
+    spec.option.disableflags |= mujoco.mjtDisableBit.mjDSBL_EULERDAMP
+    joint = spec.joints[0]
+    joint.solref_friction[:] = [2 * truth.timestep, 1.0]
+    joint.solimp_friction[:3] = [0.99, 0.99, 0.001]
+    if servo is not None:
+        kp, kv = servo
+        act = spec.actuators[0]
+        act.gaintype = mujoco.mjtGain.mjGAIN_FIXED
+        act.gainprm[0] = kp
+        act.biastype = mujoco.mjtBias.mjBIAS_AFFINE
+        act.biasprm[0:3] = [0.0, -kp, -kv]
+    spec.add_sensor(type=mujoco.mjtSensor.mjSENS_JOINTPOS, objtype=mujoco.mjtObj.mjOBJ_JOINT,
+                    objname="joint")
+    spec.add_sensor(type=mujoco.mjtSensor.mjSENS_ACTUATORFRC, objtype=mujoco.mjtObj.mjOBJ_ACTUATOR,
+                    objname="drive")
+    return spec.compile()
+
+
+def initial_state(model, q0: float, qd0: float = 0.0) -> np.ndarray:
+    """Full physics state vector of the axis at (q0, qd0)."""
+    import mujoco
+
+    data = mujoco.MjData(model)
+    data.qpos[0], data.qvel[0] = q0, qd0
+    mujoco.mj_forward(model, data)
+    x0 = np.empty(mujoco.mj_stateSize(model, mujoco.mjtState.mjSTATE_FULLPHYSICS))
+    mujoco.mj_getState(model, data, x0, mujoco.mjtState.mjSTATE_FULLPHYSICS)
+    return x0
+
+
 def reference(t: np.ndarray, amplitude: float, base_hz: float = 0.25) -> np.ndarray:
     """Smooth multi-sine reference with many velocity reversals (m or rad)."""
     w = 2 * np.pi * base_hz
@@ -50,43 +100,16 @@ def simulate_axis(description, truth: AxisTruth, *, duration: float = 20.0, fs: 
     import mujoco
     import mujoco.rollout
 
-    ax = description.axis
-    spec = mujoco.MjSpec.from_string(axis_mjcf(ax.joint_type, truth, ax.gravity_moment,
-                                               description.gravity))
-    dt_phys = truth.timestep
     w = 2 * np.pi * bandwidth_hz
-    kp, kv = truth.inertia * w * w, 2 * 0.8 * truth.inertia * w
-    # explicit semi-implicit Euler: the force a sensor reports is the force applied over the step.
-    # (implicit integrators fold dt * (damping + servo kv) into the inertia; RK4 re-evaluates the
-    # servo inside the step; both bias the "true" M and Fv by a few % against u = M qdd + ...)
-    spec.option.integrator = mujoco.mjtIntegrator.mjINT_EULER
-    spec.option.disableflags |= mujoco.mjtDisableBit.mjDSBL_EULERDAMP
-    # a stiff friction-loss constraint: Fc sign(qd) down to ~1e-4 m/s instead of the default
-    # soft (solref 0.02 s) ramp that looks like extra viscous friction near reversals
-    joint = spec.joints[0]
-    joint.solref_friction[:] = [2 * dt_phys, 1.0]
-    joint.solimp_friction[:3] = [0.99, 0.99, 0.001]
-    act = spec.actuators[0]
-    act.gaintype = mujoco.mjtGain.mjGAIN_FIXED
-    act.gainprm[0] = kp
-    act.biastype = mujoco.mjtBias.mjBIAS_AFFINE
-    act.biasprm[0:3] = [0.0, -kp, -kv]
-    spec.add_sensor(type=mujoco.mjtSensor.mjSENS_JOINTPOS, objtype=mujoco.mjtObj.mjOBJ_JOINT,
-                    objname="joint")
-    spec.add_sensor(type=mujoco.mjtSensor.mjSENS_ACTUATORFRC, objtype=mujoco.mjtObj.mjOBJ_ACTUATOR,
-                    objname="drive")
-    model = spec.compile()
+    model = build_axis_model(description, truth,
+                             servo=(truth.inertia * w * w, 2 * 0.8 * truth.inertia * w))
     data = mujoco.MjData(model)
     dt = model.opt.timestep
     step = max(1, int(round(1.0 / (fs * dt))))
     n_phys = int(round(duration / dt))
-    t_phys = (np.arange(n_phys) + 1) * dt
+    t_phys = np.arange(n_phys) * dt  # sensor row j = state before step j, at time j dt
     ref = reference(t_phys, amplitude)
-    data.qpos[0] = reference(np.zeros(1), amplitude)[0]
-    mujoco.mj_forward(model, data)
-    size = mujoco.mj_stateSize(model, mujoco.mjtState.mjSTATE_FULLPHYSICS)
-    x0 = np.empty(size)
-    mujoco.mj_getState(model, data, x0, mujoco.mjtState.mjSTATE_FULLPHYSICS)
+    x0 = initial_state(model, ref[0])
     _, sens = mujoco.rollout.rollout(model, data, x0[None], ref[None, :, None])
     sens = sens[0]
     t = t_phys[::step]
