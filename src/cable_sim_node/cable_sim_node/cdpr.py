@@ -1,0 +1,191 @@
+"""CDPR simulator node: the MuJoCo CAROCA of 001 (real pulleys, friction winches) driven by
+``/cdpr/effort_commands``.
+
+Publishes (CONTRACT sec. 2) ``/cdpr/joint_states`` (winch_1..n: motor angle, rate, torque from
+current), ``/cdpr/cable_tensions`` (cable_1..n: paid-out length, dynamometer tension),
+``/cdpr/platform_pose`` (optional), ``/cdpr/reference`` (the pick-and-place s-curve of 001 sec.
+II-C, unless ``publish_reference`` is false and another node publishes it), the ground truth
+``/cdpr/ground_truth/{pose,payload}``, ``/clock`` and ``/plant_description``. Physics:
+:class:`cablelab.sim.cdpr.CdprSim`.
+
+Modes: ``real_time`` true steps at ``rate`` Hz of wall time; false runs as fast as possible in
+lock-step with the controller (a step as soon as the command answering the last published state
+arrived, or after ``command_timeout`` s without one). Without a fresh command the winch brakes hold
+the motor angles (nominal-mass feedforward + a stiff PD), reported as WARN on /diagnostics; slack
+cables are reported too.
+
+ROS parameters: ``description`` (YAML file or text; default CAROCA), ``payload_mass`` (kg),
+``payload_com`` [x, y, z] (m), ``pulleys`` (bool), ``winch_coulomb`` (N m), ``winch_viscous``
+(N m s/rad), ``motor_inertia`` (kg m^2), ``tension_noise`` (N), ``tension_bias`` [n] (N),
+``torque_noise`` (N m), ``pose_noise`` (m), ``timestep`` (s), ``rate`` (Hz), ``real_time``,
+``publish_reference``, ``publish_pose``, ``trajectory_speed`` (time scale of the s-curve),
+``settle`` (s held at A before the trajectory starts), ``duration`` (s of simulated time after
+which the node exits; 0 = run until stopped), ``command_timeout`` (s wall), ``seed``.
+"""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+from geometry_msgs.msg import InertiaStamped, PoseStamped
+from rclpy.node import Node
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import JointState
+from std_msgs.msg import Float64MultiArray, String
+from trajectory_msgs.msg import MultiDOFJointTrajectory
+
+from cablelab.description import load_description
+from cablelab.errors import CablelabError
+from cablelab.plants.cdpr_control import PdffConfig
+from cablelab.plants.cdpr_live import ControllerConfig, LiveController
+from cablelab.plants.cdpr_trajectory import pick_and_place
+from cablelab.ros import convert
+from cablelab.ros.diagnostics import Diagnostics
+from cablelab.ros.inputs import WARN, InputMonitor
+from cablelab.ros.qos import DESCRIPTION_QOS, stream_qos
+from cablelab.sim.cdpr import CdprSim, CdprTruth, _default_description
+
+
+def _wxyz_to_xyzw(q):
+    return np.asarray(q)[[1, 2, 3, 0]]
+
+
+class CdprSimNode(Node):
+    def __init__(self):
+        super().__init__("cable_sim_node")
+        p = self.declare_parameter
+        self.description = load_description(p("description", "").value or _default_description())
+        c = self.description.cdpr
+        if c is None:
+            raise CablelabError("cable_sim_node --plant cdpr: the description has no cdpr section")
+        self.n = len(c.cables)
+        bias = list(p("tension_bias", [0.0]).value)
+        if len(bias) not in (1, self.n):
+            raise CablelabError(f"cable_sim_node: parameter tension_bias: expected 1 or {self.n} values")
+        truth = CdprTruth(
+            pulleys=bool(p("pulleys", True).value),
+            payload_mass=float(p("payload_mass", 0.0).value),
+            payload_com=tuple(float(x) for x in p("payload_com", [0.15, 0.0, -0.6]).value),
+            winch_coulomb=float(p("winch_coulomb", 0.3).value),
+            winch_viscous=float(p("winch_viscous", 0.002).value),
+            motor_inertia=float(p("motor_inertia", 2e-4).value),
+            tension_noise=float(p("tension_noise", 5.0).value),
+            tension_bias=tuple(float(b) for b in bias) if any(bias) else None,
+            torque_noise=float(p("torque_noise", 0.02).value),
+            pose_noise=float(p("pose_noise", 0.0).value),
+            timestep=float(p("timestep", 0.001).value),
+            seed=int(p("seed", 0).value))
+        self.rate = float(p("rate", 100.0).value)
+        self.real_time = bool(p("real_time", True).value)
+        self.publish_reference = bool(p("publish_reference", True).value)
+        self.publish_pose = bool(p("publish_pose", True).value)
+        self.speed = float(p("trajectory_speed", 1.0).value)
+        self.settle = float(p("settle", 1.0).value)
+        self.duration = float(p("duration", 0.0).value)
+        self.command_timeout = float(p("command_timeout", 0.5).value)
+        if self.rate <= 0 or self.speed <= 0:
+            raise CablelabError("cable_sim_node: parameters rate and trajectory_speed must be > 0")
+        start = pick_and_place(np.array([0.0])).position[0]
+        self.sim = CdprSim(self.description, truth, start)
+        self.nstep = max(1, int(round(1.0 / (self.rate * self.sim.truth.timestep))))
+        self.brake = LiveController(c, self.description.gravity, ControllerConfig(
+            feedforward=True, nominal_mass=c.platform_mass or 366.0, estimate_timeout=0.0,
+            gains=PdffConfig(kp=2.0, kd=0.05)))
+        self.brake_pose = start
+        self.u = None
+        self.commands = 0           # good commands received
+        self.commands_at_pub = 0    # ... when the last state was published (lock-step)
+        self.fallbacks = 0
+        self.slack_steps = 0
+        self.k = 0
+        self.done = False
+        self.inputs = InputMonitor()
+        self.inputs.add("effort_commands", timeout=self.command_timeout, length=self.n)
+        self._last_pub_wall = time.monotonic()
+
+        q = stream_qos()
+        self.pub_js = self.create_publisher(JointState, "/cdpr/joint_states", q)
+        self.pub_ten = self.create_publisher(JointState, "/cdpr/cable_tensions", q)
+        self.pub_pose = self.create_publisher(PoseStamped, "/cdpr/platform_pose", q)
+        self.pub_ref = self.create_publisher(MultiDOFJointTrajectory, "/cdpr/reference", q)
+        self.pub_tpose = self.create_publisher(PoseStamped, "/cdpr/ground_truth/pose", q)
+        self.pub_tpay = self.create_publisher(InertiaStamped, "/cdpr/ground_truth/payload", q)
+        self.pub_clock = self.create_publisher(Clock, "/clock", stream_qos(10))
+        self.pub_desc = self.create_publisher(String, "/plant_description", DESCRIPTION_QOS)
+        self.pub_desc.publish(convert.string_msg(self.description.to_yaml()))
+        self.create_subscription(Float64MultiArray, "/cdpr/effort_commands", self.on_command, q)
+        self.diag = Diagnostics(self, update=self.status)
+        self.timer = self.create_timer(1.0 / self.rate if self.real_time else 0.0002, self.tick)
+        self.publish_state()
+
+    # ------------------------------------------------------------------ callbacks
+    def status(self):
+        level, msg, values = self.inputs.status(time.monotonic())
+        st = self.sim.truth_state()
+        slack = [str(i + 1) for i in np.flatnonzero(st["slack"])]
+        values.update({"sim time s": f"{self.sim.time:.3f}", "brake (fallback) steps": str(self.fallbacks),
+                       "slack cable steps": str(self.slack_steps), "mode": "real time" if self.real_time
+                       else "as fast as possible (lock-step)"})
+        if slack:
+            level = max(level, WARN)
+            extra = "slack cable(s) " + ", ".join(slack)
+            msg = extra if msg == "ok" else f"{msg}; {extra}"
+        return level, msg, values
+
+    def on_command(self, msg: Float64MultiArray) -> None:
+        values = convert.float_array(msg)
+        if self.inputs.accept("effort_commands", values, time.monotonic()):
+            self.u = values.copy()
+            self.commands += 1
+
+    def reference(self, t: float):
+        """Desired pose/twist/acceleration of the s-curve at sim time t (held at A while
+        settling, at A after the return)."""
+        tt = max(0.0, t - self.settle) * self.speed
+        tr = pick_and_place(np.array([tt]))
+        return tr.position[0], tr.velocity[0] * self.speed, tr.acceleration[0] * self.speed ** 2
+
+    def tick(self) -> None:
+        now = time.monotonic()
+        if not self.real_time:
+            answered = self.commands > self.commands_at_pub
+            if not answered and now - self._last_pub_wall < self.command_timeout:
+                return                                  # lock-step: wait for the controller
+        if self.u is None or not self.inputs.fresh("effort_commands", now):
+            ms = self.sim.measure()
+            u = self.brake.update(self.sim.time, ms["motor_angle"], ms["motor_velocity"], self.brake_pose)
+            self.fallbacks += 1
+        else:
+            u = self.u
+            self.brake_pose = self.sim.truth_pose()[0]
+        self.sim.step(u, self.nstep)
+        self.k += 1
+        if self.sim.truth_state()["slack"].any():
+            self.slack_steps += 1
+        self.publish_state()
+        if self.duration and self.sim.time >= self.duration:
+            self.done = True
+
+    def publish_state(self) -> None:
+        sim, t = self.sim, self.sim.time
+        ms = sim.measure()
+        tp, tq = sim.truth_pose()
+        self.pub_clock.publish(convert.clock_msg(t))
+        if self.publish_reference:
+            pos, vel, acc = self.reference(t)
+            self.pub_ref.publish(convert.multidof_msg(t, pos, [0.0, 0.0, 0.0, 1.0], vel, None, acc, None))
+        names = [f"winch_{i}" for i in range(1, self.n + 1)]
+        self.pub_js.publish(convert.joint_state_msg(t, names, ms["motor_angle"], ms["motor_velocity"],
+                                                    ms["motor_torque"]))
+        self.pub_ten.publish(convert.joint_state_msg(t, [f"cable_{i}" for i in range(1, self.n + 1)],
+                                                     ms["cable_length"], None, ms["tension"]))
+        if self.publish_pose:
+            self.pub_pose.publish(convert.pose_msg(t, ms["position"], _wxyz_to_xyzw(ms["quat"])))
+        self.pub_tpose.publish(convert.pose_msg(t, tp, _wxyz_to_xyzw(tq)))
+        self.pub_tpay.publish(convert.inertia_msg(t, sim.truth.total_mass, sim.truth.total_com))
+        self._last_pub_wall = time.monotonic()
+        self.commands_at_pub = self.commands
+
+
+def make_node(args) -> Node:
+    return CdprSimNode()
