@@ -88,3 +88,22 @@ def test_control_bag_nothing_significant():
     ds = _dataset(CraneTruth(params=P), DESC, seed=2)
     d = rank_candidates(Model("crane", C.baseline(DESC), KNOWN_LC), ds, C.candidates(DESC))
     assert not any(r["significant"] for r in d.ranking)
+
+
+def test_002_group_fit_goes_negative_without_tilt_and_is_physical_with_it(tilted):
+    """002 sec. 6.2: the least squares gave negative inertias; the tilt columns fix it."""
+    from cablelab.effects.crane import tilt_columns
+    from cablelab.model import Param
+    from cablelab.plants.crane_identify import FIX_002, identify_groups, physical_check
+    from cablelab.plants.crane_model import PARAM_GROUPS
+
+    pi = P.groups()
+    fixed = {k: pi[PARAM_GROUPS.index(k)] for k in FIX_002}
+    s = tilted.signals
+    plain = identify_groups(s["q"], s["qd"], s["qdd"], tilted.y, fixed=fixed, bounded=False, rows=3)
+    assert physical_check(plain.values, P.boom_length)          # negative groups
+    cols = [Param(n, "", 0.0) for n in ("tilt_a", "tilt_b", "tilt_pa", "tilt_pb")]
+    fixed_fit = identify_groups(s["q"], s["qd"], s["qdd"], tilted.y, fixed=fixed, bounded=False,
+                                rows=3, extra_columns=tilt_columns(s["q"]), extra_params=cols)
+    assert physical_check(fixed_fit.values, P.boom_length) == []
+    np.testing.assert_allclose(fixed_fit.pi, pi, rtol=0.15)

@@ -227,7 +227,7 @@ DEFAULT_KD = (10.0, 12.0, 40.0)
 
 def simulate(truth: CraneTruth, duration: float, *, decimate: int = 10, seed: int = 0,
              reference=None, model_params: CraneParams | None = None,
-             kp=DEFAULT_KP, kd=DEFAULT_KD) -> SimResult:
+             kp=DEFAULT_KP, kd=DEFAULT_KD, feedforward: bool = True) -> SimResult:
     """Closed-loop run of the crane tracking ``reference`` under PD + gravity/acceleration FF.
 
     The controller of 002 sec. 5.3.1 (``Kp e + Kd e_dot + G_a(q_ref) + M_aa(q_ref) qdd_ref``, the
@@ -242,6 +242,7 @@ def simulate(truth: CraneTruth, duration: float, *, decimate: int = 10, seed: in
         reference: ``fn(t) -> (q_ref, qd_ref, qdd_ref)`` (N, 3) each; default
             :func:`reference_trajectory`.
         model_params: parameters of the feedforward (default: the truth's).
+        feedforward: False = plain PD (no gravity compensation, no acceleration feedforward).
     """
     dt = truth.timestep
     n = int(round(duration / dt))
@@ -254,7 +255,9 @@ def simulate(truth: CraneTruth, duration: float, *, decimate: int = 10, seed: in
     G = gravity_vector(q5, mp)[:, :3]
     M = mass_matrix(q5, mp)[:, :3, :3]
     kp, kd = np.asarray(kp, float), np.asarray(kd, float)
-    u0 = G + np.einsum("nij,nj->ni", M, qdd_ref) + kp * q_ref + kd * qd_ref
+    u0 = kp * q_ref + kd * qd_ref
+    if feedforward:
+        u0 = u0 + G + np.einsum("nij,nj->ni", M, qdd_ref)
     model = build_model(truth)
     data = mujoco.MjData(model)
     set_state(model, data, [q_ref[0, 0], q_ref[0, 1], q_ref[0, 2], 0.0, 0.0])
