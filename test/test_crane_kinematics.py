@@ -128,5 +128,8 @@ def test_live_tracker_matches_offline_and_reports():
     np.testing.assert_allclose(out[:, 2], d, atol=1e-12)
     assert tr.update(t[-1], tip[-1], pay[-1], a[-1])[0] == "frozen"
     assert tr.update(t[-1] + 0.01, [np.nan] * 3, pay[-1], a[-1])[0] == "dropout"
+    assert tr.counts["irregular"] == 0
+    assert tr.update(t[-1] + 0.03, tip[-1], pay[-1], a[-1])[0] == "ok"      # 3 periods: irregular
+    assert tr.counts["irregular"] == 1
     assert tr.update(t[-1] + 5.0, tip[-1], pay[-1], a[-1])[0] == "gap"
     assert tr.counts["frozen"] == 1 and tr.counts["dropout"] == 1 and tr.counts["gap"] == 1

@@ -58,9 +58,10 @@ class CraneSwingEstimator(Node):
             values[f"samples {k}"] = str(v)
         values["unpaired poses"] = str(self.unpaired)
         values["poses without a synchronous slew angle"] = str(self.unsynced)
-        if c["dropout"] or c["frozen"]:
+        if c["dropout"] or c["frozen"] or c["irregular"]:
             level = max(level, WARN)
-            extra = f"{c['dropout']} motion-capture dropouts, {c['frozen']} frozen stamps"
+            extra = (f"{c['dropout']} motion-capture dropouts, {c['frozen']} frozen stamps, "
+                     f"{c['irregular']} irregular periods")
             msg = extra if msg == "ok" else f"{msg}; {extra}"
         return level, msg, values
 

@@ -145,11 +145,15 @@ class SwingTracker:
     last_t: float | None = None
     last_x: np.ndarray | None = None
     last_v: np.ndarray = field(default_factory=lambda: np.zeros(3))
-    counts: dict = field(default_factory=lambda: {"ok": 0, "dropout": 0, "frozen": 0, "gap": 0})
+    counts: dict = field(default_factory=lambda: {"ok": 0, "dropout": 0, "frozen": 0, "gap": 0,
+                                                  "irregular": 0})
+    period: float | None = None  # running estimate of the sample period, s
 
     def update(self, t: float, tip, payload, slew: float) -> tuple[str, np.ndarray | None, np.ndarray | None]:
         """Feed one sample. Returns ``(status, [theta1, theta2, d], [rates])``.
 
+        Irregular sample periods (off the running period by more than ``IRREGULAR_FRACTION``)
+        are counted in ``counts["irregular"]``; the rate always uses the true time difference.
         status is ``"ok"``, ``"dropout"`` (non-finite pose or slew: nothing estimated),
         ``"frozen"`` (stamp not after the last one: ignored) or ``"gap"`` (estimated, but the
         velocity restarted because the previous sample is older than ``stale_after``).
@@ -172,6 +176,12 @@ class SwingTracker:
         else:
             x[0] = self.last_x[0] + np.angle(np.exp(1j * (x[0] - self.last_x[0])))  # unwrap theta1
             dt = t - self.last_t
+            if self.period is None:
+                self.period = dt
+            elif abs(dt - self.period) > IRREGULAR_FRACTION * self.period:
+                self.counts["irregular"] += 1   # irregular period: the difference uses the true dt
+            else:
+                self.period += 0.05 * (dt - self.period)
             raw = (x - self.last_x) / dt
             a = dt / (self.tau + dt) if self.tau > 0 else 1.0
             v = self.last_v + a * (raw - self.last_v)

@@ -125,15 +125,21 @@ def generate_source() -> str:
         "    qdd = np.asarray(qdd, dtype=float)",
         "    n = q.shape[0]",
     ]
-    for k, s in enumerate(q):
-        lines.append(f"    {s} = q[:, {k}]")
-        lines.append(f"    {qd[k]} = qd[:, {k}]")
-        lines.append(f"    {qdd[k]} = qdd[:, {k}]")
-    for s in q:
-        if str(s) == "d":
+    used = set()
+    for _, e in repl:
+        used |= {str(x) for x in e.free_symbols}
+    for e in reduced:
+        used |= {str(x) for x in e.free_symbols}
+    for k, sym in enumerate(q):
+        for arr, name in (("q", sym), ("qd", qd[k]), ("qdd", qdd[k])):
+            if str(name) in used:
+                lines.append(f"    {name} = {arr}[:, {k}]")
+    for sym in q:
+        if str(sym) == "d":
             continue
-        lines.append(f"    c_{s} = np.cos({s})")
-        lines.append(f"    s_{s} = np.sin({s})")
+        for f, fn in (("c", "cos"), ("s", "sin")):
+            if f"{f}_{sym}" in used:
+                lines.append(f"    {f}_{sym} = np.{fn}(q[:, {list(q).index(sym)}])")
     for sym, e in repl:
         lines.append(f"    {sym} = {pr.doprint(e)}")
     lines.append("    Y = np.zeros((n, 5, 9))")
