@@ -10,9 +10,9 @@ II-C, unless ``publish_reference`` is false and another node publishes it), the 
 
 Modes: ``real_time`` true steps at ``rate`` Hz of wall time; false runs as fast as possible in
 lock-step with the controller (a step as soon as the command answering the last published state
-arrived, or after ``command_timeout`` s without one). Without a fresh command the winch brakes hold
-the motor angles (nominal-mass feedforward + a stiff PD), reported as WARN on /diagnostics; slack
-cables are reported too.
+arrived, or after ``lockstep_timeout`` s without one). Without a fresh command the winch brakes
+lock the motor angles (the last torque + a stiff PD about the locked angles), reported as WARN on
+/diagnostics; slack cables are reported too.
 
 ROS parameters: ``description`` (YAML file or text; default CAROCA), ``payload_mass`` (kg),
 ``payload_com`` [x, y, z] (m), ``pulleys`` (bool), ``winch_coulomb`` (N m), ``winch_viscous``
@@ -20,7 +20,8 @@ ROS parameters: ``description`` (YAML file or text; default CAROCA), ``payload_m
 ``torque_noise`` (N m), ``pose_noise`` (m), ``timestep`` (s), ``rate`` (Hz), ``real_time``,
 ``publish_reference``, ``publish_pose``, ``trajectory_speed`` (time scale of the s-curve),
 ``settle`` (s held at A before the trajectory starts), ``duration`` (s of simulated time after
-which the node exits; 0 = run until stopped), ``command_timeout`` (s wall), ``seed``.
+which the node exits; 0 = run until stopped), ``command_timeout`` (s wall, real time),
+``lockstep_timeout`` (s wall, lock-step), ``seed``.
 """
 from __future__ import annotations
 
@@ -36,8 +37,6 @@ from trajectory_msgs.msg import MultiDOFJointTrajectory
 
 from cablelab.description import load_description
 from cablelab.errors import CablelabError
-from cablelab.plants.cdpr_control import PdffConfig
-from cablelab.plants.cdpr_live import ControllerConfig, LiveController
 from cablelab.plants.cdpr_trajectory import pick_and_place
 from cablelab.ros import convert
 from cablelab.ros.diagnostics import Diagnostics
@@ -83,15 +82,17 @@ class CdprSimNode(Node):
         self.settle = float(p("settle", 1.0).value)
         self.duration = float(p("duration", 0.0).value)
         self.command_timeout = float(p("command_timeout", 0.5).value)
+        self.lockstep_timeout = float(p("lockstep_timeout", 2.0).value)
         if self.rate <= 0 or self.speed <= 0:
             raise CablelabError("cable_sim_node: parameters rate and trajectory_speed must be > 0")
         start = pick_and_place(np.array([0.0])).position[0]
         self.sim = CdprSim(self.description, truth, start)
         self.nstep = max(1, int(round(1.0 / (self.rate * self.sim.truth.timestep))))
-        self.brake = LiveController(c, self.description.gravity, ControllerConfig(
-            feedforward=True, nominal_mass=c.platform_mass or 366.0, estimate_timeout=0.0,
-            gains=PdffConfig(kp=2.0, kd=0.05)))
-        self.brake_pose = start
+        # winch brakes: lock each motor angle where it was when the commands stopped, holding the
+        # last torque that carried the load (stiff PD about the locked angle)
+        self.brake_gains = (5.0, 0.05)       # N m/rad, N m s/rad
+        self.brake_q = None
+        self.brake_u = None
         self.u = None
         self.commands = 0           # good commands received
         self.commands_at_pub = 0    # ... when the last state was published (lock-step)
@@ -149,22 +150,33 @@ class CdprSimNode(Node):
         now = time.monotonic()
         if not self.real_time:
             answered = self.commands > self.commands_at_pub
-            if not answered and now - self._last_pub_wall < self.command_timeout:
+            if not answered and now - self._last_pub_wall < self.lockstep_timeout:
                 return                                  # lock-step: wait for the controller
-        if self.u is None or not self.inputs.fresh("effort_commands", now):
-            ms = self.sim.measure()
-            u = self.brake.update(self.sim.time, ms["motor_angle"], ms["motor_velocity"], self.brake_pose)
+        fresh = self.u is not None and (self.inputs.fresh("effort_commands", now) or
+                                        (not self.real_time and self.commands > self.commands_at_pub))
+        if not fresh:
+            for _ in range(self.nstep):        # brakes act continuously: every physics step
+                self.sim.step(self.brake(), 1)
             self.fallbacks += 1
         else:
-            u = self.u
-            self.brake_pose = self.sim.truth_pose()[0]
-        self.sim.step(u, self.nstep)
+            self.brake_q = None
+            self.sim.step(self.u, self.nstep)
         self.k += 1
         if self.sim.truth_state()["slack"].any():
             self.slack_steps += 1
         self.publish_state()
         if self.duration and self.sim.time >= self.duration:
             self.done = True
+
+    def brake(self) -> np.ndarray:
+        """Torques of the locked winch brakes (the plant's own safety behaviour)."""
+        ms = self.sim.measure()
+        if self.brake_q is None:
+            self.brake_q = ms["motor_angle"].copy()
+            k = self.description.cdpr.drum_radius / self.description.cdpr.gear_ratio
+            self.brake_u = self.u.copy() if self.u is not None else k * self.sim.truth_state()["tension"]
+        kp, kd = self.brake_gains
+        return self.brake_u + kp * (self.brake_q - ms["motor_angle"]) - kd * ms["motor_velocity"]
 
     def publish_state(self) -> None:
         sim, t = self.sim, self.sim.time
