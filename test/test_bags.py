@@ -369,3 +369,18 @@ def test_compressed_chunks_zstd_and_lz4_from_other_writers(tmp_path):
         got_t, got_raw = bag.raw("/js")
         assert got_t.tolist() == times.tolist() and got_raw == raws, path
         np.testing.assert_array_equal(bag.joint_state("/js").position, pos)
+
+
+def test_info_verb_json_and_errors(tmp_path, capsys):
+    import json
+
+    from cablelab.cli import main
+
+    _write_all(tmp_path / "bag", n=10)
+    assert main(["info", str(tmp_path / "bag"), "--json"]) == 0
+    out = capsys.readouterr()
+    info = json.loads(out.out)
+    assert info["plant"] == "axis" and {t["name"] for t in info["topics"]} >= {"/js", "/clock"}
+    assert main(["info", str(tmp_path / "missing")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "missing" in err and "Traceback" not in err

@@ -245,3 +245,30 @@ def test_controller_and_estimator_ignore_bad_states(ros_context):
     finally:
         ctl.destroy_node()
         est.destroy_node()
+
+
+def test_run_node_applies_ros_parameters_and_yaml_files(tmp_path, domain_id, monkeypatch):
+    """--ros-args -p and --params-file reach the node through the runner (rclpy's own parsing)."""
+    from cablelab.ros.runner import run_node
+
+    monkeypatch.setenv("ROS_DOMAIN_ID", str(domain_id))
+    params = tmp_path / "params.yaml"
+    params.write_text("/**:\n  ros__parameters:\n    inertia: 3.5\n    rate: 100.0\n")
+    seen = {}
+
+    def factory(_args):
+        from cable_sim_node.axis import AxisSimNode
+
+        node = AxisSimNode()
+        seen.update(truth=node.sim.truth, rate=node.rate)
+        node.done = True  # finish right away
+        return node
+
+    argv = ["--ros-args", "--params-file", str(params), "-p", "viscous:=7.0"]
+    assert run_node(factory, None, argv, "cable_sim_node") == 0
+    assert seen["truth"].inertia == 3.5 and seen["truth"].viscous == 7.0 and seen["rate"] == 100.0
+
+    def broken(_args):
+        raise CablelabError("description: bad thing")
+
+    assert run_node(broken, None, [], "cable_sim_node") == 2
