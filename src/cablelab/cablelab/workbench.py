@@ -17,6 +17,7 @@ from .diagnose import (channel_metrics, cv_error, derived_regimes, greedy, rank_
 from .diagnose.ranking import ALPHA, FOLDS, MIN_GAIN
 from .errors import CablelabError
 from .fit import identify as _identify
+from .fit.threads import blas_single
 from .model import Dataset, Model
 
 
@@ -64,6 +65,7 @@ def _effect_table(ident) -> dict:
                           "fixed": row["fixed"]} for row in ident.table()}
 
 
+@blas_single
 def compare(ds: Dataset, model: Model, *, segments: int = 5) -> dict:
     """Inverse-model comparison: fit on the whole record, metrics per channel, worst segments,
     residual by regime and whiteness. JSON of CONTRACT section 5 (``compare``) + extras."""
@@ -104,6 +106,7 @@ def _whiteness_summary(res, inputs) -> dict:
                           "max_abs": float(np.max(np.abs(v["xcorr"])))} for k, v in w["cross"].items()}}
 
 
+@blas_single
 def identify(ds: Dataset, model: Model, *, folds: int = FOLDS, simulation: str | None = None) -> dict:
     """Identified parameters with standard errors, rank/condition, in-sample and held-out fit.
 
@@ -133,6 +136,7 @@ def identify(ds: Dataset, model: Model, *, folds: int = FOLDS, simulation: str |
     return out
 
 
+@blas_single
 def diagnose(ds: Dataset, model: Model, candidates: Sequence[str], *, folds: int = FOLDS,
              alpha: float = ALPHA, min_gain: float = MIN_GAIN, greedy_mode: bool = False,
              quiet: bool = True) -> dict:

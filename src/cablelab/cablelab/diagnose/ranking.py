@@ -29,6 +29,7 @@ import scipy.stats
 from ..effects import get_effect
 from ..errors import CablelabError
 from ..fit import evaluate, identify
+from ..fit.threads import blas_single
 from ..model import Dataset, Model
 from .metrics import nrmse
 
@@ -67,8 +68,10 @@ def fold_indices(n: int, k: int = FOLDS, guard: int | None = None) -> list[tuple
     return out
 
 
-def cv_error(model: Model, ds: Dataset, folds: int = FOLDS) -> tuple[float, np.ndarray, np.ndarray]:
-    """Held-out NRMSE of a model (blocked k-fold).
+def cv_error(model: Model, ds: Dataset, folds: int = FOLDS, start: dict | None = None
+             ) -> tuple[float, np.ndarray, np.ndarray]:
+    """Held-out NRMSE of a model (blocked k-fold). ``start``: nonlinear parameter values to start
+    each fold's outer search from (the full-record fit), instead of a grid.
 
     Returns:
         ``(nrmse, y_meas (N, C), y_hat (N, C))`` with the held-out predictions of every sample
@@ -77,7 +80,7 @@ def cv_error(model: Model, ds: Dataset, folds: int = FOLDS) -> tuple[float, np.n
     y_meas = np.full_like(ds.y, np.nan)
     y_hat = np.full_like(ds.y, np.nan)
     for train, test in fold_indices(ds.n, folds):
-        r = identify(model, ds.subset(train))
+        r = identify(model, ds.subset(train), start=start)
         ym, yh, ok = evaluate(model, ds.subset(test), r.params)
         ym = np.where(ok[:, None], ym, np.nan)
         y_meas[test], y_hat[test] = ym, yh
@@ -180,6 +183,7 @@ class _Progress:
               file=sys.stderr, flush=True)
 
 
+@blas_single
 def rank_candidates(model: Model, ds: Dataset, candidates, *, folds: int = FOLDS,
                     alpha: float = ALPHA, min_gain: float = MIN_GAIN, quiet: bool = True) -> Diagnosis:
     """Rank candidate effects by held-out error when added to ``model``.
@@ -200,14 +204,14 @@ def rank_candidates(model: Model, ds: Dataset, candidates, *, folds: int = FOLDS
     fold_indices(ds.n, folds)  # fail early on too few samples
     prog = _Progress(len(cands) + 1, "diagnose", quiet)
     base_full = identify(model, ds)
-    err0, _, _ = cv_error(model, ds, folds)
+    err0, _, _ = cv_error(model, ds, folds, start=base_full.params)
     prog.step("baseline")
     rows = []
     for c in cands:
         m2 = model.with_effect(c)
         try:
             full = identify(m2, ds)
-            err1, _, _ = cv_error(m2, ds, folds)
+            err1, _, _ = cv_error(m2, ds, folds, start=full.params)
         except CablelabError as exc:  # e.g. the effect is not excited: rank-deficient
             rows.append({"effect": c, "error_before": err0, "error_after": None, "params": {},
                          "significant": False, "explanation": f"{c}: cannot be fitted ({exc})"})
@@ -228,6 +232,7 @@ def rank_candidates(model: Model, ds: Dataset, candidates, *, folds: int = FOLDS
     return Diagnosis(model.plant, model, err0, rows, base_full)
 
 
+@blas_single
 def greedy(model: Model, ds: Dataset, candidates, *, folds: int = FOLDS, alpha: float = ALPHA,
            min_gain: float = MIN_GAIN, max_steps: int = 10, quiet: bool = True) -> list[dict]:
     """Add the best significant candidate until none is significant (the waterfall).

@@ -91,7 +91,7 @@ def _weighted_residual(fit: LinearFit, phi, lhs, valid) -> np.ndarray:
 
 
 def identify(model: Model, ds: Dataset, *, on_deficient: str = "raise",
-             outer_grid: int = OUTER_GRID) -> Identification:
+             outer_grid: int = OUTER_GRID, start: Mapping[str, float] | None = None) -> Identification:
     """Fit the model's free parameters to the dataset.
 
     Args:
@@ -99,6 +99,8 @@ def identify(model: Model, ds: Dataset, *, on_deficient: str = "raise",
         ds: conditioned dataset of the same plant.
         on_deficient: ``"raise"`` (default) or ``"base"`` (regroup to base parameters).
         outer_grid: grid points per nonlinear parameter for the outer search start.
+        start: start values of the nonlinear parameters (e.g. the full-record fit when fitting
+            cross-validation folds); skips the grid.
     Raises:
         CablelabError: too few samples, rank-deficient regressor (names the directions).
     """
@@ -123,7 +125,9 @@ def identify(model: Model, ds: Dataset, *, on_deficient: str = "raise",
             return float(r @ r)
 
         grid = [np.linspace(a, b, outer_grid) for a, b in zip(lo, hi)]
-        if len(nl_params) > 2:  # keep the grid small: nominal start
+        if start is not None and all(k in start for k in names):
+            x0 = np.clip(np.array([float(start[k]) for k in names]), lo, hi)
+        elif len(nl_params) > 2:  # keep the grid small: nominal start
             x0 = np.array([p.nominal for p in nl_params])
         else:
             pts = np.array(list(itertools.product(*grid)))

@@ -17,6 +17,7 @@ from ..diagnose import derived_regimes, greedy, residual_by_regime, whiteness, w
 from ..diagnose.metrics import channel_metrics
 from ..errors import CablelabError
 from ..fit import identify
+from ..fit.threads import blas_single
 from ..model import Dataset, Model
 from . import plots
 
@@ -36,6 +37,7 @@ CSS = ("body{font-family:sans-serif;max-width:1100px;margin:auto;padding:1em}"
        "font-size:90%;text-align:left}th{background:#eee}img{max-width:100%}.sig{color:#060;font-weight:bold}")
 
 
+@blas_single
 def build_report(ds: Dataset, model: Model, candidates, out_dir, *, folds: int = 5,
                  title: str = "", quiet: bool = True) -> dict:
     """Analyse and write ``out_dir/index.html`` + PNGs.
