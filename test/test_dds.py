@@ -75,7 +75,9 @@ def test_sim_controller_estimator_recorder_over_dds(launcher, tmp_path):
 
     # ground truth effort is the command the simulator applied; it reports effort = command
     truth = bag.joint_state("/axis/ground_truth/joint_states")
-    np.testing.assert_array_equal(truth.effort, js.effort)
+    common, i_truth, i_js = np.intersect1d(np.round(truth.t, 6), np.round(t, 6), return_indices=True)
+    assert len(common) > 0.95 * len(t)  # (the first messages may precede DDS matching)
+    np.testing.assert_array_equal(truth.effort[i_truth], js.effort[i_js])
 
     # live RLS estimate of the inertia converges to the simulated 2 kg (Coulomb friction is a soft
     # constraint in MuJoCo, so friction terms are only loosely identified)

@@ -272,3 +272,20 @@ def test_run_node_applies_ros_parameters_and_yaml_files(tmp_path, domain_id, mon
         raise CablelabError("description: bad thing")
 
     assert run_node(broken, None, [], "cable_sim_node") == 2
+
+
+def test_clock_publisher_is_monotonic_and_throttled(ros_context):
+    from rclpy.node import Node
+
+    from cablelab.ros.clock import ClockPublisher
+
+    node = Node("clock_test")
+    try:
+        clock = ClockPublisher(node, period=0.01)
+        sent = []
+        clock.pub.publish = sent.append
+        for t in (0.0, 0.004, 0.01, 0.009, 0.02, 0.031):
+            clock.publish(t)
+        assert [m.clock.sec + m.clock.nanosec * 1e-9 for m in sent] == pytest.approx([0.0, 0.01, 0.02, 0.031])
+    finally:
+        node.destroy_node()

@@ -14,13 +14,13 @@ from __future__ import annotations
 import time
 
 from rclpy.node import Node
-from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray, String
 
 from cablelab.description import load_description
 from cablelab.plants.axis_sim import AxisSim, AxisTruth
 from cablelab.ros import convert
+from cablelab.ros.clock import ClockPublisher
 from cablelab.ros.diagnostics import Diagnostics
 from cablelab.ros.inputs import InputMonitor
 from cablelab.ros.qos import DESCRIPTION_QOS, stream_qos
@@ -47,7 +47,7 @@ class AxisSimNode(Node):
 
         self.pub_js = self.create_publisher(JointState, "/axis/joint_states", stream_qos())
         self.pub_truth = self.create_publisher(JointState, "/axis/ground_truth/joint_states", stream_qos())
-        self.pub_clock = self.create_publisher(Clock, "/clock", stream_qos(10))
+        self.clock = ClockPublisher(self)
         self.pub_desc = self.create_publisher(String, "/plant_description", DESCRIPTION_QOS)
         self.pub_desc.publish(convert.string_msg(self.description.to_yaml()))
         self.create_subscription(Float64MultiArray, "/axis/effort_command", self.on_command, stream_qos())
@@ -68,7 +68,7 @@ class AxisSimNode(Node):
 
     def publish_state(self) -> None:
         t, q, qd = self.sim.state()
-        self.pub_clock.publish(convert.clock_msg(t))
+        self.clock.publish(t)
         self.pub_js.publish(convert.joint_state_msg(t, ["joint"], [q], [qd], [self.sim.measured_effort(self.u)]))
         self.pub_truth.publish(convert.joint_state_msg(t, ["joint"], [q], [qd], [self.u]))
 
