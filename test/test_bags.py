@@ -384,3 +384,31 @@ def test_info_verb_json_and_errors(tmp_path, capsys):
     assert main(["info", str(tmp_path / "missing")]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "missing" in err and "Traceback" not in err
+
+
+def test_unindexed_mcap_falls_back_to_general_reader(tmp_path):
+    """An MCAP without chunks, indexes or statistics (valid per spec) is read by rosbags' reader
+    with the same result."""
+    from mcap.writer import CompressionType, IndexType, Writer as McapWriter
+
+    from cablelab.mcap_index import read_index
+
+    t = np.arange(300) * 1e-3
+    with BagWriter(tmp_path / "p") as w:
+        w.write_joint_states("/js", t, ["a"], np.arange(300.0)[:, None])
+    times, raws = open_bag(tmp_path / "p").raw("/js")
+    msgdef, _ = _ts().generate_msgdef(JOINT_STATE, ros_version=2)
+    path = tmp_path / "flat.mcap"
+    with open(path, "wb") as fh:
+        w = McapWriter(fh, index_types=IndexType.NONE, use_summary_offsets=False, use_statistics=False,
+                       use_chunking=False, compression=CompressionType.NONE)
+        w.start(profile="ros2", library="test")
+        sid = w.register_schema(name=JOINT_STATE, encoding="ros2msg", data=msgdef.encode())
+        cid = w.register_channel(topic="/js", message_encoding="cdr", schema_id=sid)
+        for i, (stamp, raw) in enumerate(zip(times.tolist(), raws)):
+            w.add_message(channel_id=cid, log_time=stamp, publish_time=stamp, data=raw, sequence=i)
+        w.finish()
+    assert read_index(path) is None
+    bag = open_bag(path)
+    np.testing.assert_array_equal(bag.joint_state("/js").position[:, 0], np.arange(300.0))
+    assert bag.raw("/js")[1] == raws
