@@ -107,3 +107,39 @@ def test_replay_republishes_same_messages_with_description(launcher, tmp_path):
     clock, _ = got.clock()
     assert clock.min() >= t[0] - 1e-9 and clock.max() <= t[-1] + 1e-9 and len(clock) > 100
     assert got.description.axis.inertia == 7.0
+
+
+BEST_EFFORT_PUBLISHER = """
+import time, rclpy
+from rclpy.qos import QoSProfile, ReliabilityPolicy
+from rosgraph_msgs.msg import Clock
+from std_msgs.msg import String
+rclpy.init()
+node = rclpy.create_node("foreign_sim")
+clock = node.create_publisher(Clock, "/clock", QoSProfile(depth=1, reliability=ReliabilityPolicy.BEST_EFFORT))
+desc = node.create_publisher(String, "/plant_description", 10)  # volatile, unlike the contract
+k = 0
+while rclpy.ok():
+    msg = Clock()
+    msg.clock.sec, msg.clock.nanosec = divmod(k * 10_000_000, 1_000_000_000)
+    clock.publish(msg)
+    if k % 10 == 0:
+        desc.publish(String(data="plant: axis\\naxis:\\n  joint_type: prismatic\\n"))
+    k += 1
+    time.sleep(0.01)
+"""
+
+
+def test_recorder_adapts_to_best_effort_and_volatile_publishers(launcher, tmp_path):
+    """Like rosbag2, the recorder matches what publishers offer (e.g. `ros2 bag play --clock`
+    publishes /clock best-effort): otherwise DDS would never deliver those messages."""
+    bag_dir = tmp_path / "bag"
+    rec = _record(launcher, "recorder", bag_dir)
+    launcher.start("foreign", [sys.executable, "-c", BEST_EFFORT_PUBLISHER])
+    launcher.wait_for_topics({"/clock": 300, "/plant_description": 1}, timeout=90)
+    rec.signal(signal.SIGINT)
+    assert rec.wait(30) == 0, rec.log()
+    bag = open_bag(bag_dir)
+    assert bag.counts.get("/clock", 0) > 50, bag.counts
+    assert bag.counts.get("/plant_description", 0) >= 1, bag.counts
+    assert "best-effort" in rec.log()

@@ -153,8 +153,14 @@ def wait_for_topics(counts: dict[str, int], domain_id: int, timeout: float = 60.
     from rclpy.executors import SingleThreadedExecutor
     from rclpy.node import Node
 
+    from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+
     from .convert import message_class
-    from .qos import qos_for
+    from .qos import DESCRIPTION_QOS
+
+    # best effort matches reliable and best-effort publishers alike (counting only)
+    probe_qos = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=100,
+                           reliability=ReliabilityPolicy.BEST_EFFORT)
 
     ctx = Context()
     rclpy.init(context=ctx, domain_id=domain_id)
@@ -170,11 +176,17 @@ def wait_for_topics(counts: dict[str, int], domain_id: int, timeout: float = 60.
                 types = dict(node.get_topic_names_and_types())
                 for topic in counts:
                     if topic not in subs and topic in types:
+                        infos = node.get_publishers_info_by_topic(topic)
+                        if not infos:
+                            continue  # only subscribers so far: choose the QoS once publishers exist
                         cls = message_class(types[topic][0])
 
                         def cb(_msg, topic=topic):
                             seen[topic] += 1
-                        subs[topic] = node.create_subscription(cls, topic, cb, qos_for(topic), raw=True)
+                        latched = all(
+                            i.qos_profile.durability == DurabilityPolicy.TRANSIENT_LOCAL for i in infos)
+                        qos = DESCRIPTION_QOS if latched else probe_qos
+                        subs[topic] = node.create_subscription(cls, topic, cb, qos, raw=True)
             ex.spin_once(timeout_sec=0.05)
             if all(seen[t] >= n for t, n in counts.items()):
                 return seen

@@ -20,12 +20,14 @@ def stream_qos(depth: int = 100) -> QoSProfile:
                       durability=DurabilityPolicy.VOLATILE)
 
 
-def recorder_qos(transient_local: bool = False) -> QoSProfile:
-    """Reliable keep-all (depth 1 transient-local for /plant_description)."""
+def recorder_qos(transient_local: bool = False, reliable: bool = True) -> QoSProfile:
+    """Keep-all, reliable unless ``reliable=False`` (to match a best-effort publisher);
+    transient-local depth 1 (as /plant_description) when ``transient_local``."""
+    reliability = ReliabilityPolicy.RELIABLE if reliable else ReliabilityPolicy.BEST_EFFORT
     if transient_local:
-        return DESCRIPTION_QOS
-    return QoSProfile(history=HistoryPolicy.KEEP_ALL, depth=1000,
-                      reliability=ReliabilityPolicy.RELIABLE,
+        return QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1, reliability=reliability,
+                          durability=DurabilityPolicy.TRANSIENT_LOCAL)
+    return QoSProfile(history=HistoryPolicy.KEEP_ALL, depth=1000, reliability=reliability,
                       durability=DurabilityPolicy.VOLATILE)
 
 

@@ -35,6 +35,8 @@ class RecorderNode(Node):
         self.writer = writer.open()
         self.wanted = dict(topics)
         self.subs = {}
+        self.sub_qos: dict[str, tuple[bool, bool]] = {}  # topic -> (reliable, transient_local)
+        self.registered: set[str] = set()
         self.counts = {t: 0 for t in topics}
         self.quiet = quiet
         self.duration = float(duration)
@@ -51,25 +53,48 @@ class RecorderNode(Node):
             self.create_timer(0.05, self._check_duration)
         self.create_timer(5.0, self._progress)
 
-    def _subscribe(self, topic: str, msgtype: str) -> None:
+    def _subscribe(self, topic: str, msgtype: str, reliable: bool = True,
+                   transient: bool | None = None) -> None:
         try:
             cls = message_class(msgtype)
         except ValueError:
             raise CablelabError(f"record: topic {topic}: unknown message type {msgtype}") from None
         write = self.writer.write_raw
         counts = self.counts
-        transient = topic == "/plant_description"
-        registered = []
+        if transient is None:
+            transient = topic == "/plant_description"
+        registered = self.registered
 
         def callback(data: bytes) -> None:
-            if not registered:
-                self.writer.add_topic(topic, msgtype, transient_local=transient)
-                registered.append(True)
+            if topic not in registered:
+                self.writer.add_topic(topic, msgtype, transient_local=topic == "/plant_description")
+                registered.add(topic)
             write(topic, time.time_ns(), data)
             counts[topic] += 1
 
-        self.subs[topic] = self.create_subscription(cls, topic, callback, recorder_qos(transient),
-                                                    raw=True)
+        self.subs[topic] = self.create_subscription(cls, topic, callback,
+                                                    recorder_qos(transient, reliable), raw=True)
+        self.sub_qos[topic] = (reliable, transient)
+
+    def _adapt_qos(self, topic: str, msgtype: str) -> None:
+        """Downgrade a subscription to what every publisher offers (like rosbag2): best-effort if a
+        publisher is best-effort, volatile if one is volatile (else they would never match)."""
+        from rclpy.qos import DurabilityPolicy, ReliabilityPolicy
+
+        infos = self.get_publishers_info_by_topic(topic)
+        if not infos:
+            return
+        reliable, transient = self.sub_qos[topic]
+        if reliable and any(i.qos_profile.reliability == ReliabilityPolicy.BEST_EFFORT for i in infos):
+            reliable = False
+        if transient and any(i.qos_profile.durability == DurabilityPolicy.VOLATILE for i in infos):
+            transient = False
+        if (reliable, transient) != self.sub_qos[topic]:
+            self.get_logger().warning(f"{topic}: a publisher offers "
+                                      f"{'best-effort' if not reliable else 'volatile'} QoS; "
+                                      "recording it with that QoS")
+            self.destroy_subscription(self.subs.pop(topic))
+            self._subscribe(topic, msgtype, reliable, transient)
 
     def _discover(self) -> None:
         types = dict(self.get_topic_names_and_types())
@@ -84,6 +109,8 @@ class RecorderNode(Node):
                                         f"expected {msgtype}: those messages are not recorded")
             if topic not in self.subs and found:
                 self._subscribe(topic, found[0])
+            if topic in self.subs and found:
+                self._adapt_qos(topic, found[0])
 
     def _flush(self) -> None:
         if not self.closed:
