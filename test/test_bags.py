@@ -412,3 +412,22 @@ def test_unindexed_mcap_falls_back_to_general_reader(tmp_path):
     bag = open_bag(path)
     np.testing.assert_array_equal(bag.joint_state("/js").position[:, 0], np.arange(300.0))
     assert bag.raw("/js")[1] == raws
+
+
+def test_sqlite3_bag_is_read_too(tmp_path):
+    """Older rosbag2 bags in sqlite3 storage go through rosbags' general reader."""
+    from rosbags.rosbag2 import StoragePlugin, Writer
+
+    t = np.arange(50) * 0.01
+    with BagWriter(tmp_path / "p") as w:
+        w.write_joint_states("/js", t, ["a"], np.arange(50.0)[:, None])
+        w.write_description(AXIS_YAML)
+    src = open_bag(tmp_path / "p")
+    with Writer(tmp_path / "db", version=8, storage_plugin=StoragePlugin.SQLITE3) as w:
+        for topic in ("/js", "/plant_description"):
+            conn = w.add_connection(topic, src.topics[topic], typestore=_ts())
+            for stamp, raw in zip(*[x.tolist() if hasattr(x, "tolist") else x for x in src.raw(topic)]):
+                w.write(conn, stamp, raw)
+    bag = open_bag(tmp_path / "db")
+    np.testing.assert_array_equal(bag.joint_state("/js").position[:, 0], np.arange(50.0))
+    assert bag.description.plant == "axis"

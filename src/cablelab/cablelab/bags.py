@@ -454,8 +454,7 @@ def open_bag(path, *, recover: bool = False) -> Bag:
         files = sorted(target.glob("*.mcap"))
         if len(files) == 1:
             mcap_file = files[0]
-        elif not files:
-            raise _bag_error(given, "bag has no .mcap file (only MCAP storage is supported)")
+        # several .mcap files (split bag) or sqlite3 (.db3) storage: rosbags' general reader
     if mcap_file is not None and (not mcap_file.exists() or mcap_file.stat().st_size == 0):
         raise _bag_error(mcap_file, "empty MCAP file")
     if mcap_file is not None and _mcap_truncated(mcap_file):
