@@ -36,9 +36,16 @@ class ReplayNode(Node):
         self.quiet = quiet
         names = [t for t in bag.topics if topics is None or t in topics]
         self.pubs = {}
-        for topic in names:
+        for topic in list(names):
+            try:
+                cls = message_class(bag.topics[topic])
+            except ValueError:
+                self.get_logger().warning(f"{topic}: message type {bag.topics[topic]} is not "
+                                          "installed; not replayed")
+                names.remove(topic)
+                continue
             qos = DESCRIPTION_QOS if topic == DESCRIPTION_TOPIC else stream_qos(1000)
-            self.pubs[topic] = self.create_publisher(message_class(bag.topics[topic]), topic, qos)
+            self.pubs[topic] = self.create_publisher(cls, topic, qos)
         if DESCRIPTION_TOPIC in self.pubs and bag.counts[DESCRIPTION_TOPIC]:
             self.pubs[DESCRIPTION_TOPIC].publish(bytes(bag.raw(DESCRIPTION_TOPIC)[1][-1]))
         streams = [t for t in names if t != DESCRIPTION_TOPIC and bag.counts[t]]
