@@ -86,8 +86,19 @@ def build_report(ds: Dataset, model: Model, candidates, out_dir, *, folds: int =
              f"{html.escape(ds.source)}; held-out errors by blocked {folds}-fold cross-validation.</p>"]
     parts.append("<h2>Adding the missing effects</h2><img src='waterfall.png'>")
     rows = [[i, html.escape(s["added"] or "nominal: " + " + ".join(s["effects"])),
-             _num(100 * s["error"], "{:.2f} %")] for i, s in enumerate(steps)]
-    parts.append(_table(rows, ["step", "model", "held-out NRMSE"]))
+             _num(100 * s["error"], "{:.2f} %"),
+             html.escape(", ".join(f"{k} = {v:.5g} +- {s['stderr'].get(k, 0):.2g} {s['units'].get(k, '')}"
+                                   for k, v in s["params"].items()))] for i, s in enumerate(steps)]
+    parts.append(_table(rows, ["step", "model", "held-out NRMSE", "parameters (full record)"]))
+    for i, st in enumerate(steps):
+        if i == 0:
+            continue  # the nominal residual is plotted below
+        ident_i = fin if i == len(steps) - 1 else identify(Model(model.plant, tuple(st["effects"]),
+                                                                 model.fixed), ds)
+        name = f"step_{i}_residual.png"
+        plots.residual_time(fig(name), ds.t, ident_i.residual, [], ds.channels, ds.units,
+                            f"step {i}: + {st['added']} (held-out NRMSE {100 * st['error']:.2f} %)")
+        parts.append(f"<img src='{name}'>")
     parts.append("<h2>Which effect is missing (nominal model)</h2>")
     rows = [[f"<span class='sig'>{r['effect']}</span>" if r["significant"] else r["effect"],
              _num(None if r["error_after"] is None else 100 * r["error_after"], "{:.2f} %"),
