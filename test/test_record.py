@@ -98,11 +98,10 @@ def test_replay_republishes_same_messages_with_description(launcher, tmp_path):
     np.testing.assert_array_equal(b.position, a.position)
     np.testing.assert_array_equal(b.effort, a.effort)
     np.testing.assert_array_equal(b.t, a.t)
-    # paced at rate 2: 2.99 s of bag time replayed in about 1.5 s, never faster; faster than real
-    # time unless the replayer was starved of CPU (then its typical spacing still shows rate 2)
-    span = b.t_receive[-1] - b.t_receive[0]
-    assert span > 1.2, span
-    assert span < 2.9 or np.median(np.diff(b.t_receive)) < 0.0075, span
+    # paced at rate 2: messages 10 ms apart in the bag arrive about 5 ms apart (median: robust to
+    # the burst DDS may deliver while the reliable connection completes, and to a busy machine)
+    spacing = float(np.median(np.diff(b.t_receive)))
+    assert 0.0035 < spacing < 0.0075, spacing
     # /clock synthesised from the bag's log time (the bag had none)
     clock, _ = got.clock()
     assert clock.min() >= t[0] - 1e-9 and clock.max() <= t[-1] + 1e-9 and len(clock) > 100
