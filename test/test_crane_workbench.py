@@ -107,3 +107,17 @@ def test_002_group_fit_goes_negative_without_tilt_and_is_physical_with_it(tilted
                                 rows=3, extra_columns=tilt_columns(s["q"]), extra_params=cols)
     assert physical_check(fixed_fit.values, P.boom_length) == []
     np.testing.assert_allclose(fixed_fit.pi, pi, rtol=0.15)
+
+
+@pytest.mark.parametrize("truth_kw, effect, names, values", [
+    (dict(viscous=(0.3, 0.3, 2.0)), "joint_viscous_friction", ("Fv[slew]", "Fv[luff]", "Fv[hoist]"), (0.3, 0.3, 2.0)),
+    (dict(coulomb=(0.1, 0.1, 0.3)), "joint_coulomb_friction", ("Fc[slew]", "Fc[luff]", "Fc[hoist]"), (0.1, 0.1, 0.3)),
+    (dict(torque_offset=(0.1, -0.2, 0.3)), "torque_sensor_offset", ("OF[slew]", "OF[luff]", "OF[hoist]"), (0.1, -0.2, 0.3)),
+])
+def test_generic_joint_effects_in_the_truth_are_found(truth_kw, effect, names, values):
+    ds = _dataset(CraneTruth(params=P, **truth_kw), DESC, seed=3, duration=40.0)
+    d = rank_candidates(Model("crane", C.baseline(DESC), KNOWN_LC), ds, C.candidates(DESC))
+    best = d.ranking[0]
+    assert best["effect"] == effect and best["significant"]
+    for n, v in zip(names, values):
+        assert best["params"][n] == pytest.approx(v, rel=0.1, abs=0.01), n

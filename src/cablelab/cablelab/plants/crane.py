@@ -208,19 +208,6 @@ def candidates(description) -> tuple[str, ...]:
             "torque_sensor_offset")
 
 
-def known_parameters(description) -> dict:
-    """Description values of the model's parameters (for ``--fix``): m, m_b, m_c, l_c when given."""
-    c = description.crane
-    out = {}
-    if c.payload_mass is not None:
-        out["m"] = c.payload_mass
-    if c.boom_mass is not None:
-        out["m_b"] = c.boom_mass
-    if c.counterbalance is not None:
-        out["m_c"], out["l_c"] = c.counterbalance.mass, c.counterbalance.distance
-    return out
-
-
 CRANE = register_plant(Plant(
     name="crane",
     topics=((JOINT_STATES, JOINT_STATE), (TIP_POSE, POSE), (PAYLOAD_POSE, POSE)),
