@@ -57,7 +57,10 @@ def test_identify_and_compare_on_emps(capsys):
     p = ident["params"]
     for k, v in PUBLISHED.items():
         assert p[k]["value"] == pytest.approx(v, rel=0.02)
-        assert 0 < p[k]["stderr"] < 0.02 * abs(v)
+        # the autocorrelation-corrected standard errors cover the published (independent IDIM)
+        # estimates within 3 sigma; the white-noise LS ones would not (Fc is 3.2 white sigma off)
+        assert 0 < p[k]["stderr"] < 0.05 * abs(v)
+        assert abs(p[k]["value"] - v) < 3 * p[k]["stderr"], k
     assert p["M"]["unit"] == "kg" and p["Fv"]["unit"] == "N s/m"
     assert ident["fit"]["rank"] == 4 and ident["fit"]["unidentifiable"] == []
     assert ident["fit"]["nrmse"] == pytest.approx(0.0443, abs=0.003)

@@ -26,7 +26,7 @@ def add_common(p, *, effects_required: bool = False) -> None:
 
 def add_folds(p) -> None:
     p.add_argument("--folds", type=int, default=5, metavar="K",
-                   help="blocked k-fold cross-validation over time (default 5)")
+                   help="blocked k-fold cross-validation over time (default 5; identify: 0 = none)")
 
 
 def load_from_args(args):

@@ -23,9 +23,10 @@ def run(args) -> int:
         print(dump_json(out))
         return 0
     f = out["fit"]
+    held = f"held-out {100 * f['cv_nrmse']:.2f} %, {f['folds']} folds" if f["cv_nrmse"] is not None \
+        else "no cross-validation"
     print(f"plant {out['plant']}, model {' + '.join(out['effects'])}: NRMSE {100 * f['nrmse']:.2f} % "
-          f"(held-out {100 * f['cv_nrmse']:.2f} %, {f['folds']} folds), rank {f['rank']}, "
-          f"condition {f['condition']:.3g}")
+          f"({held}), rank {f['rank']}, condition {f['condition']:.3g}")
     for name, v in out["params"].items():
         tag = " (fixed)" if v["fixed"] else ""
         print(f"  {name:>12} = {v['value']:.6g} +- {v['stderr']:.2g} {v['unit']}{tag}")

@@ -29,6 +29,7 @@ import scipy.stats
 from ..effects import get_effect
 from ..errors import CablelabError
 from ..fit import evaluate, identify
+from ..fit.identify import lag1_autocorrelation
 from ..fit.threads import blas_single
 from ..model import Dataset, Model
 from .metrics import nrmse
@@ -88,14 +89,6 @@ def cv_error(model: Model, ds: Dataset, folds: int = FOLDS, start: dict | None =
     return nrmse(y_meas, y_hat, ok), y_meas, y_hat
 
 
-def _lag1(r: np.ndarray) -> float:
-    r = r[np.isfinite(r).all(axis=1)] if r.ndim == 2 else r[np.isfinite(r)]
-    r = r - r.mean(axis=0)
-    num = np.sum(r[1:] * r[:-1])
-    den = np.sum(r * r)
-    return float(np.clip(num / den, 0.0, 0.999)) if den > 0 else 0.0
-
-
 def _n_params(ident) -> int:
     return len(ident.params) - len(ident.fixed)
 
@@ -110,7 +103,7 @@ def significance(base, cand, n_candidates: int = 1, alpha: float = ALPHA) -> dic
     """
     rss0, rss1 = base.linear.rss, cand.linear.rss
     n = cand.linear.n
-    r1 = _lag1(cand.residual)
+    r1 = lag1_autocorrelation(cand.residual)
     n_eff = max(n * (1.0 - r1) / (1.0 + r1), 3.0)
     p0, p1 = _n_params(base), _n_params(cand)
     dp = max(p1 - p0, 1)

@@ -31,7 +31,9 @@ class Identification:
     Attributes:
         model: the model.
         params: every parameter by name (free linear, nonlinear, fixed).
-        stderr: standard error by name (0 for fixed).
+        stderr: standard error by name (0 for fixed): the LS covariance, inflated by
+            sqrt((1 + r1) / (1 - r1)) for the residual's lag-1 autocorrelation r1 (AR(1) effective
+            sample size); ``extra["stderr_white"]`` has the uninflated ones.
         units: unit by name.
         fixed: names of the known (not fitted) parameters.
         linear: the inner :class:`LinearFit` (rank, condition, unidentifiable directions).
@@ -192,8 +194,28 @@ def identify(model: Model, ds: Dataset, *, on_deficient: str = "raise",
     else:
         y_hat, _ = model.predict(ds, params)
     resid = np.where(valid[:, None], ds2.y - y_hat, np.nan)
+    # coloured residuals: the LS covariance assumes independent samples; inflate the standard
+    # errors by sqrt(n / n_eff) with the AR(1) effective sample size n_eff = n (1 - r1) / (1 + r1)
+    r1 = lag1_autocorrelation(resid)
+    inflation = float(np.sqrt((1.0 + r1) / (1.0 - r1)))
+    white = dict(stderr)
+    stderr = {k: v * inflation for k, v in stderr.items()}
     return Identification(model, params, stderr, units, tuple(model.fixed), fit, y_hat, resid,
-                          valid, tuple(ds.channels))
+                          valid, tuple(ds.channels),
+                          extra={"stderr_white": white, "lag1": r1, "stderr_inflation": inflation})
+
+
+def lag1_autocorrelation(residual: np.ndarray) -> float:
+    """Lag-1 autocorrelation of a residual (N,) or (N, C) (channels pooled, NaN rows dropped),
+    clipped to [0, 0.999]."""
+    r = np.asarray(residual, dtype=float)
+    r = r.reshape(r.shape[0], -1)
+    r = r[np.isfinite(r).all(axis=1)]
+    if r.shape[0] < 3:
+        return 0.0
+    r = r - r.mean(axis=0)
+    den = float(np.sum(r * r))
+    return float(np.clip(np.sum(r[1:] * r[:-1]) / den, 0.0, 0.999)) if den > 0 else 0.0
 
 
 class _OuterProblem:
