@@ -21,7 +21,9 @@ def test_sim_controller_estimator_recorder_over_dds(launcher, tmp_path):
     bag_dir = tmp_path / "run"
     launcher.start("recorder", [sys.executable, "-m", "cablelab.cli", "record", "--plant", "axis",
                                 "-o", bag_dir, "--quiet"])
-    launcher.node("sim", "cable_sim_node", "axis", {**TRUE, "rate": 200.0})
+    # lock-step: the plant waits for the answer to each state, so a loaded machine slows the run
+    # down but cannot add control delay (the physics checks below are then deterministic)
+    launcher.node("sim", "cable_sim_node", "axis", {**TRUE, "rate": 200.0, "lockstep": True})
     launcher.node("controller", "pd_feedforward", "axis",
                   {"reference_source": "sine", "amplitude": AMPLITUDE, "frequency": FREQUENCY,
                    "kp": KP, "kd": KD})
@@ -40,7 +42,9 @@ def test_sim_controller_estimator_recorder_over_dds(launcher, tmp_path):
 
     js = bag.joint_state("/axis/joint_states")
     assert js.names == ["joint"]
-    t, q, qd = js.t, js.position[:, 0], js.velocity[:, 0]
+    # (a state is resent while the sim waits for its first answer: keep one per stamp)
+    _, first = np.unique(js.t, return_index=True)
+    t, q, qd = js.t[first], js.position[first, 0], js.velocity[first, 0]
     # sim time advances by exactly one publishing period per message (no message lost on the way)
     np.testing.assert_allclose(np.diff(t), 1 / 200.0, atol=1e-9)
     # recorded velocity = derivative of recorded position (trapezoid rule of the integrator)
@@ -71,11 +75,14 @@ def test_sim_controller_estimator_recorder_over_dds(launcher, tmp_path):
     us = np.sort(u)
     pos = np.clip(np.searchsorted(us, cmd), 1, len(us) - 1)
     nearest = np.minimum(np.abs(us[pos] - cmd), np.abs(us[pos - 1] - cmd))
-    assert np.quantile(nearest, 0.99) < 1e-6, nearest.max()
+    # (the recorder may match the controller's command publisher before its reference publisher:
+    # the very first commands can lack their recorded reference)
+    bad = np.flatnonzero(nearest > 1e-6)
+    assert len(bad) < 0.05 * len(cmd) and (bad < 0.05 * len(cmd)).all(), (bad, len(cmd))
 
     # ground truth effort is the command the simulator applied; it reports effort = command
     truth = bag.joint_state("/axis/ground_truth/joint_states")
-    common, i_truth, i_js = np.intersect1d(np.round(truth.t, 6), np.round(t, 6), return_indices=True)
+    common, i_truth, i_js = np.intersect1d(np.round(truth.t, 6), np.round(js.t, 6), return_indices=True)
     assert len(common) > 0.95 * len(t)  # (the first messages may precede DDS matching)
     np.testing.assert_array_equal(truth.effort[i_truth], js.effort[i_js])
 

@@ -7,7 +7,12 @@ and ``/plant_description`` (transient-local). Physics: :mod:`cablelab.plants.axi
 ROS parameters: ``description`` (YAML file or text; default a prismatic 2 kg axis),
 ``inertia``, ``viscous``, ``coulomb``, ``offset`` (true values, SI), ``timestep`` (s),
 ``rate`` (Hz of publishing = command sampling), ``command_timeout`` (s wall; a stale command
-falls back to 0 and the node reports WARN).
+falls back to 0 and the node reports WARN), ``lockstep`` (bool, default false: the simulation
+advances one period only after a command answering the last published state arrived, so a
+loaded machine slows the run down instead of delaying the control loop; the state is
+republished every ``lockstep_resend`` s while waiting, e.g. before the controller connected).
+
+The effort reported with a state is the command held over the period that ends at that state.
 """
 from __future__ import annotations
 
@@ -40,6 +45,10 @@ class AxisSimNode(Node):
                           viscous=p("viscous", 5.0).value, coulomb=p("coulomb", 1.0).value,
                           offset=p("offset", 0.0).value, timestep=p("timestep", 0.001).value)
         self.rate = float(p("rate", 200.0).value)
+        self.lockstep = bool(p("lockstep", False).value)
+        self.resend = float(p("lockstep_resend", 0.25).value)
+        self.answered = False  # lockstep: a command arrived since the last published state
+        self.last_publish = time.monotonic()
         self.sim = AxisSim(self.description, truth)
         self.u = 0.0
         self.inputs = InputMonitor()
@@ -59,14 +68,22 @@ class AxisSimNode(Node):
         values = convert.float_array(msg)
         if self.inputs.accept("effort_command", values, time.monotonic()):
             self.u = float(values[0])
+            self.answered = True
 
     def tick(self) -> None:
-        if not self.inputs.fresh("effort_command", time.monotonic()):
+        now = time.monotonic()
+        if self.lockstep and not self.answered:
+            if now - self.last_publish > self.resend:
+                self.publish_state()  # the controller may have missed it (not connected yet)
+            return
+        if not self.lockstep and not self.inputs.fresh("effort_command", now):
             self.u = 0.0  # no (fresh) command: the drive is switched off
         self.sim.advance(self.u, 1.0 / self.rate)
         self.publish_state()
 
     def publish_state(self) -> None:
+        self.answered = False
+        self.last_publish = time.monotonic()
         t, q, qd = self.sim.state()
         self.clock.publish(t)
         self.pub_js.publish(convert.joint_state_msg(t, ["joint"], [q], [qd], [self.sim.measured_effort(self.u)]))

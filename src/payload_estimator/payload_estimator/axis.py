@@ -3,7 +3,8 @@
 Recursive least squares (:class:`cablelab.rls.RecursiveLeastSquares`) of the axis inverse model
 ``u - m c g sin q = M qdd + Fv qd + Fc sign(qd) + offset`` (:func:`cablelab.plants.axis_control.
 regressor`) from ``/axis/joint_states``; qdd and the mid-interval velocity come from consecutive
-samples (the command is held over the interval). Publishes ``/axis/parameter_estimate``
+samples, the force from the later one (the simulator reports with each sample the command held
+over the period ending there). A sample repeating the previous stamp is ignored. Publishes ``/axis/parameter_estimate``
 (std_msgs/Float64MultiArray ``[M, Fv, Fc, offset]``, an addition to the contract, see
 docs/nodes.md) every ``publish_every`` samples.
 
@@ -75,8 +76,8 @@ class AxisEstimator(Node):
         dt = cur[0] - prev[0]
         v0 = prev[2] if np.isfinite(prev[2]) else (cur[1] - prev[1]) / dt
         v1 = cur[2] if np.isfinite(cur[2]) else (cur[1] - prev[1]) / dt
-        # effort of the previous sample was applied during [prev, cur]
-        y = prev[3] - gravity_load(0.5 * (prev[1] + cur[1]), self.gravity_moment, self.gravity)
+        # the effort reported with a sample is the command held over the period ending there
+        y = cur[3] - gravity_load(0.5 * (prev[1] + cur[1]), self.gravity_moment, self.gravity)
         self.rls.update(regressor([0.5 * (v0 + v1)], [(v1 - v0) / dt], self.eps), [y])
         self.count += 1
         if self.count % self.every == 0:
