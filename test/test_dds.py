@@ -86,8 +86,10 @@ def test_sim_controller_estimator_recorder_over_dds(launcher, tmp_path):
     assert len(common) > 0.95 * len(t)  # (the first messages may precede DDS matching)
     np.testing.assert_array_equal(truth.effort[i_truth], js.effort[i_js])
 
-    # live RLS estimate of the inertia converges to the simulated 2 kg (Coulomb friction is a soft
-    # constraint in MuJoCo, so friction terms are only loosely identified)
-    est = bag.float_array("/axis/parameter_estimate").data
-    assert abs(est[-1, 0] - TRUE["inertia"]) < 0.25 * TRUE["inertia"], est[-1]
-    assert 0 < est[-1, 1] < 3 * TRUE["viscous"], est[-1]
+    # live RLS estimate of [M, Fv, Fc, offset] converges to the simulated values (Coulomb friction
+    # is a soft constraint in MuJoCo, so Fc is only loosely identified)
+    est = bag.float_array("/axis/parameter_estimate").data[-1]
+    assert abs(est[0] - TRUE["inertia"]) < 0.05 * TRUE["inertia"], est
+    assert abs(est[1] - TRUE["viscous"]) < 0.2 * TRUE["viscous"], est
+    assert 0.5 * TRUE["coulomb"] < est[2] < 1.5 * TRUE["coulomb"], est
+    assert abs(est[3]) < 0.3, est
