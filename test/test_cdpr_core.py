@@ -3,7 +3,8 @@ import numpy as np
 import pytest
 
 from cablelab.description import load_description
-from cablelab.plants.cdpr_estimation import (mass_com, mass_com_from_wrench, tensions_from_torques,
+from cablelab.plants.cdpr_estimation import (mass_com, mass_com_batch, mass_com_from_wrench,
+                                             tensions_from_torques,
                                              torques_from_tensions)
 from cablelab.plants.cdpr_geometry import (cable_geometry, cable_wrench, matrix_to_quat,
                                            quat_to_matrix, wrench_matrix)
@@ -108,6 +109,23 @@ def test_mass_com_static_equilibrium(caroca, r):
     np.testing.assert_allclose(est.com, np.broadcast_to(c[:2], est.com.shape), atol=1e-9)
     assert est.residual.max() < 1e-6
     np.testing.assert_allclose(cable_wrench(g, t), np.einsum("tij,tj->ti", W, t), atol=1e-8)
+
+
+@pytest.mark.parametrize("r", [0.0, 0.15])
+def test_batch_kernel_equals_general_path(caroca, r):
+    """The fast offline kernel (per-coordinate, chunked) is a second implementation of
+    cable_geometry + mass_com: same mass, CoM and residual, also with tilted swivel axes."""
+    rng = np.random.default_rng(3)
+    N = 5000
+    P = np.column_stack([rng.uniform(-1, 1, N), rng.uniform(-0.4, 0.4, N), rng.uniform(0.6, 1.2, N)])
+    T = rng.uniform(200, 2000, (N, 8))
+    axes = caroca.swivel_axes + 0.1 * rng.standard_normal((8, 3))
+    axes /= np.linalg.norm(axes, axis=1, keepdims=True)
+    ref = mass_com(cable_geometry(caroca.exit_points, caroca.anchor_points, P, None, r, axes), T)
+    fast = mass_com_batch(caroca.exit_points, caroca.anchor_points, P, T, r, 9.81, axes, chunk=777)
+    np.testing.assert_allclose(fast.mass, ref.mass, rtol=1e-12)
+    np.testing.assert_allclose(fast.com, ref.com, atol=1e-12)
+    np.testing.assert_allclose(fast.residual, ref.residual, rtol=1e-9, atol=1e-9)
 
 
 def test_mass_with_acceleration_and_tilt():

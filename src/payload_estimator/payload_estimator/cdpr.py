@@ -62,7 +62,7 @@ class CdprPayloadEstimator(Node):
         self.inputs.add("pose", timeout=timeout)
         if self.config.tensions == "motor":
             self.inputs.add("joint_states", timeout=timeout)
-        q = stream_qos()
+        q = stream_qos(1000)     # deep queue: a busy moment delays samples instead of dropping them
         self.pub = self.create_publisher(InertiaStamped, "/cdpr/payload_estimate", q)
         self.create_subscription(String, "/plant_description", self.on_description, DESCRIPTION_QOS)
         text = p("description", "").value

@@ -64,7 +64,7 @@ class CdprController(Node):
         self.inputs.add("reference", timeout=float(p("reference_timeout", 0.5).value))
         self.inputs.add("payload_estimate", timeout=self.estimate_timeout, length=1,
                         required=False)
-        q = stream_qos()
+        q = stream_qos(1000)     # deep queue: a busy moment delays samples instead of dropping them
         self.pub_cmd = self.create_publisher(Float64MultiArray, "/cdpr/effort_commands", q)
         self.create_subscription(String, "/plant_description", self.on_description, DESCRIPTION_QOS)
         text = p("description", "").value

@@ -104,7 +104,8 @@ AXIS = register_plant(Plant(
     candidates=candidates,
     channels_doc="joint: measured motor force (N, prismatic) or torque (N m, revolute)",
     simulate=lambda ds, params: free_run_compare(ds, params),
-    simulation_fit=lambda ds, start, objective: fit_free_run(ds, start, objective=objective),
+    simulation_fit=lambda ds, start, objective, progress=False: fit_free_run(
+        ds, start, objective=objective, progress=progress),
 ))
 
 
@@ -185,7 +186,7 @@ def free_run_compare(ds: Dataset, params: dict, horizon_s: float = FREE_RUN_HORI
 
 def fit_free_run(ds: Dataset, start: dict, *, objective: str = "nmse",
                  free: tuple[str, ...] = ("M", "Fv", "Fc"), horizon_s: float = FREE_RUN_HORIZON_S,
-                 max_iter: int = 30):
+                 max_iter: int = 30, progress: bool = False):
     """Simulation-based identification of the axis: free-run windows (:func:`free_run`) matched to
     the measured motion with :func:`~cablelab.fit.simulation.fit_simulation` (NMSE of 003 eq. 28
     or Pearson of 000 eq. 3-7). The output is the position deviation from each window's start.
@@ -216,4 +217,5 @@ def fit_free_run(ds: Dataset, start: dict, *, objective: str = "nmse",
         sims = free_run(ds, full, horizon_s)[:, : n_win * w, :]
         return sims - base[None, :, None]
 
-    return fit_simulation(simulate, params, y_meas, objective=objective, max_iter=max_iter)
+    return fit_simulation(simulate, params, y_meas, objective=objective, max_iter=max_iter,
+                          progress=progress)

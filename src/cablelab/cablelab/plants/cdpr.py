@@ -20,7 +20,7 @@ import numpy as np
 from ..errors import CablelabError
 from ..model import Dataset
 from . import Plant, register_plant
-from .cdpr_estimation import mass_com, tensions_from_torques
+from .cdpr_estimation import mass_com, mass_com_batch, tensions_from_torques
 from .cdpr_geometry import cable_geometry, quat_to_matrix, wrench_matrix
 
 JOINT_STATE = "sensor_msgs/msg/JointState"
@@ -307,9 +307,13 @@ def estimate_arrays(arr: CdprArrays, description, effects=(), params: dict | Non
     if "tension_sensor_offset" in effs:
         t = t - np.array([params.get(f"b[{w}]", 0.0) for w in names])
     r = params.get("r_p", 0.0) if "pulley_geometry" in effs else 0.0
-    geom = cable_geometry(c.exit_points, c.anchor_points, arr.position, arr.R, r, c.swivel_axes)
-    est = mass_com(geom, t, description.gravity,
-                   arr.acc if "platform_inertia" in effs else None, arr.R)
+    if arr.R is None and "platform_inertia" not in effs:      # level and static: fast kernel
+        est = mass_com_batch(c.exit_points, c.anchor_points, arr.position, t, r,
+                             description.gravity, c.swivel_axes)
+    else:
+        geom = cable_geometry(c.exit_points, c.anchor_points, arr.position, arr.R, r, c.swivel_axes)
+        est = mass_com(geom, t, description.gravity,
+                       arr.acc if "platform_inertia" in effs else None, arr.R)
     return Estimate(arr.t, est.mass, est.com, est.residual, effs,
                     {k: float(v) for k, v in params.items()}, arr.truth_mass, arr.truth_com)
 

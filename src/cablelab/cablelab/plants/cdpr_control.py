@@ -92,7 +92,11 @@ def feedforward_tensions(geom: CableGeometry, mass, acceleration: np.ndarray, gr
     n = W.shape[2]
     tp = np.full(n, float(preload))
     rhs = w - W @ tp
-    t = tp + np.einsum("tij,tj->ti", np.linalg.pinv(W) if pinv is None else pinv, rhs)
+    if pinv is None:   # W^+ rhs = W^T (W W^T)^-1 rhs for a full-row-rank W (6 x n, n >= 6)
+        y = np.linalg.solve(W @ W.transpose(0, 2, 1), rhs[..., None])[..., 0]
+        t = tp + np.einsum("tji,tj->ti", W, y)
+    else:
+        t = tp + np.einsum("tij,tj->ti", pinv, rhs)
     return np.maximum(t, min_tension)
 
 

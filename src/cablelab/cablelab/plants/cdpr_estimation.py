@@ -11,7 +11,7 @@ import numpy as np
 
 from .cdpr_geometry import CableGeometry, cable_wrench, cross
 
-__all__ = ["MassCom", "mass_com", "mass_com_from_wrench", "tensions_from_torques",
+__all__ = ["MassCom", "mass_com", "mass_com_batch", "mass_com_from_wrench", "tensions_from_torques",
            "torques_from_tensions", "winch_friction"]
 
 
@@ -58,8 +58,9 @@ def mass_com_from_wrench(wrench: np.ndarray, gravity: float = 9.81,
         m = F[:, 2] / gravity
         mg = F[:, 2]
         com = np.empty((len(m), 2))
-        com[:, 0] = -M[:, 1] / mg
-        com[:, 1] = M[:, 0] / mg
+        with np.errstate(divide="ignore", invalid="ignore"):    # no load: CoM undefined (NaN/inf)
+            com[:, 0] = -M[:, 1] / mg
+            com[:, 1] = M[:, 0] / mg
         res = np.sqrt(F[:, 0] ** 2 + F[:, 1] ** 2 + M[:, 2] ** 2)
         return MassCom(m, com, res)
     f = np.zeros_like(F)
@@ -142,3 +143,64 @@ def torques_from_tensions(tensions: np.ndarray, velocity: np.ndarray, drum_radiu
     """Motor torques that hold the given tensions, r/R t + friction (001 eq. 14-15), N m."""
     return (np.asarray(tensions, dtype=float) * (drum_radius / gear_ratio)
             + winch_friction(velocity, coulomb, viscous, deadband))
+
+
+def mass_com_batch(exit_points: np.ndarray, anchor_points: np.ndarray, position: np.ndarray,
+                   tensions: np.ndarray, pulley_radius: float = 0.0, gravity: float = 9.81,
+                   swivel_axes: np.ndarray | None = None, chunk: int = 4096) -> MassCom:
+    """Fast offline Model I / II estimate (001 eq. 6-9, 12-13) for a level platform, over a long
+    record: the same result as ``mass_com(cable_geometry(...), tensions)`` without rotation,
+    computed per coordinate on (chunk, n) arrays that stay in cache (no (N, n, 3) temporaries).
+
+    Args:
+        exit_points (n, 3), anchor_points (n, 3): A_i (world), B_i (platform frame), m.
+        position: (N, 3) platform positions, m.  tensions: (N, n), N.
+        pulley_radius: r_p, m (0 = Model I).  swivel_axes: (n, 3), default +z.
+    """
+    A = np.asarray(exit_points, float)
+    b = np.asarray(anchor_points, float)
+    P = np.asarray(position, float)
+    T = np.asarray(tensions, float)
+    N, n = T.shape
+    z = np.tile([0.0, 0.0, 1.0], (n, 1)) if swivel_axes is None else np.asarray(swivel_axes, float)
+    r = float(pulley_radius)
+    BA = b - A                                           # B_i - A_i at P = 0
+    mass = np.empty(N)
+    com = np.empty((N, 2))
+    res = np.empty(N)
+    bx, by, bz = b[:, 0], b[:, 1], b[:, 2]
+    zx, zy, zz = z[:, 0], z[:, 1], z[:, 2]
+    for s in range(0, N, chunk):
+        p = P[s:s + chunk]
+        t = T[s:s + chunk]
+        dx = p[:, :1] + BA[:, 0]
+        dy = p[:, 1:2] + BA[:, 1]
+        dzw = p[:, 2:3] + BA[:, 2]
+        if r > 0.0:
+            dz = dx * zx + dy * zy + dzw * zz            # along the swivel axis
+            hx, hy, hz = dx - dz * zx, dy - dz * zy, dzw - dz * zz
+            h = np.sqrt(hx * hx + hy * hy + hz * hz)
+            vx = h - r
+            D2 = vx * vx + dz * dz
+            lc = np.sqrt(D2 - r * r)
+            cx = (r * vx - lc * dz) / D2
+            cz = (r * dz + lc * vx) / D2
+            a = r * (1.0 + cx) / h                       # A' - B = -d + a h_vec + r cz z
+            c = r * cz
+            w = t / lc
+            fx = w * (a * hx + c * zx - dx)
+            fy = w * (a * hy + c * zy - dy)
+            fz = w * (a * hz + c * zz - dzw)
+        else:
+            w = t / np.sqrt(dx * dx + dy * dy + dzw * dzw)
+            fx, fy, fz = -w * dx, -w * dy, -w * dzw
+        Fx, Fy, Fz = fx.sum(1), fy.sum(1), fz.sum(1)
+        Mx = (by * fz - bz * fy).sum(1)
+        My = (bz * fx - bx * fz).sum(1)
+        Mz = (bx * fy - by * fx).sum(1)
+        sl = slice(s, s + len(t))
+        mass[sl] = Fz / gravity
+        com[sl, 0] = -My / Fz
+        com[sl, 1] = Mx / Fz
+        res[sl] = np.sqrt(Fx * Fx + Fy * Fy + Mz * Mz)
+    return MassCom(mass, com, res)

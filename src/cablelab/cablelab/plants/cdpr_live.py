@@ -16,7 +16,7 @@ import numpy as np
 from ..description import CdprDescription
 from .cdpr_control import PdffConfig, feedforward_tensions, motor_angles, motor_rates, pdff_torques
 from .cdpr_estimation import mass_com, tensions_from_torques
-from .cdpr_geometry import cable_geometry, quat_to_matrix, wrench_matrix
+from .cdpr_geometry import CableGeometry, pose_geometry, quat_to_matrix, wrench_matrix
 
 __all__ = ["EstimatorConfig", "LiveEstimator", "ControllerConfig", "LiveController"]
 
@@ -53,6 +53,22 @@ class EstimatorConfig:
     pulley_radius: float | None = None
 
 
+def _geometry(desc: CdprDescription, p, R, r: float) -> CableGeometry:
+    """One-sample :class:`CableGeometry` from the fast single-pose path (directions, lengths and
+    anchors; the other fields are not needed live and left zero)."""
+    e, L, bw = pose_geometry(desc.exit_points, desc.anchor_points, p, R, r, desc.swivel_axes)
+    z = np.zeros((1, len(L)))
+    return CableGeometry(e[None], L[None], bw[None], L[None], z, z, e[None] * 0.0)
+
+
+def _zero_if_bad(x) -> np.ndarray:
+    """A (3,) twist/acceleration; missing or non-finite -> zeros (a missing feedforward term)."""
+    if x is None:
+        return np.zeros(3)
+    a = np.asarray(x, float)
+    return a if a.shape == (3,) and np.isfinite(a).all() else np.zeros(3)
+
+
 def _is_identity(q: np.ndarray) -> bool:
     return bool(abs(q[0]) == 1.0 and not q[1:].any())
 
@@ -76,6 +92,8 @@ class LiveEstimator:
     gravity: float = 9.81
     config: EstimatorConfig = field(default_factory=EstimatorConfig)
     status: list = field(default_factory=list)
+    _cond_key: tuple | None = None
+    _cond: float = 0.0
 
     def _radius(self) -> float:
         if self.config.model == "I":
@@ -136,9 +154,17 @@ class LiveEstimator:
         slack = np.flatnonzero(tens < cfg.slack_tension)
         if slack.size:
             self.status.append((WARN, "slack cable(s) " + ", ".join(str(i + 1) for i in slack)))
-        geom = geometry if geometry is not None else cable_geometry(
-            self.desc.exit_points, self.desc.anchor_points, p, R, self._radius(), self.desc.swivel_axes)
-        cond = float(np.linalg.cond(wrench_matrix(geom)[0])) if condition is None else float(condition)
+        geom = geometry if geometry is not None else _geometry(self.desc, p, R, self._radius())
+        if condition is None:
+            # cond(W) changes slowly with the pose: recomputed when the pose moved > 1 mm
+            key = (p, None if R is None else R)
+            if (self._cond_key is None or np.abs(self._cond_key[0] - p).max() > 1e-3
+                    or (R is None) != (self._cond_key[1] is None)
+                    or (R is not None and np.abs(self._cond_key[1] - R).max() > 1e-3)):
+                self._cond = float(np.linalg.cond(wrench_matrix(geom)[0]))
+                self._cond_key = key
+            condition = self._cond
+        cond = float(condition)
         if not np.isfinite(cond) or cond > cfg.max_condition:
             self.status.append((ERROR, f"ill-conditioned wrench matrix (cond {cond:.3g})"))
             return None
@@ -227,15 +253,14 @@ class LiveController:
         if e1 or e2 or e3:
             self.status.append((ERROR, e1 or e2 or e3))
             return None
-        v = np.zeros(3) if velocity is None else np.nan_to_num(np.asarray(velocity, float))
-        a = np.zeros(3) if acceleration is None else np.nan_to_num(np.asarray(acceleration, float))
+        v = _zero_if_bad(velocity)
+        a = _zero_if_bad(acceleration)
         R = None
         if quat is not None and not _is_identity(np.asarray(quat, float)):
             R = quat_to_matrix(np.asarray(quat, float))
         r = 0.0 if cfg.model == "I" else (cfg.gains.pulley_radius if cfg.gains.pulley_radius is not None
                                            else d.pulley_radius)
-        geom = geometry if geometry is not None else cable_geometry(
-            d.exit_points, d.anchor_points, p, R, r, d.swivel_axes)
+        geom = geometry if geometry is not None else _geometry(d, p, R, r)
         q_des = motor_angles(geom.lengths, d.drum_radius, d.gear_ratio)[0]
         qd_des = motor_rates(geom, v, d.drum_radius, d.gear_ratio)[0]
         t_ff = None

@@ -1,0 +1,229 @@
+"""CDPR benchmarks (issue 4 speed targets).
+
+1. Offline estimation, Model I and Model II (001 eq. 6-9, 12-13), --samples samples of 8 cables
+   on one core (``mass_com_batch``; the general ``cable_geometry + mass_com`` path for reference).
+   Target: Model II >= 1 000 000 samples/s.
+2. Offline closed-loop simulation (MuJoCo 1 kHz physics, PDFF + live estimator at 100 Hz) of the
+   60 s test trajectory. Target: >= 20x real time.
+3. Estimator node in its own process fed at 1 kHz over DDS (/cdpr/cable_tensions +
+   /cdpr/reference, --seconds s): estimates received vs sent, processing latency p99 (measured in
+   the node, reported on /diagnostics) and end-to-end latency. Target: p99 < 1 ms, zero drops.
+4. Closed loop sim -> estimator -> controller -> sim at 1 kHz in real-time mode (three
+   processes, --seconds s): achieved rate, commands per state, steps the simulator had to brake
+   because no fresh command came.
+"""
+from __future__ import annotations
+
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from harness import Bench  # noqa: E402
+
+
+def offline_estimation(bench: Bench, samples: int) -> None:
+    from cablelab.plants.cdpr_estimation import mass_com, mass_com_batch
+    from cablelab.plants.cdpr_geometry import cable_geometry
+    from cablelab.plants.cdpr_trajectory import pick_and_place
+    from cablelab.sim.cdpr import default_description
+
+    bench.section(f"offline estimation, {samples} samples x 8 cables, one core")
+    c = default_description().cdpr
+    P = pick_and_place(np.linspace(0.0, 60.0, samples)).position
+    T = np.random.default_rng(0).uniform(500.0, 2000.0, (samples, 8))
+    for r, name in ((0.0, "Model I"), (0.15, "Model II")):
+        best = bench.time(lambda: mass_com_batch(c.exit_points, c.anchor_points, P, T, r), repeat=3)
+        bench.row(case=f"{name} mass + CoM (mass_com_batch)", samples=samples, seconds=best,
+                  rate=samples / best, unit="samples/s",
+                  target=">= 1 000 000" if r else "")
+    n = min(samples, 200_000)
+    best = bench.time(lambda: mass_com(cable_geometry(c.exit_points, c.anchor_points, P[:n], None, 0.15),
+                                       T[:n]), repeat=2)
+    bench.row(case="Model II, general path (cable_geometry + mass_com)", samples=n, seconds=best,
+              rate=n / best, unit="samples/s", target="")
+
+
+def offline_simulation(bench: Bench) -> None:
+    from cablelab.sim.cdpr import CdprTruth, default_description, simulate
+
+    bench.section("offline closed-loop simulation (60 s test trajectory, 615 kg)")
+    desc = default_description()
+    t0 = time.perf_counter()
+    run = simulate(desc, CdprTruth(payload_mass=249.0), controller="pdff", duration=60.0)
+    el = time.perf_counter() - t0
+    bench.row(case="MuJoCo 1 kHz + PDFF/estimator 100 Hz", simulated_s=60.0, seconds=el,
+              rate=60.0 / el, unit="x real time", target=">= 20")
+    ez = np.abs(run.true_position[:, 2] - run.ref_position[:, 2]).max()
+    bench.log(f"  (max |z error| {1000 * ez:.2f} mm, mean live mass {np.nanmean(run.est_mass):.1f} kg)")
+
+
+class _Client:
+    """A plain rclpy node in this process on the launcher's domain."""
+
+    def __init__(self, domain_id: int):
+        import rclpy
+        from rclpy.context import Context
+        from rclpy.executors import SingleThreadedExecutor
+        from rclpy.node import Node
+
+        self.ctx = Context()
+        rclpy.init(context=self.ctx, domain_id=domain_id)
+        self.node = Node("bench_cdpr", context=self.ctx)
+        self.ex = SingleThreadedExecutor(context=self.ctx)
+        self.ex.add_node(self.node)
+        self.diag = {}
+
+        from diagnostic_msgs.msg import DiagnosticArray
+        self.node.create_subscription(DiagnosticArray, "/diagnostics", self._on_diag, 50)
+
+    def _on_diag(self, msg) -> None:
+        for st in msg.status:
+            self.diag[st.name] = {kv.key: kv.value for kv in st.values} | {"_message": st.message}
+
+    def spin(self, seconds: float) -> None:
+        end = time.monotonic() + seconds
+        while time.monotonic() < end:
+            self.ex.spin_once(timeout_sec=0.01)
+
+    def close(self) -> None:
+        import rclpy
+
+        self.node.destroy_node()
+        rclpy.try_shutdown(context=self.ctx)
+
+
+def estimator_node(bench: Bench, launch, seconds: float) -> None:
+    from geometry_msgs.msg import InertiaStamped
+    from sensor_msgs.msg import JointState
+    from std_msgs.msg import String
+    from trajectory_msgs.msg import MultiDOFJointTrajectory
+
+    from cablelab.plants.cdpr_control import feedforward_tensions
+    from cablelab.plants.cdpr_geometry import cable_geometry
+    from cablelab.plants.cdpr_trajectory import pick_and_place
+    from cablelab.ros import convert
+    from cablelab.ros.qos import DESCRIPTION_QOS, stream_qos
+    from cablelab.sim.cdpr import default_description
+
+    bench.section(f"estimator node at 1 kHz for {seconds:g} s (separate process, DDS)")
+    desc = default_description()
+    c = desc.cdpr
+    launch.node("estimator", "payload_estimator", "cdpr", {})
+    cl = _Client(launch.domain_id)
+    q = stream_qos(1000)
+    pub_d = cl.node.create_publisher(String, "/plant_description", DESCRIPTION_QOS)
+    pub_r = cl.node.create_publisher(MultiDOFJointTrajectory, "/cdpr/reference", q)
+    pub_t = cl.node.create_publisher(JointState, "/cdpr/cable_tensions", q)
+    recv = {}
+    cl.node.create_subscription(InertiaStamped, "/cdpr/payload_estimate",
+                                lambda m: recv.setdefault(round(convert.from_stamp(m.header.stamp) * 1000),
+                                                          time.perf_counter()), q)
+    pub_d.publish(convert.string_msg(desc.to_yaml()))
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and not (pub_t.get_subscription_count() and
+                                               pub_r.get_subscription_count() and "payload_estimator" in cl.diag):
+        cl.spin(0.1)
+    cl.spin(1.0)
+    n = int(seconds * 1000)
+    tr = pick_and_place(np.arange(n) * 1e-3)
+    geom = cable_geometry(c.exit_points, c.anchor_points, tr.position, None, 0.15)
+    T = feedforward_tensions(geom, 615.0, np.zeros((n, 3)))
+    names = [f"cable_{i}" for i in range(1, 9)]
+    sent = {}
+    t0 = time.monotonic()
+    k = 0
+    while k < n:
+        due = min(n, int((time.monotonic() - t0) * 1000) + 1)
+        while k < due:
+            t = k * 1e-3
+            pub_r.publish(convert.multidof_msg(t, tr.position[k], [0, 0, 0, 1.0], tr.velocity[k], None,
+                                               tr.acceleration[k], None))
+            pub_t.publish(convert.joint_state_msg(t, names, None, None, T[k]))
+            sent[k] = time.perf_counter()
+            k += 1
+        cl.ex.spin_once(timeout_sec=0.0005)
+        if k % 5000 == 0 and k:
+            bench.log(f"  sent {k}/{n}, ETA {max(0.0, seconds - (time.monotonic() - t0)):.0f} s")
+    elapsed = time.monotonic() - t0
+    cl.spin(3.0)
+    lat = np.array([recv[k] - sent[k] for k in recv if k in sent]) * 1e3
+    d = cl.diag.get("payload_estimator", {})
+    bench.row(case="estimator node: estimates / tension samples", sent=n, received=len(recv),
+              dropped=n - len(recv), rate_hz=n / elapsed, target="zero drops")
+    bench.row(case="estimator processing latency p99 (in node)", value=d.get("latency p99 ms", "?"),
+              unit="ms", target="< 1 ms")
+    bench.row(case="end-to-end latency publish -> estimate received", value=float(np.median(lat)),
+              p99=float(np.quantile(lat, 0.99)), unit="ms (median, p99)", target="")
+    cl.close()
+    launch.stop("estimator")
+
+
+def closed_loop_1khz(bench: Bench, launch, seconds: float) -> None:
+    bench.section(f"closed loop sim -> estimator -> controller -> sim at 1 kHz, real time, {seconds:g} s")
+    launch.node("estimator", "payload_estimator", "cdpr", {})
+    launch.node("controller", "pd_feedforward", "cdpr", {})
+    cl = _Client(launch.domain_id)
+    from sensor_msgs.msg import JointState
+    from std_msgs.msg import Float64MultiArray
+
+    from cablelab.ros.qos import stream_qos
+    counts = {"js": 0, "cmd": 0}
+    cl.node.create_subscription(JointState, "/cdpr/joint_states",
+                                lambda m: counts.__setitem__("js", counts["js"] + 1), stream_qos(1000))
+    cl.node.create_subscription(Float64MultiArray, "/cdpr/effort_commands",
+                                lambda m: counts.__setitem__("cmd", counts["cmd"] + 1), stream_qos(1000))
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and not {"payload_estimator", "pd_feedforward"} <= set(cl.diag):
+        cl.spin(0.2)
+    launch.node("sim", "cable_sim_node", "cdpr", {"rate": 1000.0, "real_time": True, "payload_mass": 249.0,
+                                                  "duration": seconds + 1.0, "settle": 1.0})
+    t0 = time.monotonic()
+    while launch.procs["sim"].alive() and time.monotonic() - t0 < 20 * seconds + 60:
+        cl.spin(0.2)
+        if "cable_sim_node" in cl.diag:
+            last = dict(cl.diag["cable_sim_node"])
+    wall = time.monotonic() - t0
+    sim_t = float(last.get("sim time s", "nan"))
+    brakes = int(last.get("brake (fallback) steps", "-1"))
+    steps = round(sim_t * 1000)
+    bench.row(case="achieved real-time factor (sim time / wall time)", value=sim_t / wall,
+              unit="x", target="1 (real time)")
+    bench.row(case="commands received / states published (observer)", value=counts["cmd"] / max(counts["js"], 1),
+              unit="", target="1")
+    bench.row(case="simulator steps without a fresh command (braked)", value=brakes, unit=f"of {steps}",
+              target="0")
+    ctl = cl.diag.get("pd_feedforward", {})
+    est = cl.diag.get("payload_estimator", {})
+    bench.row(case="controller / estimator processing p99 (in node)",
+              value=f"{ctl.get('latency p99 ms', '?')} / {est.get('latency p99 ms', '?')}", unit="ms",
+              target="< 1 ms")
+    cl.close()
+    launch.stop_all()
+
+
+def main(argv=None) -> int:
+    bench = Bench("cdpr", __doc__)
+    bench.parser.add_argument("--samples", type=int, default=1_000_000)
+    bench.parser.add_argument("--seconds", type=float, default=10.0, help="node tests length (10)")
+    bench.parser.add_argument("--skip-nodes", action="store_true")
+    args = bench.parse(argv)
+    offline_estimation(bench, args.samples)
+    offline_simulation(bench)
+    if not args.skip_nodes:
+        from cablelab.ros.launch import Launcher
+
+        tmp = Path(tempfile.mkdtemp(prefix="bench-cdpr-"))
+        with Launcher(log_dir=tmp / "logs") as launch:
+            bench.log(f"ROS_DOMAIN_ID {launch.domain_id}, logs in {launch.log_dir}")
+            estimator_node(bench, launch, args.seconds)
+            closed_loop_1khz(bench, launch, args.seconds)
+    bench.done()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
