@@ -18,7 +18,7 @@ def run(args) -> int:
     from ..workbench import identify
 
     _, _, ds, model = load_from_args(args)
-    out = identify(ds, model, folds=args.folds, simulation=args.simulation)
+    out = identify(ds, model, folds=args.folds, simulation=args.simulation, quiet=args.json)
     if args.json:
         print(dump_json(out))
         return 0

@@ -12,10 +12,13 @@ matching the simulated outputs to the measured ones within box bounds. Two objec
   maximises R (insensitive to gain and offset, like the paper's metric).
 
 Standard errors come from the Gauss-Newton covariance ``s^2 (J^T J)^-1`` at the optimum, with
-``s^2 = ||r||^2 / (n - p)``, mapped back to parameter units.
+``s^2 = ||r||^2 / (n - p)``, inflated by ``sqrt((1 + r1) / (1 - r1))`` for the lag-1
+autocorrelation r1 of the residual (a free-run residual is smooth, far from white).
 """
 from __future__ import annotations
 
+import sys
+import time
 from dataclasses import dataclass, field
 from typing import Callable, Sequence
 
@@ -68,7 +71,7 @@ def objective_residual(y_meas: np.ndarray, y_sim: np.ndarray, objective: str) ->
 
 def fit_simulation(simulate: Callable[[list[dict]], np.ndarray], params: Sequence[Param],
                    y_meas: np.ndarray, *, objective: str = "nmse", x0: Sequence[float] | None = None,
-                   max_iter: int = 50, verbose: bool = False) -> SimulationFit:
+                   max_iter: int = 50, verbose: bool = False, progress: bool = False) -> SimulationFit:
     """Bounded fit of simulated to measured outputs.
 
     Args:
@@ -79,6 +82,8 @@ def fit_simulation(simulate: Callable[[list[dict]], np.ndarray], params: Sequenc
         y_meas: (N, C) measured outputs (same sampling as the simulation).
         objective: ``"nmse"`` (003 eq. 28) or ``"pearson"`` (000 eq. 3-7).
         x0: start (default the nominal values).
+        progress: print a line with the objective and an ETA (upper bound: max_iter) on stderr
+            every 2 s.
     Raises:
         CablelabError: unknown objective, infinite bounds, start outside the bounds.
     """
@@ -104,8 +109,21 @@ def fit_simulation(simulate: Callable[[list[dict]], np.ndarray], params: Sequenc
         return np.stack([objective_residual(y_meas, s, objective) for s in sims], axis=1)
 
     scale = np.maximum(np.abs(start), 1e-3 * (hi - lo))
+    t0 = time.monotonic()
+    last = [t0]
+
+    def report(trace):
+        now = time.monotonic()
+        if progress and now - last[0] >= 2.0 and trace:
+            last[0] = now
+            it = len(trace)
+            eta = (now - t0) / it * max(max_iter - it, 0)
+            print(f"[fit {objective}] iteration {it}/{max_iter}, objective {2 * trace[-1].objective:.4g}, "
+                  f"{count['n']} rollouts, ETA <= {eta:.0f} s", file=sys.stderr, flush=True)
+
     x, trace = mjmin.least_squares(start, residual, bounds=[lo, hi], x_scale=scale,
-                                   max_iter=max_iter, verbose=2 if verbose else 0)
+                                   max_iter=max_iter, verbose=2 if verbose else 0, xtol=1e-6,
+                                   iter_callback=report)
     x = np.clip(np.asarray(x, float).reshape(-1), lo, hi)
     values = dict(zip(names, map(float, x)))
     # Gauss-Newton covariance from a central finite-difference Jacobian (one batch of 2p rollouts)
@@ -125,6 +143,11 @@ def fit_simulation(simulate: Callable[[list[dict]], np.ndarray], params: Sequenc
         se = np.sqrt(np.clip(np.diag(cov), 0, None))
     except np.linalg.LinAlgError:
         se = np.full(p, np.nan)
+    # coloured residuals: inflate by the AR(1) effective sample size, as cablelab.fit.identify
+    from .identify import lag1_autocorrelation
+
+    r1 = lag1_autocorrelation(r0.reshape(y_meas.shape))
+    se = se * np.sqrt((1.0 + r1) / (1.0 - r1))
     y_sim = np.asarray(simulate([values]))[0].reshape(y_meas.shape)
     nm = float(np.sum(objective_residual(y_meas, y_sim, "nmse") ** 2))
     rho = 1.0 - float(np.sum(objective_residual(y_meas, y_sim, "pearson") ** 2))
