@@ -10,8 +10,11 @@ ROS parameters: ``description`` (YAML file or text; default ``cablelab/data/cran
 ``slew_inertia``, ``luff_inertia`` (kg m^2), truth switches ``base_tilt`` [x, y] rad,
 ``viscous`` / ``coulomb`` / ``offset`` [slew, luff, hoist], ``mocap_noise`` (m),
 ``mocap_dropout`` (probability), ``timestep`` (s), ``rate`` (Hz of publishing = command
-sampling), ``command_timeout`` (s wall). Without a fresh command the drives hold the crane
-(gravity compensation + damping, like a brake) and the node reports WARN on /diagnostics.
+sampling), ``command_timeout`` (s wall), ``lockstep`` (default true: after publishing a state
+the simulation waits for the command that answers it before advancing, so a slow or loaded
+controller slows the simulation down instead of destabilising it with delayed commands). Without
+a fresh command the drives hold the crane (gravity compensation + damping, like a brake) and the
+node reports WARN on /diagnostics.
 """
 from __future__ import annotations
 
@@ -27,7 +30,7 @@ from std_msgs.msg import Float64MultiArray, String
 
 from cablelab.description import load_description
 from cablelab.errors import CablelabError
-from cablelab.plants.crane_control import hold_command
+from cablelab.plants.crane_control import LIVE_GAINS, hold_command
 from cablelab.plants.crane_model import JOINTS, CraneParams
 from cablelab.ros import convert
 from cablelab.ros.diagnostics import Diagnostics
@@ -66,6 +69,9 @@ class CraneSimNode(Node):
                            timestep=float(p("timestep", 0.001).value))
         q0 = _vec(p("initial", [0.0, 0.5, 0.6]).value, 3, "initial")
         self.rate = float(p("rate", 100.0).value)
+        self.lockstep = bool(p("lockstep", True).value)
+        self.answered = False       # a command arrived since the last published state
+        self.published_at = time.monotonic()
         self.sim = CraneSim(truth, q0)
         self.u = None
         self.fallbacks = 0
@@ -87,17 +93,30 @@ class CraneSimNode(Node):
     def status(self):
         level, msg, values = self.inputs.status(time.monotonic())
         values["fallback (hold) steps"] = str(self.fallbacks)
+        values["simulation resets"] = str(self.sim.resets)
+        if self.sim.resets:
+            level = 2
+            extra = f"simulation diverged {self.sim.resets} times (restored at rest): commands too large?"
+            msg = extra if msg == "ok" else f"{msg}; {extra}"
         return level, msg, values
 
     def on_command(self, msg: Float64MultiArray) -> None:
         values = convert.float_array(msg)
         if self.inputs.accept("effort_commands", values, time.monotonic()):
             self.u = values.copy()
+            self.answered = True
 
     def tick(self) -> None:
-        if self.u is None or not self.inputs.fresh("effort_commands", time.monotonic()):
+        now = time.monotonic()
+        timeout = self.inputs.inputs["effort_commands"].timeout
+        if (self.lockstep and self.u is not None and not self.answered
+                and now - self.published_at < timeout):
+            return  # wait for the controller's answer to the last state
+        if (self.u is None or not self.inputs.fresh("effort_commands", now)
+                or (self.lockstep and not self.answered)):
             _, q, qd = self.sim.state()
-            u = hold_command(q[None, :3], qd[None, :3], self.sim.truth.params, swing=q[None, 3:])[0]
+            u = hold_command(q[None, :3], qd[None, :3], self.sim.truth.params, LIVE_GAINS,
+                             swing=q[None, 3:])[0]
             self.fallbacks += 1
         else:
             u = self.u
@@ -105,6 +124,8 @@ class CraneSimNode(Node):
         self.publish_state()
 
     def publish_state(self) -> None:
+        self.answered = False
+        self.published_at = time.monotonic()
         t, q, qd = self.sim.state()
         m = self.sim.measurement()
         self.pub_clock.publish(convert.clock_msg(t))

@@ -25,21 +25,21 @@ from trajectory_msgs.msg import JointTrajectory
 
 from cablelab.description import load_description
 from cablelab.errors import CablelabError
-from cablelab.plants.crane_control import Gains, control_law, hold_command
+from cablelab.plants.crane_control import LIVE_GAINS, Gains, control_law, hold_command
 from cablelab.plants.crane_model import JOINTS, CraneParams
 from cablelab.ros import convert
 from cablelab.ros.diagnostics import Diagnostics
 from cablelab.ros.inputs import WARN, InputMonitor
 from cablelab.ros.qos import DESCRIPTION_QOS, stream_qos
-from cablelab.sim.crane import DEFAULT_KD, DEFAULT_KP, reference_trajectory
+from cablelab.sim.crane import reference_trajectory
 
 
 class CraneController(Node):
     def __init__(self):
         super().__init__("pd_feedforward")
         p = self.declare_parameter
-        kp = [float(x) for x in p("kp", list(DEFAULT_KP)).value]
-        kd = [float(x) for x in p("kd", list(DEFAULT_KD)).value]
+        kp = [float(x) for x in p("kp", list(LIVE_GAINS.kp)).value]
+        kd = [float(x) for x in p("kd", list(LIVE_GAINS.kd)).value]
         if len(kp) != 3 or len(kd) != 3:
             raise CablelabError("pd_feedforward --plant crane: parameters kp and kd need 3 values "
                                 "[slew, luff, hoist]")

@@ -48,6 +48,8 @@ class CraneTruth:
         mocap_noise: standard deviation of the motion-capture positions, m.
         mocap_dropout: probability that a motion-capture sample is lost (NaN pose).
         timestep: MuJoCo time step, s.
+        effort_limit: (3,) drive saturation [N m, N m, N] (MuJoCo ctrlrange).
+        rope_range: (2,) hoist joint limits [d_min, d_max], m (a rope never reaches 0 length).
     """
 
     params: CraneParams = field(default_factory=CraneParams)
@@ -59,6 +61,8 @@ class CraneTruth:
     mocap_noise: float = 0.0
     mocap_dropout: float = 0.0
     timestep: float = 0.001
+    effort_limit: tuple = (50.0, 80.0, 100.0)
+    rope_range: tuple = (0.05, 5.0)
 
 
 def gravity_in_base(truth: CraneTruth) -> np.ndarray:
@@ -89,8 +93,9 @@ def model_xml(truth: CraneTruth, kp=(0.0, 0.0, 0.0), kd=(0.0, 0.0, 0.0)) -> str:
     ptiny = 1e-12 * p.payload_mass
     boom_inertial = f'<inertial pos="{xc!r} 0 0" mass="{mtot!r}" diaginertia="{tiny!r} {jb!r} {jb!r}"/>'
     acts = "\n".join(
-        f'<general name="{j}" joint="{j}" gainprm="1" biasprm="0 {-float(kp[i])!r} {-float(kd[i])!r}" biastype="affine"/>'
-        for i, j in enumerate(("slew", "luff", "hoist")))
+        f'<general name="{j}" joint="{j}" gainprm="1" biasprm="0 {-float(kp[i])!r} {-float(kd[i])!r}" '
+        f'biastype="affine" ctrlrange="{-float(lim)!r} {float(lim)!r}"/>'
+        for i, (j, lim) in enumerate(zip(("slew", "luff", "hoist"), truth.effort_limit)))
     return f"""<mujoco model="crane">
   <compiler angle="radian" autolimits="true" boundmass="0" boundinertia="0"/>
   <option timestep="{truth.timestep!r}" gravity="{_f(gravity_in_base(truth))}" integrator="RK4"/>
@@ -106,7 +111,8 @@ def model_xml(truth: CraneTruth, kp=(0.0, 0.0, 0.0), kd=(0.0, 0.0, 0.0)) -> str:
         <body name="payload" pos="{lb!r} 0 0">
           <joint name="swing_y" type="hinge" axis="0 -1 0"/>
           <joint name="swing_x" type="hinge" axis="1 0 0"/>
-          <joint name="hoist" type="slide" axis="0 0 -1" damping="{b[2]!r}" frictionloss="{c[2]!r}"/>
+          <joint name="hoist" type="slide" axis="0 0 -1" damping="{b[2]!r}" frictionloss="{c[2]!r}"
+                 range="{float(truth.rope_range[0])!r} {float(truth.rope_range[1])!r}"/>
           <inertial pos="0 0 0" mass="{p.payload_mass!r}" diaginertia="{ptiny!r} {ptiny!r} {ptiny!r}"/>
           <site name="payload"/>
         </body>
@@ -338,6 +344,7 @@ class CraneSim:
         self.rng = np.random.default_rng(seed)
         set_state(self.model, self.data, [q0[0], q0[1], q0[2], 0.0, 0.0])
         self.u = np.zeros(3)
+        self.resets = 0  # divergences recovered (see advance)
 
     @property
     def time(self) -> float:
@@ -348,8 +355,17 @@ class CraneSim:
         self.u = u
         self.data.ctrl[:] = u
         steps = max(1, int(round(duration / self.model.opt.timestep)))
+        t0, qpos0, qvel0 = self.data.time, self.data.qpos.copy(), self.data.qvel.copy()
         for _ in range(steps):  # MuJoCo stepping with a held command (mj_step per time step)
             mujoco.mj_step(self.model, self.data)
+        ok = (self.data.time > t0 and np.all(np.isfinite(self.data.qpos))
+              and np.all(np.isfinite(self.data.qvel)) and np.abs(self.data.qvel).max() < 1e3)
+        if not ok:
+            # MuJoCo resets an unstable simulation to qpos0 (rope length 0): restore the last
+            # good state at rest instead, keep the clock running, and count it
+            self.resets += 1
+            self.data.qpos[:], self.data.qvel[:] = qpos0, 0.0
+            self.data.time = t0 + steps * self.model.opt.timestep
         mujoco.mj_forward(self.model, self.data)
 
     def state(self) -> tuple[float, np.ndarray, np.ndarray]:
