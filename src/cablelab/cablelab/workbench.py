@@ -162,7 +162,7 @@ def diagnose(ds: Dataset, model: Model, candidates: Sequence[str], *, folds: int
 
 def _row(r: dict) -> dict:
     keys = ("effect", "error_before", "error_after", "params", "significant", "stderr", "units",
-            "p_value", "delta_bic", "n_eff", "gain", "explanation")
+            "p_value", "delta_bic", "n_eff", "gain", "evidence", "explanation")
     return {k: r[k] for k in keys if k in r}
 
 

@@ -32,6 +32,7 @@ from ..fit import evaluate, identify
 from ..fit.identify import lag1_autocorrelation
 from ..fit.threads import blas_single
 from ..model import Dataset, Model
+from .localise import derived_regimes, residual_by_regime
 from .metrics import nrmse
 
 #: default number of folds, significance level, guard band (fraction of samples per side)
@@ -116,6 +117,29 @@ def significance(base, cand, n_candidates: int = 1, alpha: float = ALPHA) -> dic
             "passes": bool(p_value < alpha / max(n_candidates, 1))}
 
 
+def _evidence(before: list[dict], after: list[dict], min_share: float = 0.02) -> dict | None:
+    """The regime label (holding at least ``min_share`` of the samples) where adding the effect
+    lowers the residual mean square most: where the effect's signature lives."""
+    if not before:
+        return None
+    total = max(r["n"] for r in before) or 1
+    after_by = {(r["regime"], r["label"], r["channel"]): r for r in after}
+    best, best_drop = None, 0.0
+    for r in before:
+        a = after_by.get((r["regime"], r["label"], r["channel"]))
+        if a is None or r["nrmse"] is None or a["nrmse"] is None:
+            continue
+        n_regime = sum(x["n"] for x in before if x["regime"] == r["regime"] and x["channel"] == r["channel"])
+        if r["n"] < min_share * max(n_regime, total):
+            continue
+        drop = r["nrmse"] ** 2 - a["nrmse"] ** 2
+        if drop > best_drop:
+            best_drop = drop
+            best = {"regime": r["regime"], "label": r["label"], "channel": r["channel"],
+                    "before": r["nrmse"], "after": a["nrmse"]}
+    return best
+
+
 def _fmt(v: float, s: float) -> str:
     if s > 0 and np.isfinite(s):
         digits = max(0, int(-np.floor(np.log10(s))) + 1)
@@ -198,6 +222,9 @@ def rank_candidates(model: Model, ds: Dataset, candidates, *, folds: int = FOLDS
     prog = _Progress(len(cands) + 1, "diagnose", quiet)
     base_full = identify(model, ds)
     err0, _, _ = cv_error(model, ds, folds, start=base_full.params)
+    regimes = derived_regimes(ds)
+    y_ref = base_full.residual + base_full.y_hat
+    by_regime0 = residual_by_regime(base_full.residual, y_ref, regimes, ds.channels)
     prog.step("baseline")
     rows = []
     for c in cands:
@@ -218,7 +245,14 @@ def rank_candidates(model: Model, ds: Dataset, candidates, *, folds: int = FOLDS
                "units": {k: full.units.get(k, "") for k in own},
                "significant": significant, "p_value": sig["p_value"], "delta_bic": sig["delta_bic"],
                "n_eff": sig["n_eff"], "gain": 1.0 - err1 / err0 if err0 > 0 else 0.0}
+        row["evidence"] = _evidence(by_regime0, residual_by_regime(full.residual, y_ref, regimes,
+                                                                  ds.channels))
         row["explanation"] = explain(c, own, row["stderr"], row["units"], err0, err1, significant)
+        if significant and row["evidence"]:
+            ev = row["evidence"]
+            row["explanation"] += (f"; largest drop where {ev['regime']} is {ev['label']} "
+                                   f"({100 * ev['before']:.0f} % -> {100 * ev['after']:.0f} % of the "
+                                   f"{ev['channel']} RMS)")
         rows.append(row)
         prog.step(c)
     rows.sort(key=lambda r: (r["error_after"] is None, r["error_after"] if r["error_after"] is not None else 0))
