@@ -11,7 +11,8 @@ published (the simulator's brakes hold) and /diagnostics says why.
 ROS parameters: ``description``, ``feedforward`` (bool), ``nominal_mass`` (kg, 0 = the
 description's platform_mass), ``kp`` (N m/rad), ``kd`` (N m s/rad), ``coulomb``, ``viscous``
 (friction compensation), ``min_tension`` (N), ``preload`` (N), ``max_torque`` (N m), ``model``
-("II" | "I"), ``estimate_timeout`` (s of stamps), ``reference_timeout``, ``state_timeout`` (s wall).
+("II" | "I"), ``estimate_timeout`` (s of stamps), ``reference_timeout``, ``state_timeout`` (s wall),
+``sync_wait`` (s wall a state waits for the reference of its stamp before the latest one is used).
 """
 from __future__ import annotations
 
@@ -73,6 +74,9 @@ class CdprController(Node):
         self.create_subscription(MultiDOFJointTrajectory, "/cdpr/reference", self.on_reference, q)
         self.create_subscription(InertiaStamped, "/cdpr/payload_estimate", self.on_estimate, q)
         self.create_subscription(JointState, "/cdpr/joint_states", self.on_state, q)
+        self.pending = None
+        self.sync_wait = float(p("sync_wait", 0.005).value)
+        self.create_timer(0.002, self.on_timer)
         self.diag = Diagnostics(self, update=self.status)
 
     def set_description(self, desc) -> None:
@@ -99,6 +103,7 @@ class CdprController(Node):
             q = d["quaternion"]
             self.ref = (d["t"], d["position"], None if q is None else q[[3, 0, 1, 2]],
                         d["linear_velocity"], d["linear_acceleration"])
+            self.try_command()
 
     def on_estimate(self, msg: InertiaStamped) -> None:
         t, m, com = convert.inertia_arrays(msg)
@@ -108,6 +113,26 @@ class CdprController(Node):
             self.estimates_rejected += 1
 
     def on_state(self, msg: JointState) -> None:
+        """Keep the state; command now if the reference of its stamp is here (else a little later,
+        see :meth:`on_timer`: DDS does not order samples across topics)."""
+        self.pending = (msg, time.monotonic())
+        self.try_command()
+
+    def try_command(self, force: bool = False) -> None:
+        if self.pending is None:
+            return
+        msg, _ = self.pending
+        t = convert.from_stamp(msg.header.stamp)
+        if not force and self.ref is not None and self.ref[0] < t - 1e-9:
+            return                          # the reference of this stamp is probably on its way
+        self.pending = None
+        self.command(msg)
+
+    def on_timer(self) -> None:
+        if self.pending is not None and time.monotonic() - self.pending[1] > self.sync_wait:
+            self.try_command(force=True)
+
+    def command(self, msg: JointState) -> None:
         t0 = time.perf_counter()
         t, _names, q, qd, _eff = convert.joint_state_arrays(msg)
         if self.controller is None:
