@@ -1,6 +1,5 @@
 """Crane PD + gravity compensation + acceleration feedforward (002 sec. 5.3.1) vs MuJoCo."""
 import numpy as np
-import pytest
 
 import mujoco
 

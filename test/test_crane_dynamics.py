@@ -1,6 +1,5 @@
 """Crane dynamics: generated regressor vs 002's printed energies, MuJoCo inverse dynamics, simulation."""
 import numpy as np
-import pytest
 import sympy as sp
 
 import mujoco

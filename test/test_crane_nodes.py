@@ -3,7 +3,6 @@ over DDS, checked against the simulator's ground truth and the control law."""
 from __future__ import annotations
 
 import sys
-import time
 
 import numpy as np
 import pytest
@@ -21,7 +20,6 @@ def ros_context(domain_id):
 
 
 def test_adapters_survive_nan_wrong_length_stale(ros_context):
-    from geometry_msgs.msg import PoseStamped
     from sensor_msgs.msg import JointState
     from std_msgs.msg import Float64MultiArray
 

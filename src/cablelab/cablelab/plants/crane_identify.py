@@ -22,7 +22,7 @@ import numpy as np
 
 from ..fit.linear import LinearFit, solve_linear
 from ..model import Param
-from .crane_model import GROUP_UNITS, PARAM_GROUPS, CraneParams, regressor
+from .crane_model import GROUP_UNITS, PARAM_GROUPS, regressor
 
 __all__ = ["FIX_002", "group_params", "stacked_regressor", "null_space", "identify_groups",
            "physical_check", "GroupFit"]
