@@ -23,7 +23,7 @@ AXIS = get_plant("axis")
 
 def _diagnose(desc, truth, *, noise, delay=0.0, seed=0, amplitude=None):
     amp = amplitude or (0.3 if desc.axis.joint_type == "prismatic" else 0.8)
-    run = simulate_axis(desc, truth, duration=20.0, fs=500.0, amplitude=amp, noise_effort=noise,
+    run = simulate_axis(desc, truth, duration=12.0, fs=500.0, amplitude=amp, noise_effort=noise,
                         noise_position=1e-6, delay=delay, seed=seed)
     ds = dataset_from_arrays(run.t, run.q, run.effort, desc)
     model = Model("axis", AXIS.baseline(desc))
