@@ -104,3 +104,21 @@ def test_csv_import_with_scale_factor(tmp_path, capsys):
     err = _err(capsys, ["import", str(path), "--plant", "axis", "--map", "time=time,effort=2*nope",
                         "--description", DESC, "-o", str(tmp_path / "x")])
     assert "no column 'nope'" in err and "volt" in err
+
+
+def test_irregular_stamps_and_dropouts_are_conditioned(tmp_path, capsys):
+    """Jittered sample times and NaN dropouts (empty fields) are resampled onto a uniform grid;
+    the diagnosis still finds the hidden Coulomb friction."""
+    run = simulate_axis(load_description(DESC), AxisTruth(inertia=2.0, viscous=5.0, coulomb=1.0),
+                        duration=12.0, fs=500.0, amplitude=0.3, noise_effort=0.05, seed=4)
+    rng = np.random.default_rng(4)
+    keep = np.sort(rng.choice(run.t.size, size=int(0.8 * run.t.size), replace=False))  # 20 % lost
+    t = run.t[keep] + rng.uniform(-2e-4, 2e-4, keep.size)  # +-0.2 ms stamp jitter
+    q, eff = run.q[keep].copy(), run.effort[keep].copy()
+    eff[rng.choice(keep.size, 50, replace=False)] = np.nan  # messages with an empty effort
+    bag = _write(tmp_path / "b", t, q, eff)
+    assert main(["diagnose", bag, "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    top = out["ranking"][0]
+    assert top["effect"] == "joint_coulomb_friction" and top["significant"]
+    assert top["params"]["Fc"] == pytest.approx(1.0, rel=0.1)
