@@ -72,6 +72,12 @@ def test_identify_and_compare_on_emps(capsys):
     seg = cmp_["worst_segments"]
     assert len(seg) == 5 and all(s["channel"] == "joint" and s["t_end"] > s["t_start"] for s in seg)
     assert seg[0]["error"] >= seg[-1]["error"]
+    # free run (MuJoCo, driven by the measured force): the identified friction and offset make
+    # the simulated motion follow the real one several times more closely
+    full = _json(capsys, ["compare", str(BAG), "--effects", "joint_coulomb_friction,torque_sensor_offset",
+                          "--json"])
+    assert full["free_run"]["nrmse"] < 0.05 < cmp_["free_run"]["nrmse"]
+    assert full["joint"]["nrmse"] == pytest.approx(0.0443, abs=0.003)
 
 
 @pytest.mark.skipif(not MAT.exists(), reason="EMPS data set not present")
