@@ -61,3 +61,14 @@ def test_identify_with_tilt_gives_the_simulated_parameters(capsys):
     for k, v in truth.items():
         assert p[k] == pytest.approx(v, rel=0.25, abs=0.01), (k, p[k])
     assert not out["fit"]["active_bounds"]
+
+
+def test_free_run_shows_the_missing_counterbalance(capsys):
+    """002 sec. 6.4 / Fig. 6.3: the same efforts into the model with and without the
+    counterbalance; only the model with it follows the measured motion."""
+    bag = str(BAGS / "crane_no_counterbalance")
+    without = _json(capsys, ["compare", bag, "--json"])["free_run"]
+    with_cb = _json(capsys, ["compare", bag, "--effects", "counterbalance", "--fix", "m_b=1.0",
+                             "--json"])["free_run"]
+    assert with_cb["nrmse"] < 0.1 and without["nrmse"] > 10 * with_cb["nrmse"]
+    assert set(with_cb["channels"]) == {"alpha", "beta", "d", "theta1", "theta2"}

@@ -10,6 +10,7 @@ Pieces, one module each:
 * :mod:`.crane_identify` - stacked regressor, rank 6, base parameters, 002's fixing, bounds;
 * :mod:`.crane_swing` - swing estimation offline (vectorised) and live (:class:`SwingTracker`);
 * :mod:`.crane_control` - PD + gravity compensation + reference-acceleration feedforward;
+* :mod:`.crane_freerun` - free-run comparison of an identified model (002 sec. 6.1, 6.4);
 * :mod:`cablelab.effects.crane` - ``crane_rigid_body``, ``counterbalance``, ``base_tilt``;
 * :mod:`cablelab.sim.crane` - the MuJoCo crane with its truth switches.
 
@@ -30,6 +31,7 @@ from ..errors import CablelabError
 from ..model import Dataset
 from . import Plant, register_plant
 from .crane_dynamics_generated import regressor
+from .crane_freerun import free_run_compare
 from .crane_kinematics import SwingAngles
 from .crane_model import JOINTS, CraneParams
 from .crane_swing import SwingReport, estimate_swing
@@ -215,4 +217,5 @@ CRANE = register_plant(Plant(
     baseline=baseline,
     candidates=candidates,
     channels_doc="slew, luff torque (N m), hoist force (N)",
+    simulate=lambda ds, params: free_run_compare(ds, params),
 ))

@@ -91,7 +91,8 @@ def model_xml(truth: CraneTruth, kp=(0.0, 0.0, 0.0), kd=(0.0, 0.0, 0.0)) -> str:
     jb = mb * (lb / 2 - xc) ** 2 + mc * (lc + xc) ** 2
     tiny = 1e-12 * max(jb, 1.0)  # MuJoCo needs inertia > mjMINVAL; 1e-12 relative is far below the tests
     ptiny = 1e-12 * p.payload_mass
-    boom_inertial = f'<inertial pos="{xc!r} 0 0" mass="{mtot!r}" diaginertia="{tiny!r} {jb!r} {jb!r}"/>'
+    boom_inertial = (f'<inertial pos="{xc!r} 0 0" mass="{mtot!r}" '
+                     f'diaginertia="{tiny!r} {jb + tiny!r} {jb + tiny!r}"/>')
     acts = "\n".join(
         f'<general name="{j}" joint="{j}" gainprm="1" biasprm="0 {-float(kp[i])!r} {-float(kd[i])!r}" '
         f'biastype="affine" ctrlrange="{-float(lim)!r} {float(lim)!r}"/>'

@@ -1,0 +1,123 @@
+"""Free-run comparison of an identified crane model (002 sec. 6.1: the same inputs to the model
+and to the crane, compare the motion).
+
+The record is cut into windows of ``horizon_s``; each window starts from the measured state
+(q, qd incl. the swing) and is driven by the measured efforts (minus an identified sensor
+offset, zero-order hold at the sample period) in a MuJoCo crane built from the identified
+parameters (masses, inertias, counterbalance, base tilt, joint friction). All windows run in one
+:func:`mujoco.rollout.rollout` batch. The crane is under-actuated and marginally stable, so
+windows are short (default 1 s).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import CablelabError
+from ..model import Dataset
+from .crane_kinematics import gimbal_rates_to_swing, swing_to_gimbal
+from .crane_model import CraneParams
+
+__all__ = ["FREE_RUN_HORIZON_S", "truth_from_params", "free_run", "free_run_compare"]
+
+FREE_RUN_HORIZON_S = 1.0
+_COORDS = ("alpha", "beta", "d", "theta1", "theta2")
+
+
+def truth_from_params(params: dict, description) -> "object":
+    """A :class:`cablelab.sim.crane.CraneTruth` from identified workbench parameters by name
+    (``I_tot, I_b, m, m_b, m_c, l_c, tilt_pa, tilt_pb, Fv[...], Fc[...]``; missing = description
+    or 0)."""
+    from ..sim.crane import CraneTruth
+
+    base = CraneParams.from_description(description)
+    pos = lambda k, default: max(float(params.get(k, default)), 0.0)
+    p = CraneParams(boom_length=base.boom_length, payload_mass=max(pos("m", base.payload_mass), 1e-6),
+                    boom_mass=pos("m_b", base.boom_mass),
+                    counterbalance_mass=pos("m_c", 0.0), counterbalance_distance=pos("l_c", 0.0),
+                    slew_inertia=max(pos("I_tot", 0.0), 1e-6), luff_inertia=pos("I_b", 0.0),
+                    gravity=base.gravity)
+    if p.boom_mass + p.counterbalance_mass <= 0:
+        p = p.replace(boom_mass=1e-6)
+    g = p.gravity
+    gx = float(params.get("tilt_pa", 0.0)) / p.payload_mass
+    gy = float(params.get("tilt_pb", 0.0)) / p.payload_mass
+    ey = float(np.arcsin(np.clip(gx / g, -0.5, 0.5)))
+    ex = -float(np.arcsin(np.clip(gy / (g * np.cos(ey)), -0.5, 0.5)))
+    joints = ("slew", "luff", "hoist")
+    visc = tuple(pos(f"Fv[{j}]", 0.0) for j in joints)
+    coul = tuple(pos(f"Fc[{j}]", 0.0) for j in joints)
+    return CraneTruth(params=p, base_tilt=(ex, ey), viscous=visc, coulomb=coul, timestep=1e-3)
+
+
+def _mujoco_state(q: np.ndarray, qd: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """MuJoCo qpos, qvel (N, 5) from contract q, qd (N, 5): inverts the gimbal rate map."""
+    psi, phi = swing_to_gimbal(q[:, 1], q[:, 3], q[:, 4])
+    qpos = np.stack([q[:, 0], q[:, 1], psi, phi, q[:, 2]], axis=1)
+    z = np.zeros(q.shape[0])
+    one = np.ones(q.shape[0])
+    # columns of d(theta1, theta2)/d(gamma, phi), gamma = beta + psi (linear in the rates)
+    c_g = np.stack(gimbal_rates_to_swing(q[:, 1], psi, phi, one, z, z), axis=1)
+    c_p = np.stack(gimbal_rates_to_swing(q[:, 1], psi, phi, z, z, one), axis=1)
+    J = np.stack([c_g, c_p], axis=2)                                   # (N, 2, 2)
+    gd_pd = np.linalg.solve(J, qd[:, 3:5, None])[:, :, 0]
+    qvel = np.stack([qd[:, 0], qd[:, 1], gd_pd[:, 0] - qd[:, 1], gd_pd[:, 1], qd[:, 2]], axis=1)
+    return qpos, qvel
+
+
+def free_run(ds: Dataset, params: dict, horizon_s: float = FREE_RUN_HORIZON_S) -> np.ndarray:
+    """(N, 5) simulated contract coordinates, window by window (NaN in the unfilled tail)."""
+    import mujoco
+    import mujoco.rollout
+
+    from ..sim.crane import build_model, qpos_to_contract
+
+    dt = ds.dt
+    w = max(2, int(round(horizon_s / dt)))
+    n_win = ds.n // w
+    if n_win < 1:
+        raise CablelabError(f"{ds.source}: record shorter than one free-run window ({horizon_s} s)")
+    truth = truth_from_params(params, ds.description)
+    steps = max(1, int(round(dt / truth.timestep)))
+    truth = truth.__class__(**{**truth.__dict__, "timestep": dt / steps})
+    model = build_model(truth)
+    data = mujoco.MjData(model)
+    q, qd = ds.signals["q"], ds.signals["qd"]
+    starts = np.arange(n_win) * w
+    qpos, qvel = _mujoco_state(q[starts], qd[starts])
+    spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
+    x0 = np.zeros((n_win, mujoco.mj_stateSize(model, spec)))
+    for k in range(n_win):  # a handful of windows: set each initial state
+        data.qpos[:], data.qvel[:] = qpos[k], qvel[k]
+        mujoco.mj_getState(model, data, x0[k], spec)
+    offset = np.array([float(params.get(f"OF[{j}]", 0.0)) for j in ("slew", "luff", "hoist")])
+    u = ds.y - offset
+    ctrl = np.repeat(u[: n_win * w].reshape(n_win, w, 3), steps, axis=1)
+    state, _ = mujoco.rollout.rollout(model, data, x0, ctrl)
+    nq = model.nq
+    st = state[:, steps - 1::steps, :]                                 # after each sample period
+    qp = np.concatenate([qpos[:, None, :], st[:, :-1, 1:1 + nq]], axis=1).reshape(-1, nq)
+    out = np.full((ds.n, 5), np.nan)
+    out[: n_win * w] = qpos_to_contract(qp)
+    return out
+
+
+def free_run_compare(ds: Dataset, params: dict, horizon_s: float = FREE_RUN_HORIZON_S) -> dict:
+    """Free-run error per coordinate: NRMSE of the deviation from each window's start."""
+    sim = free_run(ds, params, horizon_s)
+    q = ds.signals["q"]
+    w = max(2, int(round(horizon_s / ds.dt)))
+    ok = np.isfinite(sim).all(axis=1)
+    idx = np.arange(ds.n)
+    base = q[(idx // w) * w]
+    out = {"horizon_s": horizon_s, "channels": {}}
+    for j, name in enumerate(_COORDS):
+        dm, dsim = (q[:, j] - base[:, j])[ok], (sim[:, j] - base[:, j])[ok]
+        e = dsim - dm
+        den = np.sqrt(np.mean(dm ** 2))
+        out["channels"][name] = {"nrmse": float(np.sqrt(np.mean(e ** 2)) / den) if den > 0 else None,
+                                 "max_abs": float(np.max(np.abs(e)))}
+    vals = [c["nrmse"] for c in out["channels"].values() if c["nrmse"] is not None]
+    out["channel"] = "q = alpha, beta, d, theta1, theta2 (mean NRMSE)"
+    out["nrmse"] = float(np.mean(vals))
+    out["max_abs"] = float(max(c["max_abs"] for c in out["channels"].values()))  # rad or m
+    return out
