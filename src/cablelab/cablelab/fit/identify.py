@@ -83,13 +83,9 @@ def _inner(model: Model, ds: Dataset, nl: Mapping[str, float], valid: np.ndarray
 
 
 def _weighted_residual(fit: LinearFit, phi, lhs, valid) -> np.ndarray:
-    w = fit.channel_scale
-    r = (lhs - phi @ fit.theta) * w[None, :] if fit.base == [] else None
-    if r is None:  # regrouped fit: residual through lstsq of the independent columns is in rss
-        raise CablelabError("nonlinear parameters with a rank-deficient linear part; fix a "
-                            "parameter (--fix NAME=VALUE) or drop an effect")
-    r = np.where(valid[:, None], r, 0.0)
-    return r.reshape(-1)
+    """Channel-weighted residual (valid rows, others 0) of a full-rank linear fit, flattened."""
+    r = (lhs - phi @ fit.theta) * fit.channel_scale[None, :]
+    return np.where(valid[:, None], r, 0.0).reshape(-1)
 
 
 def identify(model: Model, ds: Dataset, *, on_deficient: str = "raise",
