@@ -84,18 +84,27 @@ def test_effect_below_noise_is_not_marked_significant():
     assert not any(r["significant"] for r in d.ranking)
 
 
-def test_two_hidden_effects_greedy_adds_both_larger_first():
-    truth = _truth("prismatic", dict(coulomb=1.5, offset=0.5))
-    run = simulate_axis(PRISMATIC, truth, amplitude=0.3, noise_effort=0.1, noise_position=1e-6, seed=7)
-    ds = dataset_from_arrays(run.t, run.q, run.effort, PRISMATIC)
-    steps = greedy(Model("axis", AXIS.baseline(PRISMATIC)), ds, AXIS.candidates(PRISMATIC))
-    assert [s["added"] for s in steps] == [None, "joint_coulomb_friction", "torque_sensor_offset"]
+@pytest.mark.parametrize("kind,extra,order,noise", [
+    ("prismatic", dict(coulomb=1.5, offset=0.5), ("joint_coulomb_friction", "torque_sensor_offset"), 0.1),
+    ("pendulum", dict(coulomb=0.08, offset=0.25), ("torque_sensor_offset", "joint_coulomb_friction"), 0.02),
+])
+def test_two_hidden_effects_greedy_adds_both_larger_first(kind, extra, order, noise):
+    desc = PRISMATIC if kind == "prismatic" else PENDULUM
+    truth = _truth(kind, extra)
+    run = simulate_axis(desc, truth, duration=12.0, amplitude=0.3 if kind == "prismatic" else 0.8,
+                        noise_effort=noise, noise_position=1e-6, seed=7)
+    ds = dataset_from_arrays(run.t, run.q, run.effort, desc)
+    steps = greedy(Model("axis", AXIS.baseline(desc)), ds, AXIS.candidates(desc))
+    assert [s["added"] for s in steps] == [None, *order]
     errs = [s["error"] for s in steps]
     assert errs[0] > errs[1] > errs[2]
     p = steps[-1]["params"]
-    assert p["Fc"] == pytest.approx(1.5, rel=0.10)
-    assert p["OF"] == pytest.approx(0.5, rel=0.10)
-    assert p["M"] == pytest.approx(2.0, rel=0.03) and p["Fv"] == pytest.approx(5.0, rel=0.05)
+    assert p["Fc"] == pytest.approx(truth.coulomb, rel=0.10)
+    assert p["OF"] == pytest.approx(truth.offset, rel=0.10)
+    assert p["M"] == pytest.approx(truth.inertia, rel=0.03)
+    assert p["Fv"] == pytest.approx(truth.viscous, rel=0.05)
+    if kind == "pendulum":
+        assert p["mc"] == pytest.approx(0.4, rel=0.03)
 
 
 def test_pendulum_gravity_moment_recovered_as_candidate_when_not_in_the_model():
