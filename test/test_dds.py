@@ -21,6 +21,9 @@ def test_sim_controller_estimator_recorder_over_dds(launcher, tmp_path):
     bag_dir = tmp_path / "run"
     launcher.start("recorder", [sys.executable, "-m", "cablelab.cli", "record", "--plant", "axis",
                                 "-o", bag_dir, "--quiet"])
+    # a recorder still importing on a busy machine would miss the start: wait for its subscriptions
+    launcher.wait_for_subscribers(["/axis/joint_states", "/axis/effort_command", "/axis/reference"],
+                                  timeout=120, node_name="cablelab_recorder")
     # lock-step: the plant waits for the answer to each state, so a loaded machine slows the run
     # down but cannot add control delay (the physics checks below are then deterministic)
     launcher.node("sim", "cable_sim_node", "axis", {**TRUE, "rate": 200.0, "lockstep": True})

@@ -14,9 +14,14 @@ from cablelab.bags import BagWriter, open_bag
 from cablelab.errors import CablelabError
 
 
-def _record(launcher, name, bag_dir, *extra):
-    return launcher.start(name, [sys.executable, "-m", "cablelab.cli", "record", "--plant", "axis",
+def _record(launcher, name, bag_dir, *extra, wait=True):
+    """Start a recorder of the axis topics and (by default) wait until it subscribed."""
+    proc = launcher.start(name, [sys.executable, "-m", "cablelab.cli", "record", "--plant", "axis",
                                  "-o", bag_dir, "--quiet", *extra])
+    if wait:
+        launcher.wait_for_subscribers(["/axis/joint_states", "/clock"], timeout=120,
+                                      node_name="cablelab_recorder")
+    return proc
 
 
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
@@ -89,7 +94,7 @@ def test_replay_republishes_same_messages_with_description(launcher, tmp_path):
     rep = launcher.start("replay", [sys.executable, "-m", "cablelab.cli", "replay", src, "--rate", "2",
                                     "--start-delay", "90", "--quiet"])
     launcher.wait_for_topics({"/plant_description": 1}, timeout=60)  # transient-local: late joiner
-    _record(launcher, "recorder", rec_dir)  # its subscriptions start the replay
+    _record(launcher, "recorder", rec_dir, wait=False)  # its subscriptions start the replay
     assert rep.wait(150) == 0, rep.log()
     assert launcher.stop("recorder") == 0
     got = open_bag(rec_dir)
@@ -98,10 +103,9 @@ def test_replay_republishes_same_messages_with_description(launcher, tmp_path):
     np.testing.assert_array_equal(b.position, a.position)
     np.testing.assert_array_equal(b.effort, a.effort)
     np.testing.assert_array_equal(b.t, a.t)
-    # paced at rate 2: messages 10 ms apart in the bag arrive about 5 ms apart (median: robust to
-    # the burst DDS may deliver while the reliable connection completes, and to a busy machine)
-    spacing = float(np.median(np.diff(b.t_receive)))
-    assert 0.0035 < spacing < 0.0075, spacing
+    # paced, not dumped at once (the exact rate is checked in-process in test_replay_pacing; receive
+    # times of a recorder on a busy machine are too bursty for a tight bound here)
+    assert b.t_receive[-1] - b.t_receive[0] > 0.5, b.t_receive[-1] - b.t_receive[0]
     # /clock synthesised from the bag's log time (the bag had none)
     clock, _ = got.clock()
     assert clock.min() >= t[0] - 1e-9 and clock.max() <= t[-1] + 1e-9 and len(clock) > 100
@@ -142,3 +146,35 @@ def test_recorder_adapts_to_best_effort_and_volatile_publishers(launcher, tmp_pa
     assert bag.counts.get("/clock", 0) > 50, bag.counts
     assert bag.counts.get("/plant_description", 0) >= 1, bag.counts
     assert "best-effort" in rec.log()
+
+
+def test_replay_pacing_never_early_and_at_rate(tmp_path, domain_id):
+    """In process: the replayer publishes each message no earlier than (log time - first) / rate
+    after its start (load can only delay it), and the whole bag takes at least its length / rate."""
+    import time as _time
+
+    import rclpy
+    from rclpy.executors import SingleThreadedExecutor
+
+    from cablelab.ros.replayer import ReplayNode
+
+    t = 5.0 + np.arange(100) * 0.01  # 0.99 s of bag time
+    with BagWriter(tmp_path / "b") as w:
+        w.write_joint_states("/axis/joint_states", t, ["joint"], np.zeros((100, 1)))
+    rclpy.init(domain_id=domain_id)
+    try:
+        node = ReplayNode(tmp_path / "b", rate=2.0, start_delay=0.0, quiet=True)
+        ex = SingleThreadedExecutor()
+        ex.add_node(node)
+        deadline = _time.monotonic() + 60
+        while not node.done and _time.monotonic() < deadline:
+            ex.spin_once(timeout_sec=0.05)
+        assert node.done
+        sent = np.array(node.sent_wall) - node.t0_wall
+        due = (t - t[0]) / 2.0
+        assert np.all(sent >= due - 1e-6), (sent - due).min()
+        assert sent[-1] >= 0.99 / 2.0
+        assert np.median(sent - due) < 0.05  # typically on time
+        node.destroy_node()
+    finally:
+        rclpy.try_shutdown()

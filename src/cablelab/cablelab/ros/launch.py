@@ -144,6 +144,44 @@ class Launcher:
         process). Returns the counts seen."""
         return wait_for_topics(counts, self.domain_id, timeout, self.check_alive)
 
+    def wait_for_subscribers(self, topics, timeout: float = 60.0, node_name: str | None = None) -> None:
+        """Wait until every topic has a subscription in the graph (of the node ``node_name`` if
+        given), e.g. until a recorder that is still importing is ready before the publishers
+        start. Raises CablelabError naming the topics on timeout (or a dead process)."""
+        wait_for_subscribers(list(topics), self.domain_id, timeout, node_name, self.check_alive)
+
+
+def wait_for_subscribers(topics: list[str], domain_id: int, timeout: float = 60.0,
+                         node_name: str | None = None, check=None) -> None:
+    """See :meth:`Launcher.wait_for_subscribers`."""
+    import rclpy
+    from rclpy.context import Context
+    from rclpy.node import Node
+
+    ctx = Context()
+    rclpy.init(context=ctx, domain_id=domain_id)
+    node = None
+    try:
+        node = Node("cablelab_graph_probe", context=ctx)
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            missing = []
+            for topic in topics:
+                infos = node.get_subscriptions_info_by_topic(topic)
+                if not any(node_name is None or i.node_name == node_name for i in infos):
+                    missing.append(topic)
+            if not missing:
+                return
+            if check is not None:
+                check()
+            time.sleep(0.1)
+        raise CablelabError(f"timeout after {timeout:g} s waiting for subscribers on {missing} "
+                            f"(domain {domain_id})")
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown(context=ctx)
+
 
 def wait_for_topics(counts: dict[str, int], domain_id: int, timeout: float = 60.0,
                     check=None) -> dict[str, int]:
@@ -198,6 +236,6 @@ def wait_for_topics(counts: dict[str, int], domain_id: int, timeout: float = 60.
     finally:
         try:
             node.destroy_node()
-        except Exception:  # noqa: BLE001
+        except Exception:  # noqa: BLE001 - node may not exist if init failed
             pass
         rclpy.try_shutdown(context=ctx)

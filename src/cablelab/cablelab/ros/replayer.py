@@ -12,7 +12,6 @@ import heapq
 import sys
 import time
 
-import numpy as np
 from rclpy.node import Node
 
 from ..bags import CLOCK_TOPIC, DESCRIPTION_TOPIC, open_bag
@@ -63,6 +62,7 @@ class ReplayNode(Node):
         self.clock_period_ns = int(clock_period * 1e9)
         self.next_clock = self.t0_bag
         self.i = 0
+        self.sent_wall: list[float] = []  # monotonic time of each publish (for tests and stats)
         self.done = False
         self.published = 0
         self.start_deadline = time.monotonic() + start_delay
@@ -86,6 +86,7 @@ class ReplayNode(Node):
                     self.clock_pub.publish(clock_msg(self.next_clock * 1e-9))
                     self.next_clock += self.clock_period_ns
             self.pubs[topic].publish(bytes(self.raws[topic][k]))
+            self.sent_wall.append(time.monotonic())
             self.i += 1
             self.published += 1
         if not self.quiet and now - self.last_report > 5.0:
@@ -106,8 +107,3 @@ class ReplayNode(Node):
         self.done = True
         self.exit_code = 0
 
-
-def schedule_times(log_ns: np.ndarray, rate: float) -> np.ndarray:
-    """Wall-clock offsets (s) at which messages with these log times are republished."""
-    log_ns = np.asarray(log_ns, dtype=np.int64)
-    return (log_ns - log_ns.min()) * 1e-9 / rate if log_ns.size else np.zeros(0)
