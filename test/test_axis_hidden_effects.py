@@ -4,7 +4,6 @@ effects the analysed model lacks, over magnitudes and noise levels, and control 
 Oracle: the simulator's true parameters (MuJoCo joint damping, frictionloss, servo force with a
 sensor offset / delay added); the analysed model is the plant's nominal one.
 """
-import numpy as np
 import pytest
 
 from cablelab.description import load_description

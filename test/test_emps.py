@@ -4,7 +4,6 @@ Oracle: the published IDIM-LS reference model M = 95.1089 kg, Fv = 203.5034 N s/
 Fc = 20.3935 N, OF = -3.1648 N, and the README's error ladder 18 % -> 7 % -> 4 %.
 """
 import json
-import os
 from pathlib import Path
 
 import numpy as np

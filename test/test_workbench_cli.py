@@ -1,7 +1,6 @@
 """Workbench verbs end to end on small synthetic bags: report contents, bad input as one-line
 errors (exit 2, no traceback), CSV import."""
 import json
-import os
 
 import numpy as np
 import pytest

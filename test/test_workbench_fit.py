@@ -3,7 +3,7 @@ separable LS for a delay, conditioning. Oracles: closed forms, Monte Carlo scatt
 import numpy as np
 import pytest
 
-from cablelab.conditioning import Conditioning, derivatives, is_uniform, lowpass, uniform_grid, unwrap_angle
+from cablelab.conditioning import derivatives, is_uniform, lowpass, uniform_grid, unwrap_angle
 from cablelab.description import load_description
 from cablelab.effects import effects_for, get_effect
 from cablelab.errors import CablelabError

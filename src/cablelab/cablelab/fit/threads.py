@@ -22,11 +22,8 @@ def _openblas_libs() -> list:
     if _LIBS is not None:
         return _LIBS
     _LIBS = []
-    try:
-        import numpy
-        import scipy
-    except ImportError:  # pragma: no cover
-        return _LIBS
+    import numpy
+
     site = os.path.dirname(os.path.dirname(numpy.__file__))
     for path in glob.glob(os.path.join(site, "numpy.libs", "libscipy_openblas*.so*")) + \
             glob.glob(os.path.join(site, "scipy.libs", "libscipy_openblas*.so*")):
