@@ -121,3 +121,15 @@ def test_irregular_stamps_and_dropouts_are_conditioned(tmp_path, capsys):
     top = out["ranking"][0]
     assert top["effect"] == "joint_coulomb_friction" and top["significant"]
     assert top["params"]["Fc"] == pytest.approx(1.0, rel=0.1)
+
+
+def test_identify_with_simulation_based_refinement(synth_bag, capsys):
+    assert main(["identify", synth_bag, "--effects", "joint_coulomb_friction", "--simulation", "pearson",
+                 "--folds", "0", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    sim = out["simulation"]
+    assert sim["objective"] == "pearson" and sim["pearson"] > 0.999
+    for k, v in {"M": 2.0, "Fv": 5.0, "Fc": 1.0}.items():
+        assert sim["params"][k]["value"] == pytest.approx(v, rel=0.06)
+        assert out["params"][k]["value"] == pytest.approx(v, rel=0.06)
+    assert out["fit"]["cv_nrmse"] is None
