@@ -17,7 +17,7 @@ lock the motor angles (the last torque + a stiff PD about the locked angles), re
 ROS parameters: ``description`` (YAML file or text; default CAROCA), ``payload_mass`` (kg),
 ``payload_com`` [x, y, z] (m), ``pulleys`` (bool), ``winch_coulomb`` (N m), ``winch_viscous``
 (N m s/rad), ``motor_inertia`` (kg m^2), ``tension_noise`` (N), ``tension_bias`` [n] (N),
-``torque_noise`` (N m), ``pose_noise`` (m), ``timestep`` (s), ``rate`` (Hz), ``real_time``,
+``torque_noise`` (N m), ``pose_noise`` (m), ``timestep`` (s; 0 = min(2 ms, 1/rate)), ``rate`` (Hz), ``real_time``,
 ``publish_reference``, ``publish_pose``, ``trajectory_speed`` (time scale of the s-curve),
 ``settle`` (s held at A before the trajectory starts), ``duration`` (s of simulated time after
 which the node exits; 0 = run until stopped), ``command_timeout`` (s wall, real time),
@@ -72,9 +72,9 @@ class CdprSimNode(Node):
             tension_bias=tuple(float(b) for b in bias) if any(bias) else None,
             torque_noise=float(p("torque_noise", 0.02).value),
             pose_noise=float(p("pose_noise", 0.0).value),
-            timestep=float(p("timestep", 0.001).value),
+            timestep=float(p("timestep", 0.0).value) or min(0.002, 1.0 / float(p("rate", 100.0).value)),
             seed=int(p("seed", 0).value))
-        self.rate = float(p("rate", 100.0).value)
+        self.rate = float(self.get_parameter("rate").value)
         self.real_time = bool(p("real_time", True).value)
         self.publish_reference = bool(p("publish_reference", True).value)
         self.publish_pose = bool(p("publish_pose", True).value)
@@ -96,6 +96,7 @@ class CdprSimNode(Node):
         self.u = None
         self.commands = 0           # good commands received
         self.commands_at_pub = 0    # ... when the last state was published (lock-step)
+        self.u_stamp = None         # stamp of the state the last command answers, if it says
         self.fallbacks = 0
         self.slack_steps = 0
         self.k = 0
@@ -138,6 +139,12 @@ class CdprSimNode(Node):
         if self.inputs.accept("effort_commands", values, time.monotonic()):
             self.u = values.copy()
             self.commands += 1
+            self.u_stamp = None
+            if msg.layout.dim and "stamp=" in msg.layout.dim[0].label:
+                try:
+                    self.u_stamp = float(msg.layout.dim[0].label.split("stamp=")[1])
+                except ValueError:
+                    pass
 
     def reference(self, t: float):
         """Desired pose/twist/acceleration of the s-curve at sim time t (held at A while
@@ -149,11 +156,13 @@ class CdprSimNode(Node):
     def tick(self) -> None:
         now = time.monotonic()
         if not self.real_time:
-            answered = self.commands > self.commands_at_pub
+            if self.u_stamp is not None:      # the controller says which state it answers
+                answered = abs(self.u_stamp - self.sim.time) < 1e-6
+            else:
+                answered = self.commands > self.commands_at_pub
             if not answered and now - self._last_pub_wall < self.lockstep_timeout:
                 return                                  # lock-step: wait for the controller
-        fresh = self.u is not None and (self.inputs.fresh("effort_commands", now) or
-                                        (not self.real_time and self.commands > self.commands_at_pub))
+        fresh = self.u is not None and self.inputs.fresh("effort_commands", now)
         if not fresh:
             for _ in range(self.nstep):        # brakes act continuously: every physics step
                 self.sim.step(self.brake(), 1)

@@ -5,7 +5,8 @@ winch_1..n) from :class:`cablelab.plants.cdpr_live.LiveController`: motor-angle 
 inverse geometric model of the reference ``/cdpr/reference``, feedforward of 001 eq. 14 with the
 live ``/cdpr/payload_estimate`` (``feedforward`` true, PDFF) or none (PD), friction compensation
 (eq. 15) and a minimum-tension floor. A stale or implausible estimate falls back to the nominal
-mass (WARN on /diagnostics). Without a reference (or with a bad motor state) nothing is
+mass (WARN on /diagnostics). Each command carries the stamp of the state it answers in
+``layout.dim[0].label`` (``winch stamp=<s>``, optional; a lock-step simulator matches it). Without a reference (or with a bad motor state) nothing is
 published (the simulator's brakes hold) and /diagnostics says why.
 
 ROS parameters: ``description``, ``feedforward`` (bool), ``nominal_mass`` (kg, 0 = the
@@ -22,7 +23,7 @@ import numpy as np
 from geometry_msgs.msg import InertiaStamped
 from rclpy.node import Node
 from sensor_msgs.msg import JointState
-from std_msgs.msg import Float64MultiArray, String
+from std_msgs.msg import Float64MultiArray, MultiArrayDimension, String
 from trajectory_msgs.msg import MultiDOFJointTrajectory
 
 from cablelab.description import load_description
@@ -51,7 +52,7 @@ class CdprController(Node):
         self.model = str(p("model", "II").value)
         if self.model not in ("I", "II"):
             raise CablelabError("pd_feedforward: parameter model must be I or II")
-        self.estimate_timeout = float(p("estimate_timeout", 0.5).value)
+        self.estimate_timeout = float(p("estimate_timeout", 2.0).value)
         self.controller = None
         self.ref = None
         self.sent = 0
@@ -157,7 +158,10 @@ class CdprController(Node):
             self.last_skip = time.monotonic()
             self.last_problem = self.controller.status[-1][1]
             return
-        self.pub_cmd.publish(convert.float_array_msg(tau))
+        cmd = convert.float_array_msg(tau)
+        # optional: the stamp of the state this command answers (a lock-step simulator matches it)
+        cmd.layout.dim = [MultiArrayDimension(label=f"winch stamp={t:.9f}", size=len(tau), stride=len(tau))]
+        self.pub_cmd.publish(cmd)
         self.sent += 1
         self.latency.append(time.perf_counter() - t0)
         if len(self.latency) > 100000:

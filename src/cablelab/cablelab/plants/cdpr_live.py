@@ -192,7 +192,9 @@ class ControllerConfig:
     Args:
         feedforward: True = PDFF (eq. 14 with the live mass), False = PD.
         nominal_mass: mass used when the live estimate is stale or invalid, kg.
-        estimate_timeout: the live estimate is stale after this, s.
+        estimate_timeout: the live estimate is stale after this, s of stamps (the mass does not
+            change while a load is carried: a briefly late estimator should not drop the
+            feedforward to the nominal mass).
         estimate_filter: time constant of the low-pass on the live mass, s.
         valid_mass: (min, max) plausible estimate as fractions of the nominal mass.
         gains: the :class:`PdffConfig` (gains, friction compensation, tension floor).
@@ -202,7 +204,7 @@ class ControllerConfig:
 
     feedforward: bool = True
     nominal_mass: float = 366.0
-    estimate_timeout: float = 0.5
+    estimate_timeout: float = 2.0
     estimate_filter: float = 0.3
     valid_mass: tuple = (0.5, 3.0)
     gains: PdffConfig = field(default_factory=PdffConfig)
