@@ -429,17 +429,20 @@ def simulate(desc: Description, truth: CdprTruth | None = None, *, controller: s
 
 
 def write_run_bag(run: CdprRun, path, *, overwrite: bool = True, pose: bool = True,
-                  ground_truth: bool = True, commands: bool = True) -> None:
+                  ground_truth: bool = True, commands: bool = True, every: int = 1) -> None:
     """Write a run as a contract bag (CONTRACT section 2): /plant_description, /clock,
     /cdpr/joint_states, /cdpr/cable_tensions, /cdpr/reference, optional /cdpr/platform_pose,
-    /cdpr/effort_commands, /cdpr/ground_truth/{pose,payload}."""
+    /cdpr/effort_commands, /cdpr/ground_truth/{pose,payload}; ``every`` keeps every k-th sample."""
     from ..bags import BagWriter
     from ..description import dump_description
 
     def xyzw(q):
         return np.asarray(q)[:, [1, 2, 3, 0]]
 
-    A, n = run.arrays, run.motor_angle.shape[1]
+    n = run.motor_angle.shape[1]
+    k = max(1, int(every))                       # keep every k-th sample (smaller reference bags)
+    A = {key: (v[::k] if isinstance(v, np.ndarray) and v.ndim and len(v) == len(run.arrays["t"]) else v)
+         for key, v in run.arrays.items()}
     t = A["t"]
     with BagWriter(path, overwrite=overwrite) as w:
         w.write_description(run.desc.yaml_text or dump_description(run.desc), float(t[0]))
@@ -485,6 +488,7 @@ def main(argv=None) -> int:
     p.add_argument("--strip-pulley-radius", action="store_true",
                    help="write the description without pulley_radius (pulleys unknown to the analysis)")
     p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--every", type=int, default=1, help="write every k-th sample (smaller bags)")
     a = p.parse_args(argv)
     try:
         desc = load_description(a.description or _default_description())
@@ -502,7 +506,7 @@ def main(argv=None) -> int:
                                                     file=sys.stderr))
         if a.strip_pulley_radius:
             run = CdprRun(without_pulley_radius(desc), run.truth, run.arrays)
-        write_run_bag(run, a.out)
+        write_run_bag(run, a.out, every=a.every)
         el = _time.monotonic() - t0
         print(f"wrote {a.out}: {run.t[-1]:.1f} s simulated in {el:.1f} s ({run.t[-1] / el:.0f}x real time)")
     except CablelabError as exc:
