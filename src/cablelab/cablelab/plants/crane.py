@@ -31,7 +31,7 @@ from ..errors import CablelabError
 from ..model import Dataset
 from . import Plant, register_plant
 from .crane_dynamics_generated import regressor
-from .crane_freerun import free_run_compare
+from .crane_freerun import fit_free_run, free_run_compare
 from .crane_kinematics import SwingAngles
 from .crane_model import JOINTS, CraneParams
 from .crane_swing import SwingReport, estimate_swing
@@ -218,4 +218,6 @@ CRANE = register_plant(Plant(
     candidates=candidates,
     channels_doc="slew, luff torque (N m), hoist force (N)",
     simulate=lambda ds, params: free_run_compare(ds, params),
+    simulation_fit=lambda ds, start, objective, progress=False: fit_free_run(
+        ds, start, objective=objective, progress=progress),
 ))

@@ -17,9 +17,13 @@ from ..model import Dataset
 from .crane_kinematics import gimbal_rates_to_swing, swing_to_gimbal
 from .crane_model import CraneParams
 
-__all__ = ["FREE_RUN_HORIZON_S", "truth_from_params", "free_run", "free_run_compare"]
+__all__ = ["FREE_RUN_HORIZON_S", "truth_from_params", "free_run", "free_run_compare", "fit_free_run"]
 
 FREE_RUN_HORIZON_S = 1.0
+#: shorter windows for the simulation-based fit: the open-loop crane is so sensitive to its
+#: parameters (+-5 % of m_b already swings the payload wildly within 1 s) that long windows leave
+#: no slope for the optimiser away from the optimum
+FIT_HORIZON_S = 0.4
 _COORDS = ("alpha", "beta", "d", "theta1", "theta2")
 
 
@@ -64,41 +68,55 @@ def _mujoco_state(q: np.ndarray, qd: np.ndarray) -> tuple[np.ndarray, np.ndarray
     return qpos, qvel
 
 
-def free_run(ds: Dataset, params: dict, horizon_s: float = FREE_RUN_HORIZON_S) -> np.ndarray:
-    """(N, 5) simulated contract coordinates, window by window (NaN in the unfilled tail)."""
+def free_run(ds: Dataset, params, horizon_s: float = FREE_RUN_HORIZON_S) -> np.ndarray:
+    """Simulated contract coordinates, window by window (NaN in the unfilled tail).
+
+    Args:
+        params: one parameter dict, or a list of them (one batch: one model per set).
+    Returns:
+        (N, 5) for one dict, (k, N, 5) for a list of k dicts.
+    """
     import mujoco
     import mujoco.rollout
 
     from ..sim.crane import build_model, qpos_to_contract
 
+    sets = [params] if isinstance(params, dict) else list(params)
     dt = ds.dt
     w = max(2, int(round(horizon_s / dt)))
     n_win = ds.n // w
     if n_win < 1:
         raise CablelabError(f"{ds.source}: record shorter than one free-run window ({horizon_s} s)")
-    truth = truth_from_params(params, ds.description)
-    steps = max(1, int(round(dt / truth.timestep)))
-    truth = truth.__class__(**{**truth.__dict__, "timestep": dt / steps})
-    model = build_model(truth)
-    data = mujoco.MjData(model)
     q, qd = ds.signals["q"], ds.signals["qd"]
     starts = np.arange(n_win) * w
     qpos, qvel = _mujoco_state(q[starts], qd[starts])
-    spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
-    x0 = np.zeros((n_win, mujoco.mj_stateSize(model, spec)))
-    for k in range(n_win):  # a handful of windows: set each initial state
-        data.qpos[:], data.qvel[:] = qpos[k], qvel[k]
-        mujoco.mj_getState(model, data, x0[k], spec)
-    offset = np.array([float(params.get(f"OF[{j}]", 0.0)) for j in ("slew", "luff", "hoist")])
-    u = ds.y - offset
-    ctrl = np.repeat(u[: n_win * w].reshape(n_win, w, 3), steps, axis=1)
-    state, _ = mujoco.rollout.rollout(model, data, x0, ctrl)
-    nq = model.nq
+    steps = max(1, int(round(dt / 1e-3)))
+    models, x0s, ctrls = [], [], []
+    for ps in sets:
+        truth = truth_from_params(ps, ds.description)
+        truth = truth.__class__(**{**truth.__dict__, "timestep": dt / steps})
+        model = build_model(truth)
+        data = mujoco.MjData(model)
+        spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
+        x0 = np.zeros((n_win, mujoco.mj_stateSize(model, spec)))
+        for k in range(n_win):  # a handful of windows: set each initial state
+            data.qpos[:], data.qvel[:] = qpos[k], qvel[k]
+            mujoco.mj_getState(model, data, x0[k], spec)
+        offset = np.array([float(ps.get(f"OF[{j}]", 0.0)) for j in ("slew", "luff", "hoist")])
+        u = ds.y - offset
+        ctrl = np.repeat(u[: n_win * w].reshape(n_win, w, 3), steps, axis=1)
+        models += [model] * n_win
+        x0s.append(x0)
+        ctrls.append(ctrl)
+    data = [mujoco.MjData(models[0]) for _ in range(2)]
+    state, _ = mujoco.rollout.rollout(models, data, np.concatenate(x0s), np.concatenate(ctrls))
+    nq = models[0].nq
     st = state[:, steps - 1::steps, :]                                 # after each sample period
-    qp = np.concatenate([qpos[:, None, :], st[:, :-1, 1:1 + nq]], axis=1).reshape(-1, nq)
-    out = np.full((ds.n, 5), np.nan)
-    out[: n_win * w] = qpos_to_contract(qp)
-    return out
+    qstart = np.tile(qpos, (len(sets), 1))
+    qp = np.concatenate([qstart[:, None, :], st[:, :-1, 1:1 + nq]], axis=1)
+    out = np.full((len(sets), ds.n, 5), np.nan)
+    out[:, : n_win * w] = qpos_to_contract(qp.reshape(-1, nq)).reshape(len(sets), n_win * w, 5)
+    return out[0] if isinstance(params, dict) else out
 
 
 def free_run_compare(ds: Dataset, params: dict, horizon_s: float = FREE_RUN_HORIZON_S) -> dict:
@@ -121,3 +139,34 @@ def free_run_compare(ds: Dataset, params: dict, horizon_s: float = FREE_RUN_HORI
     out["nrmse"] = float(np.mean(vals))
     out["max_abs"] = float(max(c["max_abs"] for c in out["channels"].values()))  # rad or m
     return out
+
+
+def fit_free_run(ds: Dataset, start: dict, *, objective: str = "nmse",
+                 free: tuple[str, ...] = ("I_tot", "I_b", "m", "m_b", "m_c"),
+                 horizon_s: float = FIT_HORIZON_S, max_iter: int = 20, progress: bool = False):
+    """Simulation-based identification of the crane: free-run windows (:func:`free_run`) matched
+    to the measured motion (deviation of alpha, beta, d, theta1, theta2 from each window's start)
+    with :func:`~cablelab.fit.simulation.fit_simulation` (NMSE of 003 eq. 28 or Pearson of 000
+    eq. 3-7). Parameters of ``free`` with a positive start value are fitted within
+    [start / 5, start * 5]; the others are held at their start value.
+    """
+    from ..fit.simulation import fit_simulation
+    from ..model import Param
+
+    w = max(2, int(round(horizon_s / ds.dt)))
+    n_win = ds.n // w
+    q = ds.signals["q"]
+    idx = np.arange(n_win * w)
+    base = q[(idx // w) * w]
+    y_meas = q[: n_win * w] - base
+    params = [Param(k, "", float(start[k]), float(start[k]) / 5.0, float(start[k]) * 5.0)
+              for k in free if float(start.get(k, 0.0)) > 0]
+    if not params:
+        raise CablelabError("free-run fit: no free parameter with a positive start value")
+
+    def simulate(sets):
+        full = [{**start, **s} for s in sets]
+        return free_run(ds, full, horizon_s)[:, : n_win * w, :] - base[None]
+
+    return fit_simulation(simulate, params, y_meas, objective=objective, max_iter=max_iter,
+                          progress=progress)
