@@ -3,7 +3,7 @@
 1. Offline estimation, Model I and Model II (001 eq. 6-9, 12-13), --samples samples of 8 cables
    on one core (``mass_com_batch``; the general ``cable_geometry + mass_com`` path for reference).
    Target: Model II >= 1 000 000 samples/s.
-2. Offline closed-loop simulation (MuJoCo 1 kHz physics, PDFF + live estimator at 100 Hz) of the
+2. Offline closed-loop simulation (MuJoCo 2 ms physics, PDFF + live estimator at 100 Hz) of the
    60 s test trajectory. Target: >= 20x real time.
 3. Estimator node in its own process fed at 1 kHz over DDS (/cdpr/cable_tensions +
    /cdpr/reference, --seconds s): estimates received vs sent, processing latency p99 (measured in
@@ -11,6 +11,9 @@
 4. Closed loop sim -> estimator -> controller -> sim at 1 kHz in real-time mode (three
    processes, --seconds s): achieved rate, commands per state, steps the simulator had to brake
    because no fresh command came.
+
+``--paper`` instead prints the reproduction of 001 Tables I-II and Fig. 15 (three payloads, PD and
+PDFF runs of the offline simulation) used in docs/cdpr.md.
 """
 from __future__ import annotations
 
@@ -55,10 +58,60 @@ def offline_simulation(bench: Bench) -> None:
     t0 = time.perf_counter()
     run = simulate(desc, CdprTruth(payload_mass=249.0), controller="pdff", duration=60.0)
     el = time.perf_counter() - t0
-    bench.row(case="MuJoCo 1 kHz + PDFF/estimator 100 Hz", simulated_s=60.0, seconds=el,
+    bench.row(case="MuJoCo 500 Hz physics + PDFF/estimator 100 Hz", simulated_s=60.0, seconds=el,
               rate=60.0 / el, unit="x real time", target=">= 20")
     ez = np.abs(run.true_position[:, 2] - run.ref_position[:, 2]).max()
     bench.log(f"  (max |z error| {1000 * ez:.2f} mm, mean live mass {np.nanmean(run.est_mass):.1f} kg)")
+
+
+def estimator_in_process(bench: Bench, n: int = 5000) -> None:
+    """Per-sample cost of the estimator node's callbacks (reference + tensions), called directly
+    with ready messages: the compute part of the latency, without DDS and scheduling."""
+    import rclpy
+
+    from cablelab.plants.cdpr_control import feedforward_tensions
+    from cablelab.plants.cdpr_geometry import cable_geometry
+    from cablelab.plants.cdpr_trajectory import pick_and_place
+    from cablelab.ros import convert
+    from cablelab.sim.cdpr import default_description
+    from payload_estimator.cdpr import CdprPayloadEstimator
+    from pd_feedforward.cdpr import CdprController
+
+    bench.section("node callbacks in process (compute only: no DDS, no executor)")
+    desc = default_description()
+    c = desc.cdpr
+    tr = pick_and_place(np.arange(n) * 1e-3)
+    T = feedforward_tensions(cable_geometry(c.exit_points, c.anchor_points, tr.position, None, 0.15),
+                             615.0, np.zeros((n, 3)))
+    names = [f"cable_{i}" for i in range(1, 9)]
+    refs = [convert.multidof_msg(k * 1e-3, tr.position[k], [0, 0, 0, 1.0], tr.velocity[k], None,
+                                 tr.acceleration[k], None) for k in range(n)]
+    tens = [convert.joint_state_msg(k * 1e-3, names, None, None, T[k]) for k in range(n)]
+    js = [convert.joint_state_msg(k * 1e-3, [f"winch_{i}" for i in range(1, 9)], -666 * np.ones(8),
+                                  np.zeros(8), np.ones(8)) for k in range(n)]
+    rclpy.init(domain_id=231)
+    try:
+        est = CdprPayloadEstimator()
+        ctl = CdprController()
+        est.pub.publish = lambda m: None
+        ctl.pub_cmd.publish = lambda m: None
+        est.on_description(convert.string_msg(desc.to_yaml()))
+        ctl.on_description(convert.string_msg(desc.to_yaml()))
+        for name, fn in (("estimator: reference + tensions callbacks", lambda k: (est.on_reference(refs[k]),
+                                                                                  est.on_tensions(tens[k]))),
+                         ("controller: reference + joint_states callbacks", lambda k: (ctl.on_reference(refs[k]),
+                                                                                       ctl.on_state(js[k])))):
+            dt = np.empty(n)
+            for k in range(n):
+                t0 = time.perf_counter()
+                fn(k)
+                dt[k] = time.perf_counter() - t0
+            bench.row(case=name, samples=n, median_ms=1000 * float(np.median(dt)),
+                      p99_ms=1000 * float(np.quantile(dt, 0.99)), target="p99 < 1 ms")
+        est.destroy_node()
+        ctl.destroy_node()
+    finally:
+        rclpy.try_shutdown()
 
 
 class _Client:
@@ -205,14 +258,67 @@ def closed_loop_1khz(bench: Bench, launch, seconds: float) -> None:
     launch.stop_all()
 
 
+def paper_tables(bench: Bench) -> None:
+    """001 Tables I-II and Fig. 15 from offline closed-loop runs (MP, MP+M1, MP+M2)."""
+    from cablelab.plants.cdpr import estimate_arrays, CdprArrays
+    from cablelab.sim.cdpr import CdprTruth, default_description, simulate, without_pulley_radius
+
+    desc = default_description()
+    desc1 = without_pulley_radius(desc)
+    c = desc.cdpr
+    scale = c.gear_ratio / c.drum_radius
+    t1, t2, f15 = [], [], []
+    for name, pl in (("MP", 0.0), ("MP+M1", 122.0), ("MP+M2", 249.0)):
+        bench.log(f"  {name}: PDFF and PD runs")
+        run = simulate(desc, CdprTruth(payload_mass=pl, seed=7), controller="pdff")
+        pd = simulate(desc, CdprTruth(payload_mass=pl, seed=7), controller="pd")
+        true = run.true_mass
+
+        def arr(source):
+            ten = run.tension if source == "dynamometer" else run.motor_torque * scale
+            return CdprArrays(run.t, ten, run.motor_velocity, run.motor_torque, run.ref_position, None,
+                              run.ref_acceleration, run.ref_velocity, true, None, source, scale)
+
+        def stats(e):
+            err = 100 * (e.mass - true) / true
+            return e.mass.mean(), 100 * (e.mass.mean() - true) / true, np.abs(err).max(), e.mass.std()
+
+        m1 = stats(estimate_arrays(arr("dynamometer"), desc1))
+        m2 = stats(estimate_arrays(arr("dynamometer"), desc))
+        raw = stats(estimate_arrays(arr("motor"), desc))
+        fr = stats(estimate_arrays(arr("motor"), desc, ("winch_coulomb_friction", "winch_viscous_friction")))
+        t1.append((name, true, m1, m2))
+        t2.append((name, raw, fr, m2))
+        ez = lambda r: 1000 * np.abs(r.true_position[:, 2] - r.ref_position[:, 2]).max()  # noqa: E731
+        f15.append((name, ez(pd), ez(run)))
+    bench.section("001 Table I: estimated mass with Models I and II (dynamometers, desired pose)")
+    for name, true, m1, m2 in t1:
+        bench.row(payload=name, real_kg=true, modelI_kg=m1[0], modelII_kg=m2[0], modelI_err_pct=m1[1],
+                  modelII_err_pct=m2[1], modelI_std=m1[3], modelII_std=m2[3])
+    bench.section("001 Table II: dynamometers vs motor torques (Model II)")
+    for name, raw, fr, dyn in t2:
+        bench.row(payload=name, raw_mean=raw[0], raw_err_pct=raw[1], raw_max_pct=raw[2], raw_std=raw[3],
+                  fric_mean=fr[0], fric_max_pct=fr[2], fric_std=fr[3], dyn_mean=dyn[0], dyn_max_pct=dyn[2],
+                  dyn_std=dyn[3])
+    bench.section("001 Fig. 15: max |z error| (mm), PD vs PDFF")
+    for name, a, b in f15:
+        bench.row(payload=name, PD_mm=a, PDFF_mm=b)
+
+
 def main(argv=None) -> int:
     bench = Bench("cdpr", __doc__)
     bench.parser.add_argument("--samples", type=int, default=1_000_000)
     bench.parser.add_argument("--seconds", type=float, default=10.0, help="node tests length (10)")
     bench.parser.add_argument("--skip-nodes", action="store_true")
+    bench.parser.add_argument("--paper", action="store_true", help="001 Tables I-II, Fig. 15 instead")
     args = bench.parse(argv)
+    if args.paper:
+        paper_tables(bench)
+        bench.done()
+        return 0
     offline_estimation(bench, args.samples)
     offline_simulation(bench)
+    estimator_in_process(bench)
     if not args.skip_nodes:
         from cablelab.ros.launch import Launcher
 
