@@ -102,7 +102,7 @@ def cdpr_page(out: Path, bag: Path, pd_bag: Path | None, rows: list, report_inde
                       ("Model II, motor torques - friction", {"tensions": "motor", "effects":
                        ("winch_coulomb_friction", "winch_viscous_friction")})):
         e = estimate_bag(bag, kw.pop("description", None), **kw)
-        ax[0].plot(e.t, e.mass, lw=0.8, label=label)
+        ax[0].plot(e.t - 1.0, e.mass, lw=0.8, label=label)     # t = 0 at the end of the 1 s settle
     ax[0].axhline(TRUE_MASS, color="k", ls="--", lw=1, label="true 615 kg")
     ax[0].set_ylabel("estimated mass (kg)")
     ax[0].set_ylim(TRUE_MASS - 150, TRUE_MASS + 150)
