@@ -21,8 +21,9 @@ def run(args) -> int:
         return 0
     print(f"plant {out['plant']}, model {' + '.join(out['effects'])}, {out['samples']} samples")
     for ch, m in out["channels"].items():
+        pearson = "n/a" if m["pearson"] is None else f"{m['pearson']:.4f}"   # constant model output
         print(f"  {ch}: NRMSE {100 * m['nrmse']:.2f} %  fit {m['fit_percent']:.1f} %  pearson "
-              f"{m['pearson']:.4f}  MAE {m['mae']:.4g}  max {m['max_abs']:.4g}")
+              f"{pearson}  MAE {m['mae']:.4g}  max {m['max_abs']:.4g}")
     for name, v in out["params"].items():
         print(f"  {name:>12} = {v['value']:.6g} +- {v['stderr']:.2g} {v['unit']}")
     if "free_run" in out:
