@@ -39,7 +39,7 @@ def test_adapters_survive_bad_input(ros_context):
         assert sim.u is None and sim.inputs.inputs["effort_commands"].rejected == 3
         p0 = sim.sim.truth_pose()[0].copy()
         for _ in range(100):
-            sim.tick()
+            sim.step_once()
         assert np.linalg.norm(sim.sim.truth_pose()[0] - p0) < 0.02 and sim.fallbacks == 100
 
         ms, t = sim.sim.measure(), sim.sim.time

@@ -21,7 +21,8 @@ ROS parameters: ``description`` (YAML file or text; default CAROCA), ``payload_m
 ``publish_reference``, ``publish_pose``, ``trajectory_speed`` (time scale of the s-curve),
 ``settle`` (s held at A before the trajectory starts), ``duration`` (s of simulated time after
 which the node exits; 0 = run until stopped), ``command_timeout`` (s wall, real time),
-``lockstep_timeout`` (s wall, lock-step), ``seed``.
+``lockstep_timeout`` (s wall, lock-step), ``extras_every`` (publish /clock, the measured pose and
+the ground truth every k-th step: lighter at 1 kHz), ``seed``.
 """
 from __future__ import annotations
 
@@ -51,7 +52,7 @@ def _wxyz_to_xyzw(q):
 
 class CdprSimNode(Node):
     def __init__(self):
-        super().__init__("cable_sim_node")
+        super().__init__("cable_sim_node", start_parameter_services=False)  # smaller wait set
         p = self.declare_parameter
         self.description = load_description(p("description", "").value or _default_description())
         c = self.description.cdpr
@@ -81,6 +82,7 @@ class CdprSimNode(Node):
         self.speed = float(p("trajectory_speed", 1.0).value)
         self.settle = float(p("settle", 1.0).value)
         self.duration = float(p("duration", 0.0).value)
+        self.extras_every = max(1, int(p("extras_every", 1).value))
         self.command_timeout = float(p("command_timeout", 0.5).value)
         self.lockstep_timeout = float(p("lockstep_timeout", 2.0).value)
         if self.rate <= 0 or self.speed <= 0:
@@ -98,12 +100,14 @@ class CdprSimNode(Node):
         self.commands_at_pub = 0    # ... when the last state was published (lock-step)
         self.u_stamp = None         # stamp of the state the last command answers, if it says
         self.fallbacks = 0
+        self.fallbacks_running = 0  # ... after the first command (not the start-up wait)
         self.slack_steps = 0
         self.k = 0
         self.done = False
         self.inputs = InputMonitor()
         self.inputs.add("effort_commands", timeout=self.command_timeout, length=self.n)
         self._last_pub_wall = time.monotonic()
+        self._wall0 = None          # wall time of sim time 0 (real-time mode)
 
         q = stream_qos()
         self.pub_js = self.create_publisher(JointState, "/cdpr/joint_states", q)
@@ -126,6 +130,7 @@ class CdprSimNode(Node):
         st = self.sim.truth_state()
         slack = [str(i + 1) for i in np.flatnonzero(st["slack"])]
         values.update({"sim time s": f"{self.sim.time:.3f}", "brake (fallback) steps": str(self.fallbacks),
+                       "brake steps after the first command": str(self.fallbacks_running),
                        "slack cable steps": str(self.slack_steps), "mode": "real time" if self.real_time
                        else "as fast as possible (lock-step)"})
         if slack:
@@ -148,12 +153,38 @@ class CdprSimNode(Node):
 
     def reference(self, t: float):
         """Desired pose/twist/acceleration of the s-curve at sim time t (held at A while
-        settling, at A after the return)."""
-        tt = max(0.0, t - self.settle) * self.speed
-        tr = pick_and_place(np.array([tt]))
+        settling, at A after the return); tabulated once at the publishing rate."""
+        if getattr(self, "_ref_table", None) is None:
+            end = self.settle + 60.0 / self.speed + 1.0
+            grid = np.arange(int(end * self.rate) + 2) / self.rate
+            tt = np.maximum(0.0, grid - self.settle) * self.speed
+            tr = pick_and_place(tt)
+            self._ref_table = (tr.position, tr.velocity * self.speed, tr.acceleration * self.speed ** 2)
+        k = int(round(t * self.rate))
+        pos, vel, acc = self._ref_table
+        if k < len(pos) and abs(k / self.rate - t) < 1e-9:
+            return pos[k], vel[k], acc[k]
+        tr = pick_and_place(np.array([max(0.0, t - self.settle) * self.speed]))
         return tr.position[0], tr.velocity[0] * self.speed, tr.acceleration[0] * self.speed ** 2
 
     def tick(self) -> None:
+        """Timer: lock-step, one step when answered; real time, as many steps as the wall clock
+        says are due (catching up after a late timer, at most 20 at once)."""
+        if not self.real_time:
+            self.step_once()
+            return
+        now = time.monotonic()
+        if self._wall0 is None:
+            self._wall0 = now - self.k / self.rate
+        due = min(20, int((now - self._wall0) * self.rate) - self.k)
+        if due > 19:                                   # far behind: do not try to catch up forever
+            self._wall0 = now - self.k / self.rate
+        for _ in range(max(0, due)):
+            self.step_once()
+            if self.done:
+                return
+
+    def step_once(self) -> None:
         now = time.monotonic()
         if not self.real_time:
             if self.u_stamp is not None:      # the controller says which state it answers
@@ -167,6 +198,8 @@ class CdprSimNode(Node):
             for _ in range(self.nstep):        # brakes act continuously: every physics step
                 self.sim.step(self.brake(), 1)
             self.fallbacks += 1
+            if self.commands:
+                self.fallbacks_running += 1
         else:
             self.brake_q = None
             self.sim.step(self.u, self.nstep)
@@ -191,7 +224,9 @@ class CdprSimNode(Node):
         sim, t = self.sim, self.sim.time
         ms = sim.measure()
         tp, tq = sim.truth_pose()
-        self.pub_clock.publish(convert.clock_msg(t))
+        extra = self.k % self.extras_every == 0          # /clock, pose and truth: maybe decimated
+        if extra:
+            self.pub_clock.publish(convert.clock_msg(t))
         if self.publish_reference:
             pos, vel, acc = self.reference(t)
             self.pub_ref.publish(convert.multidof_msg(t, pos, [0.0, 0.0, 0.0, 1.0], vel, None, acc, None))
@@ -200,10 +235,11 @@ class CdprSimNode(Node):
                                                     ms["motor_torque"]))
         self.pub_ten.publish(convert.joint_state_msg(t, [f"cable_{i}" for i in range(1, self.n + 1)],
                                                      ms["cable_length"], None, ms["tension"]))
-        if self.publish_pose:
+        if self.publish_pose and extra:
             self.pub_pose.publish(convert.pose_msg(t, ms["position"], _wxyz_to_xyzw(ms["quat"])))
-        self.pub_tpose.publish(convert.pose_msg(t, tp, _wxyz_to_xyzw(tq)))
-        self.pub_tpay.publish(convert.inertia_msg(t, sim.truth.total_mass, sim.truth.total_com))
+        if extra:
+            self.pub_tpose.publish(convert.pose_msg(t, tp, _wxyz_to_xyzw(tq)))
+            self.pub_tpay.publish(convert.inertia_msg(t, sim.truth.total_mass, sim.truth.total_com))
         self._last_pub_wall = time.monotonic()
         self.commands_at_pub = self.commands
 

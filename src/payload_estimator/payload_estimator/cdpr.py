@@ -36,7 +36,7 @@ from cablelab.ros.qos import DESCRIPTION_QOS, stream_qos
 
 class CdprPayloadEstimator(Node):
     def __init__(self):
-        super().__init__("payload_estimator")
+        super().__init__("payload_estimator", start_parameter_services=False)  # smaller wait set
         p = self.declare_parameter
         r = float(p("pulley_radius", 0.0).value)
         self.config = EstimatorConfig(

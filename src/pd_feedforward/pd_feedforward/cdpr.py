@@ -38,7 +38,7 @@ from cablelab.ros.qos import DESCRIPTION_QOS, stream_qos
 
 class CdprController(Node):
     def __init__(self):
-        super().__init__("pd_feedforward")
+        super().__init__("pd_feedforward", start_parameter_services=False)  # smaller wait set
         p = self.declare_parameter
         d = PdffConfig()
         self.gains = PdffConfig(kp=float(p("kp", d.kp).value), kd=float(p("kd", d.kd).value),
