@@ -120,7 +120,8 @@ def test_closed_loop_over_dds(launcher, tmp_path):
     launcher.node("controller", "pd_feedforward", "cdpr", {})
     launcher.wait_for_topics({"/diagnostics": 2}, timeout=60)
     launcher.node("sim", "cable_sim_node", "cdpr", {"real_time": False, "payload_mass": 249.0,
-                                                    "duration": 8.0, "settle": 1.0})
+                                                    "duration": 8.0, "settle": 1.0,
+                                                    "wait_for_subscribers": 3})
     deadline = time.monotonic() + 240
     while launcher.procs["sim"].alive() and time.monotonic() < deadline:
         time.sleep(0.5)

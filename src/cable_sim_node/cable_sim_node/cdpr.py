@@ -22,7 +22,8 @@ ROS parameters: ``description`` (YAML file or text; default CAROCA), ``payload_m
 ``settle`` (s held at A before the trajectory starts), ``duration`` (s of simulated time after
 which the node exits; 0 = run until stopped), ``command_timeout`` (s wall, real time),
 ``lockstep_timeout`` (s wall, lock-step), ``extras_every`` (publish /clock, the measured pose and
-the ground truth every k-th step: lighter at 1 kHz), ``seed``.
+the ground truth every k-th step: lighter at 1 kHz), ``wait_for_subscribers`` (time starts only
+once /cdpr/joint_states has this many subscribers, max 60 s: no sample lost to discovery), ``seed``.
 """
 from __future__ import annotations
 
@@ -83,6 +84,8 @@ class CdprSimNode(Node):
         self.settle = float(p("settle", 1.0).value)
         self.duration = float(p("duration", 0.0).value)
         self.extras_every = max(1, int(p("extras_every", 1).value))
+        self.wait_subs = int(p("wait_for_subscribers", 0).value)
+        self._created = time.monotonic()
         self.command_timeout = float(p("command_timeout", 0.5).value)
         self.lockstep_timeout = float(p("lockstep_timeout", 2.0).value)
         if self.rate <= 0 or self.speed <= 0:
@@ -170,6 +173,15 @@ class CdprSimNode(Node):
     def tick(self) -> None:
         """Timer: lock-step, one step when answered; real time, as many steps as the wall clock
         says are due (catching up after a late timer, at most 20 at once)."""
+        if self.k == 0 and self.wait_subs:
+            # before time starts: wait (max 60 s) for the expected subscribers of the state topics
+            now = time.monotonic()
+            if self.pub_js.get_subscription_count() < self.wait_subs and now - self._created < 60.0:
+                if now - self._last_pub_wall > 0.5:
+                    self.publish_state()          # the initial state again, for late joiners
+                return
+            self.wait_subs = 0
+            self.publish_state()
         if not self.real_time:
             self.step_once()
             return

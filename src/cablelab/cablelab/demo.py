@@ -51,7 +51,8 @@ def run_nodes(out: Path, name: str, feedforward: bool, duration: float, domain: 
         launch.wait_for_topics({"/diagnostics": 2}, timeout=90)
         time.sleep(1.0)
         launch.node("sim", "cable_sim_node", "cdpr", {"real_time": False, "payload_mass": PAYLOAD,
-                                                      "duration": duration, "settle": 1.0})
+                                                      "duration": duration, "settle": 1.0,
+                                                      "wait_for_subscribers": 3})
         t0 = time.monotonic()
         last = 0.0
         while launch.procs["sim"].alive():
