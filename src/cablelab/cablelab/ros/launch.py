@@ -76,6 +76,7 @@ class Launcher:
         self.log_dir.mkdir(parents=True, exist_ok=True)
         self.env = ros_env(self.domain_id, env)
         self.procs: dict[str, Process] = {}
+        self._probe: Probe | None = None
 
     def __enter__(self) -> "Launcher":
         return self
@@ -128,8 +129,12 @@ class Launcher:
         return proc.wait(10)
 
     def stop_all(self, grace: float = 15.0) -> dict[str, int | None]:
-        """Stop every process, most recently started first."""
-        return {name: self.stop(name, grace) for name in reversed(list(self.procs))}
+        """Stop every process, most recently started first, and close the probe."""
+        codes = {name: self.stop(name, grace) for name in reversed(list(self.procs))}
+        if self._probe is not None:
+            self._probe.close()
+            self._probe = None
+        return codes
 
     def check_alive(self) -> None:
         """CablelabError naming a process that failed (exit code != 0), with the end of its log."""
@@ -138,82 +143,90 @@ class Launcher:
                 tail = " | ".join(proc.log().strip().splitlines()[-5:])
                 raise CablelabError(f"process {proc.name} exited with {proc.popen.returncode}: {tail}")
 
+    def probe(self) -> "Probe":
+        """This launcher's in-process graph probe (one DDS participant on the domain, kept until
+        :meth:`stop_all`: creating and destroying participants next to starting nodes slows
+        discovery on a busy machine)."""
+        if self._probe is None:
+            self._probe = Probe(self.domain_id)
+        return self._probe
+
     def wait_for_topics(self, counts: dict[str, int], timeout: float = 60.0) -> dict[str, int]:
         """Subscribe (in this process, on this domain) and wait until every topic delivered its
         count of messages. Raises CablelabError naming the silent topics on timeout (or a dead
         process). Returns the counts seen."""
-        return wait_for_topics(counts, self.domain_id, timeout, self.check_alive)
+        return self.probe().wait_for_topics(counts, timeout, self.check_alive)
 
     def wait_for_subscribers(self, topics, timeout: float = 60.0, node_name: str | None = None) -> None:
         """Wait until every topic has a subscription in the graph (of the node ``node_name`` if
         given), e.g. until a recorder that is still importing is ready before the publishers
         start. Raises CablelabError naming the topics on timeout (or a dead process)."""
-        wait_for_subscribers(list(topics), self.domain_id, timeout, node_name, self.check_alive)
+        self.probe().wait_for_subscribers(list(topics), timeout, node_name, self.check_alive)
 
 
-def wait_for_subscribers(topics: list[str], domain_id: int, timeout: float = 60.0,
-                         node_name: str | None = None, check=None) -> None:
-    """See :meth:`Launcher.wait_for_subscribers`."""
-    import rclpy
-    from rclpy.context import Context
-    from rclpy.node import Node
+class Probe:
+    """An rclpy node in its own context on ``domain_id``, for watching the graph and topics."""
 
-    ctx = Context()
-    rclpy.init(context=ctx, domain_id=domain_id)
-    node = None
-    try:
-        node = Node("cablelab_graph_probe", context=ctx)
+    def __init__(self, domain_id: int):
+        import rclpy
+        from rclpy.context import Context
+        from rclpy.executors import SingleThreadedExecutor
+        from rclpy.node import Node
+
+        self.domain_id = domain_id
+        self.ctx = Context()
+        rclpy.init(context=self.ctx, domain_id=domain_id)
+        self.node = Node("cablelab_probe", context=self.ctx)
+        self.executor = SingleThreadedExecutor(context=self.ctx)
+        self.executor.add_node(self.node)
+
+    def close(self) -> None:
+        import rclpy
+
+        try:
+            self.node.destroy_node()
+        finally:
+            rclpy.try_shutdown(context=self.ctx)
+
+    def wait_for_subscribers(self, topics: list[str], timeout: float = 60.0,
+                             node_name: str | None = None, check=None) -> None:
         deadline = time.monotonic() + timeout
+        missing = list(topics)
         while time.monotonic() < deadline:
-            missing = []
-            for topic in topics:
-                infos = node.get_subscriptions_info_by_topic(topic)
-                if not any(node_name is None or i.node_name == node_name for i in infos):
-                    missing.append(topic)
+            missing = [t for t in topics if not any(
+                node_name is None or i.node_name == node_name
+                for i in self.node.get_subscriptions_info_by_topic(t))]
             if not missing:
                 return
             if check is not None:
                 check()
-            time.sleep(0.1)
+            self.executor.spin_once(timeout_sec=0.1)
         raise CablelabError(f"timeout after {timeout:g} s waiting for subscribers on {missing} "
-                            f"(domain {domain_id})")
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown(context=ctx)
+                            f"(domain {self.domain_id})")
 
+    def wait_for_topics(self, counts: dict[str, int], timeout: float = 60.0,
+                        check=None) -> dict[str, int]:
+        """Subscribe and wait until every topic delivered its count of messages (types from the
+        graph; QoS chosen from the publishers: transient-local if they all are, else best
+        effort, which matches reliable and best-effort publishers alike)."""
+        from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
-def wait_for_topics(counts: dict[str, int], domain_id: int, timeout: float = 60.0,
-                    check=None) -> dict[str, int]:
-    """See :meth:`Launcher.wait_for_topics`; the topic types are discovered from the graph."""
-    import rclpy
-    from rclpy.context import Context
-    from rclpy.executors import SingleThreadedExecutor
-    from rclpy.node import Node
+        from .convert import message_class
+        from .qos import DESCRIPTION_QOS
 
-    from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
-
-    from .convert import message_class
-    from .qos import DESCRIPTION_QOS
-
-    # best effort matches reliable and best-effort publishers alike (counting only)
-    probe_qos = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=100,
-                           reliability=ReliabilityPolicy.BEST_EFFORT)
-
-    ctx = Context()
-    rclpy.init(context=ctx, domain_id=domain_id)
-    seen = {t: 0 for t in counts}
-    try:
-        node = Node("cablelab_probe", context=ctx)
-        ex = SingleThreadedExecutor(context=ctx)
-        ex.add_node(node)
+        probe_qos = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=100,
+                               reliability=ReliabilityPolicy.BEST_EFFORT)
+        node = self.node
+        seen = {t: 0 for t in counts}
         subs = {}
-        deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline:
-            if len(subs) < len(counts):
-                types = dict(node.get_topic_names_and_types())
-                for topic in counts:
-                    if topic not in subs and topic in types:
+        try:
+            deadline = time.monotonic() + timeout
+            while time.monotonic() < deadline:
+                if len(subs) < len(counts):
+                    types = dict(node.get_topic_names_and_types())
+                    for topic in counts:
+                        if topic in subs or topic not in types:
+                            continue
                         infos = node.get_publishers_info_by_topic(topic)
                         if not infos:
                             continue  # only subscribers so far: choose the QoS once publishers exist
@@ -221,21 +234,28 @@ def wait_for_topics(counts: dict[str, int], domain_id: int, timeout: float = 60.
 
                         def cb(_msg, topic=topic):
                             seen[topic] += 1
-                        latched = all(
-                            i.qos_profile.durability == DurabilityPolicy.TRANSIENT_LOCAL for i in infos)
+                        latched = all(i.qos_profile.durability == DurabilityPolicy.TRANSIENT_LOCAL
+                                      for i in infos)
                         qos = DESCRIPTION_QOS if latched else probe_qos
                         subs[topic] = node.create_subscription(cls, topic, cb, qos, raw=True)
-            ex.spin_once(timeout_sec=0.05)
-            if all(seen[t] >= n for t, n in counts.items()):
-                return seen
-            if check is not None:
-                check()
-        silent = [t for t, n in counts.items() if seen[t] < n]
-        raise CablelabError(f"timeout after {timeout:g} s waiting for topics {silent} "
-                            f"(domain {domain_id}, seen {seen})")
+                self.executor.spin_once(timeout_sec=0.05)
+                if all(seen[t] >= n for t, n in counts.items()):
+                    return seen
+                if check is not None:
+                    check()
+            silent = [t for t, n in counts.items() if seen[t] < n]
+            raise CablelabError(f"timeout after {timeout:g} s waiting for topics {silent} "
+                                f"(domain {self.domain_id}, seen {seen})")
+        finally:
+            for sub in subs.values():
+                node.destroy_subscription(sub)
+
+
+def wait_for_topics(counts: dict[str, int], domain_id: int, timeout: float = 60.0,
+                    check=None) -> dict[str, int]:
+    """One-off :meth:`Probe.wait_for_topics` (own participant, closed afterwards)."""
+    probe = Probe(domain_id)
+    try:
+        return probe.wait_for_topics(counts, timeout, check)
     finally:
-        try:
-            node.destroy_node()
-        except Exception:  # noqa: BLE001 - node may not exist if init failed
-            pass
-        rclpy.try_shutdown(context=ctx)
+        probe.close()

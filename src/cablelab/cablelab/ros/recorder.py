@@ -33,6 +33,9 @@ class RecorderNode(Node):
         super().__init__("cablelab_recorder")
         writer = output if isinstance(output, BagWriter) else BagWriter(output, overwrite=overwrite)
         self.writer = writer.open()
+        from ..cdr import typestore
+
+        typestore()  # build the message definitions now, not in the first callback
         self.wanted = dict(topics)
         self.subs = {}
         self.sub_qos: dict[str, tuple[bool, bool]] = {}  # topic -> (reliable, transient_local)
@@ -111,6 +114,19 @@ class RecorderNode(Node):
                 self._subscribe(topic, found[0])
             if topic in self.subs and found:
                 self._adapt_qos(topic, found[0])
+
+    def drain(self, executor, quiet_time: float = 0.2, limit: float = 1.0) -> None:
+        """After a stop request: keep taking messages DDS already delivered until none arrived
+        for ``quiet_time`` s (at most ``limit`` s), so a stop loses nothing that was received."""
+        t_end = time.monotonic() + limit
+        last_total, last_change = -1, time.monotonic()
+        while time.monotonic() < t_end:
+            executor.spin_once(timeout_sec=0.05)
+            total = sum(self.counts.values())
+            if total != last_total:
+                last_total, last_change = total, time.monotonic()
+            elif time.monotonic() - last_change > quiet_time:
+                break
 
     def _flush(self) -> None:
         if not self.closed:

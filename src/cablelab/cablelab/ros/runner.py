@@ -6,7 +6,8 @@
 :func:`run_node`. ``--help`` never needs ROS. Standard ROS arguments (``--ros-args -p name:=value
 --params-file f.yaml -r from:=to``) pass through to rclpy.
 
-Shutdown: SIGINT and SIGTERM stop the spin loop; the node's ``shutdown()`` method (if any) runs
+Shutdown: SIGINT and SIGTERM stop the spin loop; the node's ``drain(executor)`` method (if any)
+processes what is already queued, its ``shutdown()`` method (if any) runs
 (e.g. the recorder closes its bag), then the node is destroyed and rclpy shut down; exit code 0.
 A :class:`~cablelab.errors.CablelabError` while building the node prints one line, exit 2.
 """
@@ -70,6 +71,9 @@ def run_node(node_factory, args, ros_args: list[str], prog: str) -> int:
         executor.add_node(node)
         while not stop.event.is_set() and rclpy.ok() and not getattr(node, "done", False):
             executor.spin_once(timeout_sec=0.1)
+        drain = getattr(node, "drain", None)
+        if callable(drain) and rclpy.ok():
+            drain(executor)  # e.g. the recorder takes what DDS already delivered
         code = int(getattr(node, "exit_code", 0) or 0)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
