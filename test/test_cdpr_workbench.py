@@ -35,8 +35,8 @@ def bags(tmp_path_factory):
     # Coulomb friction only (viscous 0), analysed from motor torques
     make("coulomb", CdprTruth(payload_mass=M2, winch_viscous=0.0, seed=3))
     # strong accelerations: the test trajectory three times faster
-    from cablelab.sim.cdpr import _reference
-    make("fast", CdprTruth(payload_mass=M2, seed=4), reference=_reference(60.0, 100.0, 3.0))
+    from cablelab.sim.cdpr import scaled_reference
+    make("fast", CdprTruth(payload_mass=M2, seed=4), reference=scaled_reference(60.0, 100.0, 3.0))
     return out
 
 

@@ -44,7 +44,7 @@ from cablelab.ros import convert
 from cablelab.ros.diagnostics import Diagnostics
 from cablelab.ros.inputs import WARN, InputMonitor
 from cablelab.ros.qos import DESCRIPTION_QOS, stream_qos
-from cablelab.sim.cdpr import CdprSim, CdprTruth, _default_description
+from cablelab.sim.cdpr import CdprSim, CdprTruth, default_description_path
 
 
 def _wxyz_to_xyzw(q):
@@ -55,7 +55,7 @@ class CdprSimNode(Node):
     def __init__(self):
         super().__init__("cable_sim_node", start_parameter_services=False)  # smaller wait set
         p = self.declare_parameter
-        self.description = load_description(p("description", "").value or _default_description())
+        self.description = load_description(p("description", "").value or default_description_path())
         c = self.description.cdpr
         if c is None:
             raise CablelabError("cable_sim_node --plant cdpr: the description has no cdpr section")

@@ -20,7 +20,7 @@ import numpy as np
 from ..errors import CablelabError
 from ..model import Dataset
 from . import Plant, register_plant
-from .cdpr_estimation import mass_com, mass_com_batch, tensions_from_torques
+from .cdpr_estimation import mass_com, mass_com_batch
 from .cdpr_geometry import cable_geometry, quat_to_matrix, wrench_matrix
 
 JOINT_STATE = "sensor_msgs/msg/JointState"

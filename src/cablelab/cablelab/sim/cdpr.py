@@ -32,7 +32,8 @@ from ..errors import CablelabError
 from ..plants.cdpr_geometry import cable_geometry, swivel_reference
 
 __all__ = ["CdprTruth", "CdprSim", "CdprRun", "build_model_xml", "simulate", "write_run_bag", "PAYLOADS",
-           "default_description", "without_pulley_radius"]
+           "default_description", "default_description_path", "scaled_reference",
+           "without_pulley_radius"]
 
 #: 001 sec. II-C: the empty platform and the two payloads M1, M2 (kg)
 PAYLOADS = {"MP": 0.0, "MP+M1": 122.0, "MP+M2": 249.0}
@@ -491,7 +492,7 @@ def main(argv=None) -> int:
     p.add_argument("--every", type=int, default=1, help="write every k-th sample (smaller bags)")
     a = p.parse_args(argv)
     try:
-        desc = load_description(a.description or _default_description())
+        desc = load_description(a.description or default_description_path())
         kw = {"payload_mass": a.payload, "pulleys": not a.no_pulleys, "seed": a.seed}
         if a.coulomb is not None:
             kw["winch_coulomb"] = a.coulomb
@@ -501,7 +502,7 @@ def main(argv=None) -> int:
             kw["tension_bias"] = tuple(a.bias)
         t0 = _time.monotonic()
         run = simulate(desc, CdprTruth(**kw), controller=a.controller, duration=a.duration / a.speed,
-                       rate=a.rate, reference=_reference(a.duration, a.rate, a.speed),
+                       rate=a.rate, reference=scaled_reference(a.duration, a.rate, a.speed),
                        progress=lambda f, el: print(f"sim: {100 * f:3.0f} %  ETA {el / max(f, 1e-9) - el:5.1f} s",
                                                     file=sys.stderr))
         if a.strip_pulley_radius:
@@ -515,7 +516,7 @@ def main(argv=None) -> int:
     return 0
 
 
-def _default_description() -> str:
+def default_description_path() -> str:
     import os
 
     return os.path.join(os.path.dirname(os.path.dirname(__file__)), "data", "caroca.yaml")
@@ -525,15 +526,16 @@ def default_description() -> Description:
     """The shipped CAROCA description (``cablelab/data/caroca.yaml``)."""
     from ..description import load_description
 
-    return load_description(_default_description())
+    return load_description(default_description_path())
 
 
-def _reference(duration: float, rate: float, speed: float):
-    from ..plants.cdpr_trajectory import pick_and_place
+def scaled_reference(duration: float, rate: float, speed: float):
+    """The 001 test trajectory played ``speed`` times faster (velocities x speed, accelerations
+    x speed^2), ``duration / speed`` s sampled at ``rate`` Hz (the strong-accelerations bags)."""
+    from ..plants.cdpr_trajectory import Trajectory, pick_and_place
 
     t = np.arange(int(round(duration / speed * rate)) + 1) / rate
     tr = pick_and_place(t * speed)
-    from ..plants.cdpr_trajectory import Trajectory
     return Trajectory(t, tr.position, tr.velocity * speed, tr.acceleration * speed ** 2)
 
 
