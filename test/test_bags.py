@@ -1,11 +1,6 @@
 """Bag round trips checked against rosbags' reference (de)serialiser, and bad-bag errors."""
 from __future__ import annotations
 
-import os
-import shutil
-import subprocess
-import sys
-
 import numpy as np
 import pytest
 
