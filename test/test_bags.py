@@ -426,3 +426,21 @@ def test_sqlite3_bag_is_read_too(tmp_path):
     bag = open_bag(tmp_path / "db")
     np.testing.assert_array_equal(bag.joint_state("/js").position[:, 0], np.arange(50.0))
     assert bag.description.plant == "axis"
+
+
+def test_contract_type_mismatch_is_named(tmp_path, capsys):
+    from cablelab.cli import main
+
+    t = np.arange(5) * 0.1
+    with BagWriter(tmp_path / "b") as w:
+        w.write_float_arrays("/cdpr/joint_states", t, np.zeros((5, 8)))  # wrong type
+        w.write_joint_states("/cdpr/cable_tensions", t, ["cable_1"], effort=np.ones((5, 1)))
+    bag = open_bag(tmp_path / "b")
+    assert bag.contract_mismatches() == [("/cdpr/joint_states", "std_msgs/msg/Float64MultiArray",
+                                          "sensor_msgs/msg/JointState")]
+    with pytest.raises(CablelabError) as e:
+        bag.check_contract()
+    msg = _one_line(e)
+    assert "/cdpr/joint_states" in msg and "Float64MultiArray" in msg and "JointState" in msg
+    assert main(["info", str(tmp_path / "b")]) == 0
+    assert "warning:  /cdpr/joint_states has type" in capsys.readouterr().out

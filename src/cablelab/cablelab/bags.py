@@ -238,6 +238,26 @@ class Bag:
             raise CablelabError(f"{self.path}: topic {topic} has type {self.topics[topic]}, "
                                 f"expected {msgtype}")
 
+    def contract_mismatches(self) -> list[tuple[str, str, str]]:
+        """(topic, type in the bag, contract type) of every contract topic (CONTRACT section 2,
+        :mod:`cablelab.topics`) recorded with another type."""
+        from .topics import COMMON, PLANT_TOPICS
+
+        contract = dict(COMMON)
+        for table in PLANT_TOPICS.values():
+            contract.update(table)
+        return [(t, have, contract[t]) for t, have in sorted(self.topics.items())
+                if t in contract and have != contract[t]]
+
+    def check_contract(self) -> None:
+        """CablelabError naming the first contract topic recorded with another type (both types)."""
+        bad = self.contract_mismatches()
+        if bad:
+            topic, have, want = bad[0]
+            more = f" (and {len(bad) - 1} more)" if len(bad) > 1 else ""
+            raise CablelabError(f"{self.path}: topic {topic} has type {have}, the contract says "
+                                f"{want}{more}")
+
     def raw(self, topic: str) -> tuple[np.ndarray, list[bytes]]:
         """(log times in ns (N,), serialised CDR messages) of a topic, sorted by log time."""
         if topic not in self.topics:
@@ -550,6 +570,8 @@ def bag_info(path, *, recover: bool = False) -> dict:
     }
     if bag.recovered:
         info["recovered"] = True
+    info["contract_mismatches"] = [{"topic": t, "type": have, "contract_type": want}
+                                   for t, have, want in bag.contract_mismatches()]
     return info
 
 
