@@ -128,3 +128,43 @@ def test_closed_loop_pd_vs_pdff_fig15(desc):
         assert not run.slack.any()
     assert err["pdff"] < 0.005
     assert err["pd"] > 3 * err["pdff"] and err["pd"] > 0.012
+
+
+def test_any_geometry_tilted_swivels(desc):
+    """Another robot: CAROCA's layout at half scale, sheaves of 0.05 m on swivel axes tilted by
+    ~10 deg. The MuJoCo tendons equal the Model II hand formula once each sheave is turned to its
+    geometric swivel angle, and the cable tension aligns the free swivels (to 0.02 rad from 0.15 rad off:
+    on a tilted axis the sheave's own weight pulls it slightly downhill, as on a real pulley)."""
+    from cablelab.description import load_description
+    rng = np.random.default_rng(5)
+    lines = ["plant: cdpr", "cdpr:", "  drum_radius: 0.03", "  gear_ratio: 10", "  pulley_radius: 0.05",
+             "  platform_mass: 200", "  cables:"]
+    for cab in desc.cdpr.cables:
+        ax = np.array([0.15 * rng.standard_normal(), 0.15 * rng.standard_normal(), 1.0])
+        ax /= np.linalg.norm(ax)
+        A, B = 0.5 * cab.exit_point, 0.5 * cab.anchor_point
+        lines.append(f"    - {{exit_point: [{A[0]}, {A[1]}, {A[2]}], anchor_point: [{B[0]}, {B[1]}, {B[2]}], "
+                     f"swivel_axis: [{ax[0]:.4f}, {ax[1]:.4f}, {ax[2]:.4f}]}}")
+    small = load_description("\n".join(lines) + "\n")
+    c = small.cdpr
+    p = np.array([0.1, -0.05, 0.5])
+    sim = CdprSim(small, CdprTruth(winch_coulomb=0.0, winch_viscous=0.0, platform_mass=200.0), p)
+    run = sim.cable_total - sim.measure()["cable_length"]
+    for q in ([0.2, 0.1, 0.4], [-0.3, 0.1, 0.6]):
+        g = cable_geometry(c.exit_points, c.anchor_points, np.array(q), None, 0.05, c.swivel_axes)
+        sim.data.qpos[sim._free_q:sim._free_q + 3] = q
+        sim.data.qpos[sim._swivel_q] = g.swivel_angles[0]
+        mujoco.mj_forward(sim.model, sim.data)
+        np.testing.assert_allclose(sim.data.ten_length - run, g.lengths[0], atol=5e-5)
+    # free swivels align under tension (the platform held by the feedforward torques)
+    sim.reset(p)
+    sim.data.qpos[sim._swivel_q] += 0.15
+    from cablelab.plants.cdpr_control import feedforward_tensions
+    g = cable_geometry(c.exit_points, c.anchor_points, p, None, 0.05, c.swivel_axes)
+    t_ff = feedforward_tensions(g, 200.0, np.zeros(3), preload=300.0)[0]
+    assert t_ff.min() > 10.0
+    _hold(sim, p, 3.0, t_ff * c.drum_radius / c.gear_ratio)
+    st = sim.truth_state()
+    assert np.linalg.norm(st["position"] - p) < 0.02 and not st["slack"].any()
+    g = cable_geometry(c.exit_points, c.anchor_points, st["position"], None, 0.05, c.swivel_axes)
+    np.testing.assert_allclose(st["swivel"], g.swivel_angles[0], atol=0.02)   # from 0.15 rad off
