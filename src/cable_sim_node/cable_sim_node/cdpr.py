@@ -87,7 +87,7 @@ class CdprSimNode(Node):
         self.wait_subs = int(p("wait_for_subscribers", 0).value)
         self._created = time.monotonic()
         self.command_timeout = float(p("command_timeout", 0.5).value)
-        self.lockstep_timeout = float(p("lockstep_timeout", 2.0).value)
+        self.lockstep_timeout = float(p("lockstep_timeout", 10.0).value)
         if self.rate <= 0 or self.speed <= 0:
             raise CablelabError("cable_sim_node: parameters rate and trajectory_speed must be > 0")
         start = pick_and_place(np.array([0.0])).position[0]
@@ -107,6 +107,12 @@ class CdprSimNode(Node):
         self.slack_steps = 0
         self.k = 0
         self.done = False
+        # the robot is switched on hanging on its locked winch brakes at A: settle that first, so
+        # the first published state already carries the load (sim time restarts at 0)
+        for _ in range(int(round(0.5 / self.sim.truth.timestep))):
+            self.sim.step(self.brake(), 1)
+        self.sim.data.time = 0.0
+        self.brake_q = None
         self.inputs = InputMonitor()
         self.inputs.add("effort_commands", timeout=self.command_timeout, length=self.n)
         self._last_pub_wall = time.monotonic()
@@ -205,7 +211,9 @@ class CdprSimNode(Node):
                 answered = self.commands > self.commands_at_pub
             if not answered and now - self._last_pub_wall < self.lockstep_timeout:
                 return                                  # lock-step: wait for the controller
-        fresh = self.u is not None and self.inputs.fresh("effort_commands", now)
+            fresh = answered and self.u is not None     # an answer is fresh however late it came
+        else:
+            fresh = self.u is not None and self.inputs.fresh("effort_commands", now)
         if not fresh:
             for _ in range(self.nstep):        # brakes act continuously: every physics step
                 self.sim.step(self.brake(), 1)

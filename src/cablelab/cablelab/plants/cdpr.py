@@ -111,7 +111,10 @@ def load_arrays(bag, description, tensions: str = "dynamometer", pose: str = "de
     if ok.sum() < 2:
         raise CablelabError(f"{bag.path}: {what} has no complete samples of {n} cables")
     t, tens = t[ok], tens[ok]
+    t, first = np.unique(t, return_index=True)       # sorted, repeated stamps dropped
+    tens = tens[first]
     jok = _finite_rows(js.t, js.position)
+    jok &= np.r_[True, np.diff(js.t) > 0] if len(js.t) else jok     # repeated stamps
     qd = js.velocity
     if not np.isfinite(qd[jok]).all():          # empty velocity: derive from the angles
         qd = np.gradient(js.position[jok], js.t[jok], axis=0)
