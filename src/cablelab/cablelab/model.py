@@ -29,6 +29,8 @@ import numpy as np
 
 from .errors import CablelabError
 
+#: gravity of a dataset without a description, m/s^2
+STANDARD_GRAVITY = 9.81
 
 @dataclass(frozen=True)
 class Param:
@@ -133,6 +135,11 @@ class Dataset:
     def fs(self) -> float:
         """Sample rate, Hz."""
         return 1.0 / self.dt
+
+    @property
+    def gravity(self) -> float:
+        """Gravity g, m/s^2: the description's, else the standard 9.81."""
+        return float(getattr(self.description, "gravity", STANDARD_GRAVITY))
 
     # ------------------------------------------------------------------ helpers for effects
     def actuator_block(self, per_actuator: np.ndarray) -> np.ndarray:

@@ -17,8 +17,7 @@ def _inertia(ds: Dataset) -> np.ndarray:
 
 
 def _gravity(ds: Dataset) -> np.ndarray:
-    g = getattr(ds.description, "gravity", 9.81) if ds.description is not None else 9.81
-    return (g * np.sin(ds.require_signal("q"))).reshape(ds.n, 1, 1)
+    return (ds.gravity * np.sin(ds.require_signal("q"))).reshape(ds.n, 1, 1)
 
 
 AXIS_INERTIA = register(Effect(

@@ -22,14 +22,14 @@ import numpy as np
 from ..model import Dataset, Effect, Param
 from ..plants.cdpr_geometry import cross
 from . import register
-from .friction import coulomb_sign
+from .friction import coulomb_regressor, viscous_regressor
 
 #: search range of the sheave radius r_p, m
 PULLEY_BOUNDS = (0.0, 0.4)
 
 
 def _gravity(ds: Dataset) -> np.ndarray:
-    g = ds.description.gravity if ds.description is not None else 9.81
+    g = ds.gravity
     n = ds.n
     up = np.zeros((n, 3))
     up[:, 2] = g
@@ -54,14 +54,6 @@ def _pulley(ds: Dataset) -> np.ndarray:
     # W_I t = w_model - r_p S t with S = (W(r_ref) - W(0)) / r_ref (the dataset's "pulley_slope"):
     # exact at r_p = r_ref, second order in (r_p - r_ref) elsewhere
     return -ds.require_signal("pulley_slope")[:, :, None]
-
-
-def _coulomb(ds: Dataset) -> np.ndarray:
-    return ds.actuator_block(coulomb_sign(ds.require_actuators("winch_coulomb_friction")))
-
-
-def _viscous(ds: Dataset) -> np.ndarray:
-    return ds.actuator_block(ds.require_actuators("winch_viscous_friction"))
 
 
 def _tension_offset(ds: Dataset) -> np.ndarray:
@@ -108,7 +100,7 @@ WINCH_COULOMB_FRICTION = register(Effect(
     explanation="a constant motor torque is lost to dry friction, changing sign with the winch",
     signature="mass estimate from motor torques jumps when winches reverse",
     reference="001 eq. 15, Table II",
-    regressor=_coulomb,
+    regressor=coulomb_regressor("winch_coulomb_friction"),
     per_actuator=True,
 ))
 
@@ -119,7 +111,7 @@ WINCH_VISCOUS_FRICTION = register(Effect(
     explanation="motor torque lost in proportion to the winch speed",
     signature="mass estimate from motor torques drifts with the cable speeds",
     reference="001 eq. 15",
-    regressor=_viscous,
+    regressor=viscous_regressor("winch_viscous_friction"),
     per_actuator=True,
 ))
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..model import Dataset, Effect, Param
+from ..model import Effect, Param, RegressorFn
 from . import register
 
 #: velocities below this magnitude (in the actuator's unit/s) count as "at rest" for sign(v):
@@ -25,12 +25,17 @@ def coulomb_sign(v: np.ndarray, deadband: float = COULOMB_DEADBAND) -> np.ndarra
     return s
 
 
-def _viscous(ds: Dataset) -> np.ndarray:
-    return ds.actuator_block(ds.require_actuators("joint_viscous_friction"))
+def viscous_regressor(effect_id: str) -> RegressorFn:
+    """Regressor of a viscous friction effect: ``ds -> (N, C, n_act)`` block of the actuator
+    velocities ``v_j`` (rad/s or m/s) through the actuator -> channel map (001 eq. 15, F_v term).
+    ``effect_id`` names the effect in the error raised when the plant has no actuator velocities."""
+    return lambda ds: ds.actuator_block(ds.require_actuators(effect_id))
 
 
-def _coulomb(ds: Dataset) -> np.ndarray:
-    return ds.actuator_block(coulomb_sign(ds.require_actuators("joint_coulomb_friction")))
+def coulomb_regressor(effect_id: str) -> RegressorFn:
+    """Regressor of a Coulomb friction effect: ``ds -> (N, C, n_act)`` block of
+    :func:`coulomb_sign` of the actuator velocities (001 eq. 15, F_c term)."""
+    return lambda ds: ds.actuator_block(coulomb_sign(ds.require_actuators(effect_id)))
 
 
 JOINT_VISCOUS_FRICTION = register(Effect(
@@ -40,7 +45,7 @@ JOINT_VISCOUS_FRICTION = register(Effect(
     explanation="a force opposing motion in proportion to the actuator velocity",
     signature="residual grows in proportion to velocity",
     reference="001 eq. 15; 002 sec. 3",
-    regressor=_viscous,
+    regressor=viscous_regressor("joint_viscous_friction"),
     per_actuator=True,
 ))
 
@@ -51,6 +56,6 @@ JOINT_COULOMB_FRICTION = register(Effect(
     explanation="a constant force opposing motion, changing sign with the velocity",
     signature="residual jumps at velocity reversals",
     reference="001 eq. 15; EMPS reference model",
-    regressor=_coulomb,
+    regressor=coulomb_regressor("joint_coulomb_friction"),
     per_actuator=True,
 ))
