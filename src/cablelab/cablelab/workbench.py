@@ -130,7 +130,7 @@ def identify(ds: Dataset, model: Model, *, folds: int = FOLDS, simulation: str |
         plant = _plant_of(ds)
         if plant is None or plant.simulation_fit is None:
             raise CablelabError(f"plant {ds.plant} offers no simulation-based fit")
-        sf = plant.simulation_fit(ds, ident.params, simulation, progress=not quiet)
+        sf = plant.simulation_fit(ds, ident.params, objective=simulation, progress=not quiet)
         out["simulation"] = {"objective": sf.objective, "nmse": sf.nmse, "pearson": sf.pearson,
                              "iterations": sf.iterations, "evaluations": sf.evaluations,
                              "params": {k: {"value": v, "stderr": sf.stderr[k]} for k, v in sf.params.items()}}

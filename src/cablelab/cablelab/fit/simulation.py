@@ -153,3 +153,59 @@ def fit_simulation(simulate: Callable[[list[dict]], np.ndarray], params: Sequenc
     rho = 1.0 - float(np.sum(objective_residual(y_meas, y_sim, "pearson") ** 2))
     return SimulationFit(values, dict(zip(names, map(float, se))), objective, nm, rho, y_sim,
                          iterations=len(trace), evaluations=count["n"])
+
+
+# ----------------------------------------------------------------------------- free-run windows
+# A free run of a marginally stable plant is cut into windows of a fixed horizon, each started
+# from the measured state (002 sec. 6.1); what the model must reproduce is the deviation of the
+# measured motion from each window's start.
+
+def window_length(dt: float, horizon_s: float) -> int:
+    """Samples per free-run window of ``horizon_s`` (s) at sample period ``dt`` (s), at least 2."""
+    return max(2, int(round(horizon_s / dt)))
+
+
+def free_run_windows(ds, horizon_s: float) -> tuple[int, int]:
+    """``(w, n_win)``: samples per window and number of whole windows of ``horizon_s`` in ``ds``.
+
+    Raises:
+        CablelabError: the record is shorter than one window.
+    """
+    w = window_length(ds.dt, horizon_s)
+    n_win = ds.n // w
+    if n_win < 1:
+        raise CablelabError(f"{ds.source}: record shorter than one free-run window ({horizon_s} s)")
+    return w, n_win
+
+
+def window_starts(x: np.ndarray, w: int) -> np.ndarray:
+    """(N, ...) value of ``x`` at the start of the window of ``w`` samples each sample is in."""
+    idx = np.arange(len(x))
+    return x[(idx // w) * w]
+
+
+def fit_free_run_windows(run: Callable[[list[dict]], np.ndarray], q: np.ndarray, start: dict,
+                         params: Sequence[Param], horizon_s: float, dt: float, *,
+                         objective: str = "nmse", max_iter: int = 50,
+                         progress: bool = False) -> SimulationFit:
+    """:func:`fit_simulation` of a windowed free run to the measured motion.
+
+    Args:
+        run: ``fn([values, ...]) -> (k, N, C)`` simulated coordinates, window by window, for k
+            complete parameter sets (``start`` updated with the free values).
+        q: (N,) or (N, C) measured coordinates (rad or m); the fit matches the deviation of the
+            simulated and measured q from each window's start over the whole windows.
+        start: values of every parameter (the held ones stay there); params: the free ones.
+        horizon_s, dt: window length and sample period, s.
+    """
+    q = np.asarray(q, float)
+    q = q[:, None] if q.ndim == 1 else q
+    w = window_length(dt, horizon_s)
+    n = (len(q) // w) * w
+    base = window_starts(q[:n], w)
+
+    def simulate(sets):
+        return run([{**start, **s} for s in sets])[:, :n, :] - base[None]
+
+    return fit_simulation(simulate, params, q[:n] - base, objective=objective, max_iter=max_iter,
+                          progress=progress)

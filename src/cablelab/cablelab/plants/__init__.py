@@ -31,7 +31,7 @@ class Plant:
         channels_doc: one line describing the output channels (for docs and reports).
         simulate: optional free-run comparison ``fn(ds, params) -> dict`` (``{"channel",
             "nrmse", "max_abs", "pearson", ...}``) shown by ``compare`` next to the inverse model.
-        simulation_fit: optional simulation-based fit ``fn(ds, start_params, objective,
+        simulation_fit: optional simulation-based fit ``fn(ds, start_params, *, objective,
             progress=False) ->``
             :class:`~cablelab.fit.simulation.SimulationFit` (``identify --simulation nmse|pearson``).
     """

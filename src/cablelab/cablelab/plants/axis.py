@@ -14,6 +14,7 @@ import numpy as np
 
 from ..conditioning import Conditioning, condition_motion
 from ..errors import CablelabError
+from ..fit.simulation import fit_free_run_windows, free_run_windows, window_length, window_starts
 from ..model import Dataset
 from . import Plant, register_plant
 
@@ -96,19 +97,6 @@ def candidates(description) -> tuple[str, ...]:
     return cands
 
 
-AXIS = register_plant(Plant(
-    name="axis",
-    topics=((TOPIC, JOINT_STATE),),
-    dataset=dataset,
-    baseline=baseline,
-    candidates=candidates,
-    channels_doc="joint: measured motor force (N, prismatic) or torque (N m, revolute)",
-    simulate=lambda ds, params: free_run_compare(ds, params),
-    simulation_fit=lambda ds, start, objective, progress=False: fit_free_run(
-        ds, start, objective=objective, progress=progress),
-))
-
-
 # ----------------------------------------------------------------------------- free-run simulation
 
 #: free-run horizon: the record is cut into windows of this length, each simulated from the
@@ -138,10 +126,7 @@ def free_run(ds: Dataset, param_sets: list[dict], horizon_s: float = FREE_RUN_HO
     from .axis_truth import build_axis_model, initial_state
 
     dt = ds.dt
-    w = max(2, int(round(horizon_s / dt)))
-    n_win = ds.n // w
-    if n_win < 1:
-        raise CablelabError(f"{ds.source}: record shorter than one free-run window ({horizon_s} s)")
+    w, n_win = free_run_windows(ds, horizon_s)
     q, qd = ds.signals["q"], ds.signals["qd"]
     starts = np.arange(n_win) * w
     desc = ds.description
@@ -173,10 +158,8 @@ def free_run_compare(ds: Dataset, params: dict, horizon_s: float = FREE_RUN_HORI
     each window's start (the motion the model must reproduce) and max abs error."""
     sim = free_run(ds, [params], horizon_s)[0, :, 0]
     q = ds.signals["q"]
-    w = max(2, int(round(horizon_s / ds.dt)))
     ok = np.isfinite(sim)
-    idx = np.arange(ds.n)
-    base = q[(idx // w) * w]
+    base = window_starts(q, window_length(ds.dt, horizon_s))
     dq_meas, dq_sim = (q - base)[ok], (sim - base)[ok]
     e = dq_sim - dq_meas
     return {"channel": "position", "horizon_s": horizon_s,
@@ -196,26 +179,26 @@ def fit_free_run(ds: Dataset, start: dict, *, objective: str = "nmse",
             ``free`` are held at their start value.
         free: parameters to fit, bounded to [start / 5, start * 5] (positive ones).
     """
-    from ..fit.simulation import fit_simulation
     from ..model import Param
 
-    w = max(2, int(round(horizon_s / ds.dt)))
-    n_win = ds.n // w
-    q = ds.signals["q"]
-    idx = np.arange(n_win * w)
-    base = q[(idx // w) * w]
-    y_meas = (q[: n_win * w] - base)[:, None]
     params = []
     for k in free:
         v = float(start.get(k, 0.0))
         if v <= 0:
             raise CablelabError(f"free-run fit: start value of {k} must be > 0 (got {v:g})")
         params.append(Param(k, "", v, v / 5.0, v * 5.0))
+    return fit_free_run_windows(lambda sets: free_run(ds, sets, horizon_s), ds.signals["q"], start,
+                                params, horizon_s, ds.dt, objective=objective, max_iter=max_iter,
+                                progress=progress)
 
-    def simulate(sets):
-        full = [{**start, **s} for s in sets]
-        sims = free_run(ds, full, horizon_s)[:, : n_win * w, :]
-        return sims - base[None, :, None]
 
-    return fit_simulation(simulate, params, y_meas, objective=objective, max_iter=max_iter,
-                          progress=progress)
+AXIS = register_plant(Plant(
+    name="axis",
+    topics=((TOPIC, JOINT_STATE),),
+    dataset=dataset,
+    baseline=baseline,
+    candidates=candidates,
+    channels_doc="joint: measured motor force (N, prismatic) or torque (N m, revolute)",
+    simulate=free_run_compare,
+    simulation_fit=fit_free_run,
+))

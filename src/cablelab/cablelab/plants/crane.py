@@ -218,7 +218,6 @@ CRANE = register_plant(Plant(
     baseline=baseline,
     candidates=candidates,
     channels_doc="slew, luff torque (N m), hoist force (N)",
-    simulate=lambda ds, params: free_run_compare(ds, params),
-    simulation_fit=lambda ds, start, objective, progress=False: fit_free_run(
-        ds, start, objective=objective, progress=progress),
+    simulate=free_run_compare,
+    simulation_fit=fit_free_run,
 ))

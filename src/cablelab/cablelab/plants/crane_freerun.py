@@ -13,9 +13,10 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import CablelabError
+from ..fit.simulation import fit_free_run_windows, free_run_windows, window_length, window_starts
 from ..model import Dataset
 from .crane_kinematics import gimbal_rates_to_swing, swing_to_gimbal
-from .crane_model import CraneParams
+from .crane_model import JOINTS, CraneParams
 
 __all__ = ["FREE_RUN_HORIZON_S", "truth_from_params", "free_run", "free_run_compare", "fit_free_run"]
 
@@ -47,9 +48,8 @@ def truth_from_params(params: dict, description) -> "object":
     gy = float(params.get("tilt_pb", 0.0)) / p.payload_mass
     ey = float(np.arcsin(np.clip(gx / g, -0.5, 0.5)))
     ex = -float(np.arcsin(np.clip(gy / (g * np.cos(ey)), -0.5, 0.5)))
-    joints = ("slew", "luff", "hoist")
-    visc = tuple(pos(f"Fv[{j}]", 0.0) for j in joints)
-    coul = tuple(pos(f"Fc[{j}]", 0.0) for j in joints)
+    visc = tuple(pos(f"Fv[{j}]", 0.0) for j in JOINTS)
+    coul = tuple(pos(f"Fc[{j}]", 0.0) for j in JOINTS)
     return CraneTruth(params=p, base_tilt=(ex, ey), viscous=visc, coulomb=coul, timestep=1e-3)
 
 
@@ -83,10 +83,7 @@ def free_run(ds: Dataset, params, horizon_s: float = FREE_RUN_HORIZON_S) -> np.n
 
     sets = [params] if isinstance(params, dict) else list(params)
     dt = ds.dt
-    w = max(2, int(round(horizon_s / dt)))
-    n_win = ds.n // w
-    if n_win < 1:
-        raise CablelabError(f"{ds.source}: record shorter than one free-run window ({horizon_s} s)")
+    w, n_win = free_run_windows(ds, horizon_s)
     q, qd = ds.signals["q"], ds.signals["qd"]
     starts = np.arange(n_win) * w
     qpos, qvel = _mujoco_state(q[starts], qd[starts])
@@ -102,7 +99,7 @@ def free_run(ds: Dataset, params, horizon_s: float = FREE_RUN_HORIZON_S) -> np.n
         for k in range(n_win):  # a handful of windows: set each initial state
             data.qpos[:], data.qvel[:] = qpos[k], qvel[k]
             mujoco.mj_getState(model, data, x0[k], spec)
-        offset = np.array([float(ps.get(f"OF[{j}]", 0.0)) for j in ("slew", "luff", "hoist")])
+        offset = np.array([float(ps.get(f"OF[{j}]", 0.0)) for j in JOINTS])
         u = ds.y - offset
         ctrl = np.repeat(u[: n_win * w].reshape(n_win, w, 3), steps, axis=1)
         models += [model] * n_win
@@ -123,10 +120,8 @@ def free_run_compare(ds: Dataset, params: dict, horizon_s: float = FREE_RUN_HORI
     """Free-run error per coordinate: NRMSE of the deviation from each window's start."""
     sim = free_run(ds, params, horizon_s)
     q = ds.signals["q"]
-    w = max(2, int(round(horizon_s / ds.dt)))
     ok = np.isfinite(sim).all(axis=1)
-    idx = np.arange(ds.n)
-    base = q[(idx // w) * w]
+    base = window_starts(q, window_length(ds.dt, horizon_s))
     out = {"horizon_s": horizon_s, "channels": {}}
     for j, name in enumerate(_COORDS):
         dm, dsim = (q[:, j] - base[:, j])[ok], (sim[:, j] - base[:, j])[ok]
@@ -150,23 +145,12 @@ def fit_free_run(ds: Dataset, start: dict, *, objective: str = "nmse",
     eq. 3-7). Parameters of ``free`` with a positive start value are fitted within
     [start / 5, start * 5]; the others are held at their start value.
     """
-    from ..fit.simulation import fit_simulation
     from ..model import Param
 
-    w = max(2, int(round(horizon_s / ds.dt)))
-    n_win = ds.n // w
-    q = ds.signals["q"]
-    idx = np.arange(n_win * w)
-    base = q[(idx // w) * w]
-    y_meas = q[: n_win * w] - base
     params = [Param(k, "", float(start[k]), float(start[k]) / 5.0, float(start[k]) * 5.0)
               for k in free if float(start.get(k, 0.0)) > 0]
     if not params:
         raise CablelabError("free-run fit: no free parameter with a positive start value")
-
-    def simulate(sets):
-        full = [{**start, **s} for s in sets]
-        return free_run(ds, full, horizon_s)[:, : n_win * w, :] - base[None]
-
-    return fit_simulation(simulate, params, y_meas, objective=objective, max_iter=max_iter,
-                          progress=progress)
+    return fit_free_run_windows(lambda sets: free_run(ds, sets, horizon_s), ds.signals["q"], start,
+                                params, horizon_s, ds.dt, objective=objective, max_iter=max_iter,
+                                progress=progress)
