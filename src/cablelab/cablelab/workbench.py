@@ -11,7 +11,6 @@ from typing import Sequence
 
 import numpy as np
 
-from .conditioning import Conditioning
 from .diagnose import (channel_metrics, cv_error, derived_regimes, greedy, rank_candidates,
                        residual_by_regime, whiteness, worst_segments)
 from .diagnose.ranking import ALPHA, FOLDS, MIN_GAIN
@@ -31,16 +30,10 @@ def load(bag_path, description_path=None, options: dict | None = None):
         CablelabError: unreadable bag, no description, missing topics (one line each).
     """
     from .bags import open_bag
-    from .description import load_description
     from .plants import get_plant
 
     bag = open_bag(bag_path)
-    if description_path:
-        desc = load_description(description_path)
-    else:
-        desc = bag.description
-        if desc is None:
-            raise CablelabError(f"{bag_path}: no /plant_description in the bag; give --description FILE")
+    desc = load_bag_description(bag_path, description_path, bag)
     plant = get_plant(desc.plant)
     for topic, msgtype in plant.topics:
         if not bag.has(topic):
@@ -50,6 +43,26 @@ def load(bag_path, description_path=None, options: dict | None = None):
         bag.require(topic, msgtype)
     ds = plant.dataset(bag, desc, dict(options or {}))
     return plant, desc, ds
+
+
+def load_bag_description(bag_path, description_path=None, bag=None):
+    """The plant description of a run: the given file, else ``/plant_description`` in the bag
+    (``bag``: the already opened bag, else it is opened).
+
+    Raises:
+        CablelabError: unreadable file or bag, or no description in the bag (one line).
+    """
+    from .description import load_description
+
+    if description_path:
+        return load_description(description_path)
+    if bag is None:
+        from .bags import open_bag
+
+        bag = open_bag(bag_path)
+    if bag.description is None:
+        raise CablelabError(f"{bag_path}: no /plant_description in the bag; give --description FILE")
+    return bag.description
 
 
 def build_model(plant, desc, effects: Sequence[str] = (), baseline: Sequence[str] | None = None,
@@ -164,15 +177,3 @@ def _row(r: dict) -> dict:
     keys = ("effect", "error_before", "error_after", "params", "significant", "stderr", "units",
             "p_value", "delta_bic", "n_eff", "gain", "evidence", "explanation")
     return {k: r[k] for k in keys if k in r}
-
-
-def conditioning_from_args(args) -> Conditioning:
-    """Build :class:`Conditioning` from the shared CLI options."""
-    kw = {}
-    if getattr(args, "cutoff", None) is not None:
-        kw["cutoff_hz"] = args.cutoff
-    if getattr(args, "decimate", None):
-        kw["decimate"] = args.decimate
-    if getattr(args, "border", None) is not None:
-        kw["border"] = args.border
-    return Conditioning(**kw)

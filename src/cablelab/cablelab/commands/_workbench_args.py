@@ -5,23 +5,36 @@ import json
 import math
 
 
-def add_common(p, *, effects_required: bool = False) -> None:
+def add_bag(p) -> None:
+    """The bag and its plant description (every verb that reads a recorded run)."""
     p.add_argument("bag", help="rosbag2 directory or its .mcap file")
     p.add_argument("--description", metavar="FILE",
                    help="plant description YAML (default: /plant_description in the bag)")
+
+
+def add_tensions(p) -> None:
+    p.add_argument("--tensions", choices=("dynamometer", "motor"), default="dynamometer",
+                   help="CDPR: cable tensions from the dynamometers or from the motor torques")
+
+
+def add_json(p) -> None:
+    p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
+
+
+def add_common(p, *, effects_required: bool = False) -> None:
+    add_bag(p)
     p.add_argument("--effects", metavar="A,B", default="", required=effects_required,
                    help="effects added to the plant's nominal model (ids of CONTRACT section 4)")
     p.add_argument("--baseline", metavar="A,B", default=None,
                    help="replace the plant's nominal effects ('none' = empty model)")
     p.add_argument("--fix", metavar="NAME=VALUE", action="append", default=[],
                    help="known parameter moved to the left-hand side (repeatable)")
-    p.add_argument("--tensions", choices=("dynamometer", "motor"), default="dynamometer",
-                   help="CDPR: tensions from the dynamometers or from motor torques")
+    add_tensions(p)
     p.add_argument("--cutoff", type=float, metavar="HZ", default=None,
                    help="zero-phase Butterworth cut-off for positions (default fs/10)")
     p.add_argument("--decimate", type=int, metavar="K", default=None,
                    help="keep every K-th sample after filtering")
-    p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
+    add_json(p)
 
 
 def add_folds(p) -> None:
@@ -29,10 +42,24 @@ def add_folds(p) -> None:
                    help="blocked k-fold cross-validation over time (default 5; identify: 0 = none)")
 
 
+def conditioning_from_args(args):
+    """:class:`~cablelab.conditioning.Conditioning` from the shared options (defaults where unset)."""
+    from ..conditioning import Conditioning
+
+    kw = {}
+    if getattr(args, "cutoff", None) is not None:
+        kw["cutoff_hz"] = args.cutoff
+    if getattr(args, "decimate", None):
+        kw["decimate"] = args.decimate
+    if getattr(args, "border", None) is not None:
+        kw["border"] = args.border
+    return Conditioning(**kw)
+
+
 def load_from_args(args):
     """(plant, description, dataset, model) from the shared options."""
     from ..model import parse_effect_list, parse_fixed
-    from ..workbench import build_model, conditioning_from_args, load
+    from ..workbench import build_model, load
 
     options = {"conditioning": conditioning_from_args(args), "tensions": args.tensions}
     plant, desc, ds = load(args.bag, args.description, options)

@@ -11,34 +11,28 @@ import importlib
 import inspect
 
 from ..errors import CablelabError
+from ._workbench_args import add_bag, add_json, add_tensions, dump_json
 
 HELP = "estimate the payload (CDPR mass and CoM) or the swing (crane) per sample from a bag"
 
 
 def add_arguments(p) -> None:
-    p.add_argument("bag", help="rosbag2 directory or its .mcap file")
-    p.add_argument("--description", metavar="FILE",
-                   help="plant description YAML (default: /plant_description in the bag)")
-    p.add_argument("--tensions", choices=("dynamometer", "motor"), default="dynamometer",
-                   help="CDPR: cable tensions from the dynamometers or from the motor torques")
+    add_bag(p)
+    add_tensions(p)
     p.add_argument("--effects", metavar="A,B", default="",
                    help="effects added to the plant's nominal model (e.g. pulley_geometry, "
                         "platform_inertia, winch_coulomb_friction)")
     p.add_argument("--pose", choices=("desired", "measured"), default="desired",
                    help="CDPR: pose for the wrench matrix (001 uses the desired pose)")
     p.add_argument("--out", metavar="BAG2", help="also write the per-sample estimates as a bag")
-    p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
+    add_json(p)
 
 
 def run(args) -> int:
-    from ..bags import open_bag
-    from ..description import load_description
     from ..model import parse_effect_list
-    from ._workbench_args import dump_json
+    from ..workbench import load_bag_description
 
-    desc = load_description(args.description) if args.description else open_bag(args.bag).description
-    if desc is None:
-        raise CablelabError(f"{args.bag}: no /plant_description in the bag; give --description FILE")
+    desc = load_bag_description(args.bag, args.description)
     try:
         mod = importlib.import_module(f"cablelab.plants.{desc.plant}")
     except ModuleNotFoundError:
