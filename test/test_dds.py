@@ -26,14 +26,17 @@ def test_sim_controller_estimator_recorder_over_dds(launcher, tmp_path):
                                   timeout=120, node_name="cablelab_recorder")
     # lock-step: the plant waits for the answer to each state, so a loaded machine slows the run
     # down but cannot add control delay (the physics checks below are then deterministic)
-    launcher.node("sim", "cable_sim_node", "axis", {**TRUE, "rate": 200.0, "lockstep": True})
+    # (time starts once the recorder, the controller and the estimator are matched on the states)
+    launcher.node("sim", "cable_sim_node", "axis", {**TRUE, "rate": 200.0, "lockstep": True,
+                                                    "wait_for_subscribers": 3})
     launcher.node("controller", "pd_feedforward", "axis",
                   {"reference_source": "sine", "amplitude": AMPLITUDE, "frequency": FREQUENCY,
                    "kp": KP, "kd": KD})
     launcher.node("estimator", "payload_estimator", "axis", {"publish_every": 10})
-    # 4 s of simulated motion (800 samples) flowing through all four processes
-    launcher.wait_for_topics({"/axis/joint_states": 800, "/axis/effort_command": 600,
-                              "/axis/parameter_estimate": 40, "/plant_description": 1}, timeout=120)
+    # 4 s of simulated motion (800 samples) flowing through all four processes, in the bag
+    launcher.wait_for_recorded(bag_dir, {"/axis/joint_states": 800, "/axis/effort_command": 600,
+                                         "/axis/reference": 600, "/axis/parameter_estimate": 40,
+                                         "/plant_description": 1}, timeout=180)
     codes = launcher.stop_all()
     assert codes == {"estimator": 0, "controller": 0, "sim": 0, "recorder": 0}, codes
 
@@ -53,6 +56,15 @@ def test_sim_controller_estimator_recorder_over_dds(launcher, tmp_path):
     # recorded velocity = derivative of recorded position (trapezoid rule of the integrator)
     dq = np.diff(q) / np.diff(t)
     np.testing.assert_allclose(dq, 0.5 * (qd[1:] + qd[:-1]), atol=0.02 * AMPLITUDE * 2 * np.pi * FREQUENCY)
+
+    # lock-step, no control delay however slow the machine: the effort applied over each period
+    # is the controller law of the state that starts it (law recomputed; a resent state answered
+    # twice must not shift the commands by a period; the first answers may precede the
+    # controller's copy of /plant_description, i.e. lack the feedforward inertia)
+    u_law = pd_feedforward(q, qd, *sine_reference(t, AMPLITUDE, FREQUENCY), KP, KD, inertia=2.0)
+    applied = js.effort[first, 0][1:]
+    late_cmd = np.flatnonzero(np.abs(applied - u_law[:-1]) > 1e-6 * (1.0 + np.abs(u_law[:-1])))
+    assert len(late_cmd) <= 10 and (late_cmd < 10).all(), late_cmd
 
     # the reference the controller published is the sine evaluated at the measurement stamps
     ref = bag.joint_trajectory("/axis/reference")

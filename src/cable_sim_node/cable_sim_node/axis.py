@@ -8,9 +8,17 @@ ROS parameters: ``description`` (YAML file or text; default a prismatic 2 kg axi
 ``inertia``, ``viscous``, ``coulomb``, ``offset`` (true values, SI), ``timestep`` (s),
 ``rate`` (Hz of publishing = command sampling), ``command_timeout`` (s wall; a stale command
 falls back to 0 and the node reports WARN), ``lockstep`` (bool, default false: the simulation
-advances one period only after a command answering the last published state arrived, so a
+advances one period only after the command answering the last published state arrived, so a
 loaded machine slows the run down instead of delaying the control loop; the state is
-republished every ``lockstep_resend`` s while waiting, e.g. before the controller connected).
+republished every ``lockstep_resend`` s while waiting, e.g. before the controller connected),
+``wait_for_subscribers`` (int, default 0: time starts only when ``/axis/joint_states`` has that
+many matched subscriptions, at most 60 s, so a recorder started with the run misses nothing).
+
+Lock-step matching: a command that names the stamp of the state it answers
+(:func:`cablelab.ros.convert.command_msg`, as the cablelab controllers send) is applied only if
+it answers the latest state; an answer to an earlier one (e.g. to a state resent while waiting)
+is counted on /diagnostics and ignored, so resends can never add a control delay. A command that
+names no stamp answers whatever state was published last.
 
 The effort reported with a state is the command held over the period that ends at that state.
 """
@@ -47,8 +55,10 @@ class AxisSimNode(Node):
         self.rate = float(p("rate", 200.0).value)
         self.lockstep = bool(p("lockstep", False).value)
         self.resend = float(p("lockstep_resend", 0.25).value)
-        self.answered = False  # lockstep: a command arrived since the last published state
-        self.last_publish = time.monotonic()
+        self.answered = False  # lockstep: the command answering the last published state arrived
+        self.stale_answers = 0  # lockstep: answers to earlier states, ignored
+        self.wait_subs = int(p("wait_for_subscribers", 0).value)
+        self.created = self.last_publish = time.monotonic()
         self.sim = AxisSim(self.description, truth)
         self.u = 0.0
         self.inputs = InputMonitor()
@@ -60,18 +70,36 @@ class AxisSimNode(Node):
         self.pub_desc = self.create_publisher(String, "/plant_description", DESCRIPTION_QOS)
         self.pub_desc.publish(convert.string_msg(self.description.to_yaml()))
         self.create_subscription(Float64MultiArray, "/axis/effort_command", self.on_command, stream_qos())
-        self.diag = Diagnostics(self, update=lambda: self.inputs.status(time.monotonic()))
+        self.diag = Diagnostics(self, update=self.status)
         self.timer = self.create_timer(1.0 / self.rate, self.tick)
         self.publish_state()
 
+    def status(self):
+        level, msg, values = self.inputs.status(time.monotonic())
+        values["sim time s"] = f"{self.sim.t:.3f}"
+        values["stale answers ignored (lock-step)"] = str(self.stale_answers)
+        return level, msg, values
+
     def on_command(self, msg: Float64MultiArray) -> None:
         values = convert.float_array(msg)
-        if self.inputs.accept("effort_command", values, time.monotonic()):
-            self.u = float(values[0])
-            self.answered = True
+        if not self.inputs.accept("effort_command", values, time.monotonic()):
+            return
+        stamp = convert.command_stamp(msg)
+        if self.lockstep and stamp is not None and not convert.same_stamp(stamp, self.sim.t):
+            self.stale_answers += 1  # answers an earlier state (already stepped past it)
+            return
+        self.u = float(values[0])
+        self.answered = True
 
     def tick(self) -> None:
         now = time.monotonic()
+        if self.wait_subs:
+            # before time starts: wait for the expected subscribers of the state topic
+            if self.pub_js.get_subscription_count() < self.wait_subs and now - self.created < 60.0:
+                if now - self.last_publish > self.resend:
+                    self.publish_state()  # the initial state again, for late joiners
+                return
+            self.wait_subs = 0
         if self.lockstep and not self.answered:
             if now - self.last_publish > self.resend:
                 self.publish_state()  # the controller may have missed it (not connected yet)

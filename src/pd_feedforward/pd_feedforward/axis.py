@@ -10,6 +10,10 @@ sine``, also published on ``/axis/reference`` so recordings hold it).
 ROS parameters: ``kp`` (N/m), ``kd`` (N s/m), ``inertia`` (feedforward M_ff; default the
 description's ``axis.inertia`` from /plant_description, else 0), ``reference_source``,
 ``amplitude``, ``frequency`` (Hz), ``offset``, ``reference_timeout`` (s wall).
+
+Each command names the stamp of the state it answers (``layout.dim[0].label = 'joint stamp=<t>'``,
+:func:`cablelab.ros.convert.command_msg`): a lock-step simulator applies only the answer to its
+latest state.
 """
 from __future__ import annotations
 
@@ -97,7 +101,7 @@ class AxisController(Node):
         else:
             return  # no reference: command nothing, the simulator's command timeout stops the drive
         u = pd_feedforward(q[0], qd[0], q_ref, qd_ref, qdd_ref, self.kp, self.kd, self.inertia)
-        self.pub_cmd.publish(convert.float_array_msg([u]))
+        self.pub_cmd.publish(convert.command_msg([u], stamp=t, label="joint"))
 
 
 def make_node(args) -> Node:

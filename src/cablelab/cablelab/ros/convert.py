@@ -13,7 +13,7 @@ from builtin_interfaces.msg import Time
 from geometry_msgs.msg import InertiaStamped, PoseStamped, Transform, Twist
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
-from std_msgs.msg import Float64MultiArray, String
+from std_msgs.msg import Float64MultiArray, MultiArrayDimension, String
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint, MultiDOFJointTrajectory, \
     MultiDOFJointTrajectoryPoint
 
@@ -71,6 +71,35 @@ def float_array_msg(data) -> Float64MultiArray:
 
 def float_array(msg: Float64MultiArray) -> np.ndarray:
     return np.asarray(msg.data, dtype=float)
+
+
+def command_msg(data, stamp: float | None = None, label: str = "command") -> Float64MultiArray:
+    """An effort command (std_msgs/Float64MultiArray, ros2_control forward-command style) that
+    says which state it answers: ``layout.dim[0].label = '<label> stamp=<t>'`` (t = header stamp
+    of that state, s). A lock-step simulator matches it (:func:`command_stamp`); everyone else
+    just reads ``data``. Without ``stamp`` the layout is empty."""
+    msg = float_array_msg(data)
+    if stamp is not None:
+        n = len(msg.data)
+        msg.layout.dim = [MultiArrayDimension(label=f"{label} stamp={float(stamp):.9f}", size=n, stride=n)]
+    return msg
+
+
+def command_stamp(msg: Float64MultiArray) -> float | None:
+    """The stamp (s) of the state a command answers (see :func:`command_msg`), None if it does
+    not say (a foreign controller) or says something unreadable."""
+    if not msg.layout.dim or "stamp=" not in msg.layout.dim[0].label:
+        return None
+    try:
+        t = float(msg.layout.dim[0].label.split("stamp=", 1)[1])
+    except ValueError:
+        return None
+    return t if np.isfinite(t) else None
+
+
+def same_stamp(a: float | None, b: float | None, tol: float = 1e-6) -> bool:
+    """True if two stamps (s) name the same sample (both given, within ``tol`` s)."""
+    return a is not None and b is not None and abs(a - b) < tol
 
 
 def pose_msg(t: float, position, quaternion, frame_id: str = "world") -> PoseStamped:

@@ -163,6 +163,31 @@ class Launcher:
         start. Raises CablelabError naming the topics on timeout (or a dead process)."""
         self.probe().wait_for_subscribers(list(topics), timeout, node_name, self.check_alive)
 
+    def wait_for_recorded(self, bag_dir, counts: dict[str, int], timeout: float = 60.0,
+                          poll: float = 0.5) -> dict[str, int]:
+        """Wait until the bag a recorder is writing to ``bag_dir`` holds at least ``counts``
+        messages per topic (read like ``cablelab info --recover``: everything flushed so far).
+        What the recorder got is what a test checks; what a probe saw is only a hint, since every
+        subscriber matches each publisher at its own time. Raises CablelabError naming the short
+        topics on timeout (or a dead process). Returns the counts seen."""
+        from ..bags import open_bag
+
+        deadline = time.monotonic() + timeout
+        seen: dict[str, int] = {}
+        while time.monotonic() < deadline:
+            self.check_alive()
+            try:
+                got = open_bag(bag_dir, recover=True).counts
+            except CablelabError:
+                got = {}  # not created or nothing flushed yet
+            seen = {t: int(got.get(t, 0)) for t in counts}
+            if all(seen[t] >= n for t, n in counts.items()):
+                return seen
+            time.sleep(poll)
+        short = [t for t, n in counts.items() if seen.get(t, 0) < n]
+        raise CablelabError(f"timeout after {timeout:g} s waiting for {bag_dir} to record "
+                            f"{short} (domain {self.domain_id}, recorded {seen})")
+
 
 class Probe:
     """An rclpy node in its own context on ``domain_id``, for watching the graph and topics."""
