@@ -1,4 +1,7 @@
-"""``./run demo``: the main job: CAROCA (001) through real nodes, then the analysis.
+"""``./run demo``: the main job: CAROCA (001) and the boom crane (002) through real nodes, then
+the analysis.
+
+CDPR part:
 
 1. Two closed-loop runs of the pick-and-place test trajectory (001 sec. II-C, A -> E -> A) with
    the heaviest payload (366 + 249 kg, CoM offset along x_p as 001 Fig. 11): simulator,
@@ -9,11 +12,19 @@
    motor torques raw vs friction compensated (001 Table II); PD vs PDFF z error (001 Fig. 15).
 3. ``cablelab diagnose`` starting from Model I (pulleys unknown), and from motor torques without
    friction: which effect is missing; ``cablelab report`` (HTML) of the first, plus a CDPR page
-   with the mass estimates and the z errors.
-4. A short table with the paper's numbers side by side, and where the report is.
+   with the mass estimates and the z errors (``bags/demo/report/``).
 
-Options: ``--out DIR`` (default bags/demo), ``--duration S`` (simulated s per run, default 61 =
-1 s settle + A -> E -> A), ``--skip-pd``, ``--folds K``.
+Crane part (:mod:`cablelab.demo_crane`): the crane on a hidden tilted base (002 sec. 6.5) with
+swing estimator and PD + gravity feedforward over DDS into ``bags/demo/crane/run``; live and
+offline swing angles vs ground truth, diagnosis (``base_tilt`` first) and report in
+``bags/demo/crane/report/``.
+
+Finally a short table per plant with the papers' numbers side by side, and
+``bags/demo/index.html`` linking both plants' pages and reports.
+
+Options: ``--out DIR`` (default bags/demo), ``--duration S`` (simulated s of the CDPR PDFF run,
+default 61 = 1 s settle + A -> E -> A), ``--skip-pd``, ``--crane-duration S`` (default 30),
+``--skip-cdpr``, ``--skip-crane``, ``--quick`` (short runs: a smoke test), ``--folds K``.
 """
 from __future__ import annotations
 
@@ -143,80 +154,142 @@ def _model1(bag: Path):
     return without_pulley_radius(open_bag(bag).description)
 
 
+def cdpr_part(out: Path, a) -> dict:
+    """Steps 1-3 for CAROCA; returns the table rows, bags and report paths."""
+    from .plants.cdpr import estimate_bag
+    from .ros.launch import unique_domain_id
+
+    t0 = time.monotonic()
+    log("CAROCA (001): 8 cables, 2-DoF pulleys r = 0.15 m, 366 kg platform + 249 kg payload")
+    pdff = run_nodes(out, "cdpr_pdff", True, a.duration, unique_domain_id(1))
+    pd = None if a.skip_pd else run_nodes(out, "cdpr_pd", False, min(a.duration, 31.0),
+                                          unique_domain_id(2))
+    log("estimating (cablelab estimate) ...")
+    m1 = estimate_bag(pdff, _model1(pdff)).summary()
+    m2 = estimate_bag(pdff).summary()
+    raw = estimate_bag(pdff, tensions="motor").summary()
+    fr = estimate_bag(pdff, tensions="motor",
+                      effects=("winch_coulomb_friction", "winch_viscous_friction")).summary()
+    _, ez = z_error(pdff)
+    ez_pd = z_error(pd)[1] if pd is not None else None
+
+    log("diagnosing (cablelab diagnose) ...")
+    from .workbench import build_model, diagnose, load
+    from .plants import get_plant
+    plant = get_plant("cdpr")
+    _, desc, ds = load(pdff, None, {"tensions": "dynamometer"})
+    base1 = build_model(plant, desc, (), ("cdpr_gravity",))
+    _, _, dsm = load(pdff, None, {"tensions": "motor"})
+    d2 = diagnose(dsm, build_model(plant, desc), plant.candidates(desc), folds=a.folds)
+
+    log("writing the report (cablelab report) ...")
+    from .report import build_report
+    rep = build_report(ds, base1, plant.candidates(desc), out / "report", folds=a.folds,
+                       title="CAROCA demo: dynamometers, Model I baseline")
+    d1 = rep["steps"][0]                # the report's first greedy step is the diagnosis
+
+    def err(s):
+        return 100 * (s["mass"]["mean"] - TRUE_MASS) / TRUE_MASS
+
+    rows = [
+        ["mass error, Model I, dynamometers (%)", f"{err(m1):+.2f}", f"-{PAPER['model1_err']}"],
+        ["mass error, Model II, dynamometers (%)", f"{err(m2):+.2f}", f"+{PAPER['model2_err']}"],
+        ["mass std, Model I / II (kg)", f"{m1['mass']['std']:.1f} / {m2['mass']['std']:.1f}",
+         f"{PAPER['model1_std']} / {PAPER['model2_std']}"],
+        ["mass std, motor raw / - friction / dyn (kg)",
+         f"{raw['mass']['std']:.1f} / {fr['mass']['std']:.1f} / {m2['mass']['std']:.1f}",
+         f"{PAPER['raw_std']} / {PAPER['friction_std']} / {PAPER['dyn_std']}"],
+        ["CoM x_G, y_G (mm), Model II (true 60.7, 0)",
+         f"{1000 * m2['com']['x']:.1f}, {1000 * m2['com']['y']:.1f}", "offset along x_p (Fig. 10)"],
+        ["max |z error| PD / PDFF (mm)",
+         f"{'-' if ez_pd is None else f'{1000 * np.abs(ez_pd).max():.1f}'} / {1000 * np.abs(ez).max():.1f}",
+         f"~{PAPER['pd_z']:.0f} / < {PAPER['pdff_z']:.0f}"],
+        ["diagnose, Model I + dynamometers: first effect", d1["ranking"][0]["effect"], "pulleys (sec. V-A)"],
+        ["diagnose, motor torques: first effect", d2["ranking"][0]["effect"], "friction (eq. 15)"],
+    ]
+    page = cdpr_page(out, pdff, pd, rows, rep["index"])
+    return {"rows": rows, "bags": [b for b in (pdff, pd) if b is not None], "report": rep["index"],
+            "page": page, "first": d1["ranking"][0]["effect"], "seconds": time.monotonic() - t0}
+
+
+def index_page(out: Path, parts: dict) -> str:
+    """``out/index.html``: one table per plant (cablelab vs paper) linking each plant's pages."""
+    import html
+
+    body = ["<h1>cablelab demo</h1><p>Each plant ran as separate processes over DDS (simulator, "
+            "estimator, controller, recorder); the analysis is <code>cablelab estimate / diagnose / "
+            "report</code> on the recorded bags.</p>"]
+    for title, part in parts.items():
+        rel = {k: os.path.relpath(part[k], out) for k in ("report", "page")}
+        rows = "".join("<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in r) + "</tr>"
+                       for r in part["rows"])
+        body.append(f"<h2>{html.escape(title)}</h2><p><a href='{rel['page']}'>demo page</a> | "
+                    f"<a href='{rel['report']}'>diagnosis report</a> | bags: "
+                    f"{html.escape(', '.join(os.path.relpath(b, out) for b in part['bags']))}</p>"
+                    f"<table border=1 cellpadding=4><tr><th>quantity</th><th>cablelab</th>"
+                    f"<th>paper</th></tr>{rows}</table>")
+    path = out / "index.html"
+    path.write_text("<!DOCTYPE html><html><head><meta charset='utf-8'><title>cablelab demo</title>"
+                    "</head><body style='font-family:sans-serif;max-width:1000px;margin:auto'>"
+                    + "".join(body) + "</body></html>")
+    return str(path)
+
+
+def print_table(title: str, rows: list) -> None:
+    w = max(len(r[0]) for r in rows)
+    v = max(22, max(len(r[1]) for r in rows))
+    print(f"\n{title}")
+    print(f"{'quantity':<{w}}  {'cablelab':>{v}}  paper")
+    for r in rows:
+        print(f"{r[0]:<{w}}  {r[1]:>{v}}  {r[2]}")
+
+
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(prog="./run demo", description=__doc__.split("\n\n")[0])
     p.add_argument("--out", default="bags/demo", help="output directory (default bags/demo)")
-    p.add_argument("--duration", type=float, default=61.0, help="simulated s per run")
-    p.add_argument("--skip-pd", action="store_true", help="only the PDFF run")
+    p.add_argument("--duration", type=float, default=61.0, help="CDPR: simulated s of the PDFF run")
+    p.add_argument("--skip-pd", action="store_true", help="CDPR: only the PDFF run")
+    p.add_argument("--crane-duration", type=float, default=30.0, help="crane: simulated s")
+    p.add_argument("--skip-cdpr", action="store_true", help="only the crane part")
+    p.add_argument("--skip-crane", action="store_true", help="only the CDPR part")
+    p.add_argument("--quick", action="store_true",
+                   help="short runs (CDPR 12 s PDFF only, crane 12 s, 3 folds): a smoke test")
     p.add_argument("--folds", type=int, default=5)
     a = p.parse_args(argv)
+    if a.quick:
+        a.duration, a.skip_pd, a.crane_duration, a.folds = min(a.duration, 12.0), True, \
+            min(a.crane_duration, 12.0), 3
     from .errors import CablelabError
-    from .plants.cdpr import estimate_bag
     from .ros.launch import unique_domain_id
 
     t_start = time.monotonic()
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
+    parts = {}
     try:
-        log("CAROCA (001): 8 cables, 2-DoF pulleys r = 0.15 m, 366 kg platform + 249 kg payload")
-        pdff = run_nodes(out, "cdpr_pdff", True, a.duration, unique_domain_id(1))
-        pd = None if a.skip_pd else run_nodes(out, "cdpr_pd", False, min(a.duration, 31.0),
-                                              unique_domain_id(2))
-        log("estimating (cablelab estimate) ...")
-        m1 = estimate_bag(pdff, _model1(pdff)).summary()
-        m2 = estimate_bag(pdff).summary()
-        raw = estimate_bag(pdff, tensions="motor").summary()
-        fr = estimate_bag(pdff, tensions="motor",
-                          effects=("winch_coulomb_friction", "winch_viscous_friction")).summary()
-        _, ez = z_error(pdff)
-        ez_pd = z_error(pd)[1] if pd is not None else None
-
-        log("diagnosing (cablelab diagnose) ...")
-        from .workbench import build_model, diagnose, load
-        from .plants import get_plant
-        plant = get_plant("cdpr")
-        _, desc, ds = load(pdff, None, {"tensions": "dynamometer"})
-        base1 = build_model(plant, desc, (), ("cdpr_gravity",))
-        d1 = diagnose(ds, base1, plant.candidates(desc), folds=a.folds)
-        _, _, dsm = load(pdff, None, {"tensions": "motor"})
-        d2 = diagnose(dsm, build_model(plant, desc), plant.candidates(desc), folds=a.folds)
-
-        log("writing the report (cablelab report) ...")
-        from .report import build_report
-        rep = build_report(ds, base1, plant.candidates(desc), out / "report", folds=a.folds,
-                           title="CAROCA demo: dynamometers, Model I baseline")
-
-        def err(s):
-            return 100 * (s["mass"]["mean"] - TRUE_MASS) / TRUE_MASS
-
-        rows = [
-            ["mass error, Model I, dynamometers (%)", f"{err(m1):+.2f}", f"-{PAPER['model1_err']}"],
-            ["mass error, Model II, dynamometers (%)", f"{err(m2):+.2f}", f"+{PAPER['model2_err']}"],
-            ["mass std, Model I / II (kg)", f"{m1['mass']['std']:.1f} / {m2['mass']['std']:.1f}",
-             f"{PAPER['model1_std']} / {PAPER['model2_std']}"],
-            ["mass std, motor raw / - friction / dyn (kg)",
-             f"{raw['mass']['std']:.1f} / {fr['mass']['std']:.1f} / {m2['mass']['std']:.1f}",
-             f"{PAPER['raw_std']} / {PAPER['friction_std']} / {PAPER['dyn_std']}"],
-            ["CoM x_G, y_G (mm), Model II (true 60.7, 0)",
-             f"{1000 * m2['com']['x']:.1f}, {1000 * m2['com']['y']:.1f}", "offset along x_p (Fig. 10)"],
-            ["max |z error| PD / PDFF (mm)",
-             f"{'-' if ez_pd is None else f'{1000 * np.abs(ez_pd).max():.1f}'} / {1000 * np.abs(ez).max():.1f}",
-             f"~{PAPER['pd_z']:.0f} / < {PAPER['pdff_z']:.0f}"],
-            ["diagnose, Model I + dynamometers: first effect", d1["ranking"][0]["effect"], "pulleys (sec. V-A)"],
-            ["diagnose, motor torques: first effect", d2["ranking"][0]["effect"], "friction (eq. 15)"],
-        ]
-        page = cdpr_page(out, pdff, pd, rows, rep["index"])
+        if not a.skip_cdpr:
+            parts["CAROCA CDPR (001), payload M2, 615 kg"] = cdpr_part(out, a)
+        if not a.skip_crane:
+            from . import demo_crane
+            cr = demo_crane.run(out / "crane", duration=a.crane_duration, folds=a.folds,
+                                domain=unique_domain_id(3))
+            parts["Boom crane (002), hidden tilted base"] = {
+                "rows": cr.rows, "bags": [cr.bag], "report": cr.report, "page": cr.page,
+                "first": cr.first, "seconds": cr.seconds}
+        index = index_page(out, parts) if parts else None
     except (CablelabError, RuntimeError) as exc:
         print(f"cablelab demo: error: {exc}", file=sys.stderr)
         return 2
-    w = max(len(r[0]) for r in rows)
-    print(f"\nCAROCA (001), payload M2 (615 kg), through sim + estimator + controller + recorder over DDS")
-    print(f"{'quantity':<{w}}  {'cablelab':>22}  {'001':>22}")
-    for r in rows:
-        print(f"{r[0]:<{w}}  {r[1]:>22}  {r[2]:>22}")
-    print(f"\nbags:   {pdff}" + ("" if pd is None else f", {pd}"))
-    print(f"report: {os.path.abspath(rep['index'])}")
-    print(f"        {os.path.abspath(page)}")
+    for title, part in parts.items():
+        print_table(f"{title}: sim + estimator + controller + recorder over DDS "
+                    f"({part['seconds']:.0f} s)", part["rows"])
+    print()
+    for title, part in parts.items():
+        print(f"{title.split(' (')[0]}: bags {', '.join(str(b) for b in part['bags'])}")
+        print(f"    report {os.path.abspath(part['report'])}")
+        print(f"    page   {os.path.abspath(part['page'])}")
+    if index:
+        print(f"index:  {os.path.abspath(index)}")
     print(f"({time.monotonic() - t_start:.0f} s)")
     return 0
 
