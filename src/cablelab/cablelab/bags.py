@@ -606,6 +606,17 @@ def _sec_nsec(ns: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return sec.astype(np.int32), (ns - sec * 1_000_000_000).astype(np.uint32)
 
 
+def _stamp_fills(ns: np.ndarray, prefix: str = "header.stamp") -> dict:
+    """cdr.encode fills of a builtin_interfaces/Time field from stamps ``ns`` (int64 ns)."""
+    sec, nsec = _sec_nsec(ns)
+    return {f"{prefix}.sec": sec, f"{prefix}.nanosec": nsec}
+
+
+def _axes_fills(prefix: str, a: np.ndarray, axes: str = "xyz") -> dict:
+    """cdr.encode fills ``{prefix}.x, .y, ...`` from the columns of ``a`` (N, len(axes))."""
+    return {f"{prefix}.{ax}": a[:, i] for i, ax in enumerate(axes)}
+
+
 def _as2d(a, n: int, k: int | None, what: str) -> np.ndarray | None:
     """a as an (n, k) float array (1-D input is taken as n rows); None stays None."""
     if a is None:
@@ -762,9 +773,8 @@ class BagWriter:
         """rosgraph_msgs/Clock messages holding t (s), logged at t."""
         ts = cdr.typestore()
         ns = _ns(t)
-        sec, nsec = _sec_nsec(ns)
         tmpl = ts.types[CLOCK](clock=ts.types["builtin_interfaces/msg/Time"](sec=0, nanosec=0))
-        flat, L = cdr.encode(CLOCK, tmpl, {"clock.sec": sec, "clock.nanosec": nsec}, len(ns))
+        flat, L = cdr.encode(CLOCK, tmpl, _stamp_fills(ns, "clock"), len(ns))
         self._write_batch(topic, CLOCK, ns, flat, L)
 
     def write_joint_states(self, topic: str, t, names, position=None, velocity=None, effort=None,
@@ -779,8 +789,7 @@ class BagWriter:
         tmpl = ts.types[JOINT_STATE](
             header=self._header(frame_id), name=[str(x) for x in names],
             **{f: np.zeros(0 if a is None else k) for f, a in arrays.items()})
-        sec, nsec = _sec_nsec(ns)
-        fills = {"header.stamp.sec": sec, "header.stamp.nanosec": nsec}
+        fills = _stamp_fills(ns)
         fills.update({f: a for f, a in arrays.items() if a is not None and k})
         flat, L = cdr.encode(JOINT_STATE, tmpl, fills, n)
         self._write_batch(topic, JOINT_STATE, self._log(ns, log_time), flat, L)
@@ -797,10 +806,8 @@ class BagWriter:
         tmpl = g[POSE_STAMPED](header=self._header(frame_id), pose=g["geometry_msgs/msg/Pose"](
             position=g["geometry_msgs/msg/Point"](x=0.0, y=0.0, z=0.0),
             orientation=g["geometry_msgs/msg/Quaternion"](x=0.0, y=0.0, z=0.0, w=1.0)))
-        sec, nsec = _sec_nsec(ns)
-        fills = {"header.stamp.sec": sec, "header.stamp.nanosec": nsec}
-        fills.update({f"pose.position.{a}": p[:, i] for i, a in enumerate("xyz")})
-        fills.update({f"pose.orientation.{a}": q[:, i] for i, a in enumerate("xyzw")})
+        fills = {**_stamp_fills(ns), **_axes_fills("pose.position", p),
+                 **_axes_fills("pose.orientation", q, "xyzw")}
         flat, L = cdr.encode(POSE_STAMPED, tmpl, fills, n)
         self._write_batch(topic, POSE_STAMPED, self._log(ns, log_time), flat, L)
 
@@ -816,9 +823,7 @@ class BagWriter:
         tmpl = g[INERTIA_STAMPED](header=self._header(frame_id), inertia=g["geometry_msgs/msg/Inertia"](
             m=0.0, com=g["geometry_msgs/msg/Vector3"](x=0.0, y=0.0, z=0.0),
             ixx=0.0, ixy=0.0, ixz=0.0, iyy=0.0, iyz=0.0, izz=0.0))
-        sec, nsec = _sec_nsec(ns)
-        fills = {"header.stamp.sec": sec, "header.stamp.nanosec": nsec, "inertia.m": m}
-        fills.update({f"inertia.com.{a}": c[:, i] for i, a in enumerate("xyz")})
+        fills = {**_stamp_fills(ns), "inertia.m": m, **_axes_fills("inertia.com", c)}
         flat, L = cdr.encode(INERTIA_STAMPED, tmpl, fills, n)
         self._write_batch(topic, INERTIA_STAMPED, self._log(ns, log_time), flat, L)
 
@@ -850,8 +855,7 @@ class BagWriter:
             **{f: np.zeros(0 if a is None else k) for f, a in arrays.items()})
         tmpl = g[JOINT_TRAJECTORY](header=self._header(""), joint_names=[str(x) for x in names],
                                    points=[point])
-        sec, nsec = _sec_nsec(ns)
-        fills = {"header.stamp.sec": sec, "header.stamp.nanosec": nsec}
+        fills = _stamp_fills(ns)
         fills.update({f"points[0].{f}": a for f, a in arrays.items() if a is not None and k})
         flat, L = cdr.encode(JOINT_TRAJECTORY, tmpl, fills, n)
         self._write_batch(topic, JOINT_TRAJECTORY, self._log(ns, log_time), flat, L)
@@ -888,15 +892,12 @@ class BagWriter:
             time_from_start=g["builtin_interfaces/msg/Duration"](sec=0, nanosec=0))
         tmpl = g[MULTIDOF_TRAJECTORY](header=self._header("world"), joint_names=[joint_name],
                                       points=[point])
-        sec, nsec = _sec_nsec(ns)
-        fills = {"header.stamp.sec": sec, "header.stamp.nanosec": nsec}
-        base = "points[0]."
-        fills.update({f"{base}transforms[0].translation.{a}": p[:, i] for i, a in enumerate("xyz")})
-        fills.update({f"{base}transforms[0].rotation.{a}": q[:, i] for i, a in enumerate("xyzw")})
+        fills = {**_stamp_fills(ns), **_axes_fills("points[0].transforms[0].translation", p),
+                 **_axes_fills("points[0].transforms[0].rotation", q, "xyzw")}
         for arr, path in ((lv, "velocities[0].linear"), (av, "velocities[0].angular"),
                           (la, "accelerations[0].linear"), (aa, "accelerations[0].angular")):
             if arr is not None:
-                fills.update({f"{base}{path}.{a}": arr[:, i] for i, a in enumerate("xyz")})
+                fills.update(_axes_fills(f"points[0].{path}", arr))
         flat, L = cdr.encode(MULTIDOF_TRAJECTORY, tmpl, fills, n)
         self._write_batch(topic, MULTIDOF_TRAJECTORY, self._log(ns, log_time), flat, L)
 
