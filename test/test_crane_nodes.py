@@ -83,11 +83,16 @@ def test_crane_nodes_over_dds(launcher, tmp_path):
     bag_dir = tmp_path / "run"
     launcher.start("recorder", [sys.executable, "-m", "cablelab.cli", "record", "--plant", "crane",
                                 "-o", bag_dir, "--quiet"])
+    # a recorder still importing on a busy machine would miss the start: wait for its subscriptions
+    launcher.wait_for_subscribers(["/crane/joint_states", "/crane/effort_commands",
+                                   "/crane/swing_estimate"], timeout=120, node_name="cablelab_recorder")
     launcher.node("sim", "cable_sim_node", "crane", {"rate": 100.0, "mocap_dropout": 0.02})
     launcher.node("estimator", "payload_estimator", "crane", {})
     launcher.node("controller", "pd_feedforward", "crane", {"reference_source": "excitation"})
-    launcher.wait_for_topics({"/crane/joint_states": 800, "/crane/effort_commands": 600,
-                              "/crane/swing_estimate": 600, "/plant_description": 1}, timeout=150)
+    # what the checks below read is the bag: wait until it holds the run (8 s of motion)
+    launcher.wait_for_recorded(bag_dir, {"/crane/joint_states": 800, "/crane/effort_commands": 600,
+                                         "/crane/swing_estimate": 600, "/crane/reference": 600,
+                                         "/plant_description": 1}, timeout=180)
     codes = launcher.stop_all()
     assert codes == {"estimator": 0, "controller": 0, "sim": 0, "recorder": 0}, codes
 
@@ -111,6 +116,21 @@ def test_crane_nodes_over_dds(launcher, tmp_path):
     # the crane moved and the swing is non-trivial
     js = bag.joint_state("/crane/joint_states", ["slew", "luff", "hoist"])
     assert np.ptp(js.position[:, 0]) > 0.05
+    # lock-step, no control delay however slow the machine: once commands flow, the effort applied
+    # over each period (reported with the state that ends it, exactly: no effort noise, no
+    # offset) is the controller's answer to the state that starts it. The controller answers
+    # every state in order, so the recorded commands and the applied efforts are one sequence
+    # shifted by one period (answers to states of the real-time start, before the first
+    # command arrived, are ignored by the simulator)
+    cmd = bag.float_array("/crane/effort_commands").data
+    eff = js.effort
+    mid = len(cmd) // 2
+    hit = np.flatnonzero(np.all(eff == cmd[mid], axis=1))
+    assert len(hit) == 1, hit
+    shift = hit[0] - mid                       # eff[k + shift] = cmd[k]
+    k = np.arange(max(0, -shift), min(len(cmd), len(eff) - shift))
+    same = np.all(eff[k + shift] == cmd[k], axis=1)
+    assert same[len(k) // 10:].all(), np.flatnonzero(~same)
     # it tracks the reference it was given
     ref = bag.joint_trajectory("/crane/reference", ["slew", "luff", "hoist"])
     late = ref.t > ref.t[0] + 2.0

@@ -10,11 +10,20 @@ ROS parameters: ``description`` (YAML file or text; default ``cablelab/data/cran
 ``slew_inertia``, ``luff_inertia`` (kg m^2), truth switches ``base_tilt`` [x, y] rad,
 ``viscous`` / ``coulomb`` / ``offset`` [slew, luff, hoist], ``mocap_noise`` (m),
 ``mocap_dropout`` (probability), ``timestep`` (s), ``rate`` (Hz of publishing = command
-sampling), ``command_timeout`` (s wall), ``lockstep`` (default true: after publishing a state
-the simulation waits for the command that answers it before advancing, so a slow or loaded
-controller slows the simulation down instead of destabilising it with delayed commands). Without
-a fresh command the drives hold the crane (gravity compensation + damping, like a brake) and the
-node reports WARN on /diagnostics.
+sampling), ``command_timeout`` (s wall, real-time mode), ``lockstep`` (default true: once
+commands flow, after publishing a state the simulation waits for the command that answers it
+before advancing, so a slow or loaded controller slows the simulation down instead of
+destabilising it with delayed commands; an answer is applied however late it comes),
+``lockstep_timeout`` (s wall, default 10: without an answer for that long the simulation drops
+back to real time, holding the crane, until commands flow again). Without a fresh command the
+drives hold the crane (gravity compensation + damping, like a brake) and the node reports WARN
+on /diagnostics.
+
+Lock-step matching: a command naming the stamp of the state it answers
+(:func:`cablelab.ros.convert.command_msg`, as the cablelab controller sends) answers the latest
+state only if the stamps agree; answers to earlier states (e.g. to states published while the
+simulation still ran in real time) are counted and ignored, so they never add a control delay.
+A command naming no stamp answers the last published state.
 """
 from __future__ import annotations
 
@@ -70,7 +79,9 @@ class CraneSimNode(Node):
         q0 = _vec(p("initial", [0.0, 0.5, 0.6]).value, 3, "initial")
         self.rate = float(p("rate", 100.0).value)
         self.lockstep = bool(p("lockstep", True).value)
-        self.answered = False       # a command arrived since the last published state
+        self.lockstep_timeout = float(p("lockstep_timeout", 10.0).value)
+        self.answered = False       # the command answering the last published state arrived
+        self.stale_answers = 0      # lock-step: answers to earlier states, ignored
         self.published_at = time.monotonic()
         self.sim = CraneSim(truth, q0)
         self.u = None
@@ -93,6 +104,7 @@ class CraneSimNode(Node):
     def status(self):
         level, msg, values = self.inputs.status(time.monotonic())
         values["fallback (hold) steps"] = str(self.fallbacks)
+        values["stale answers ignored (lock-step)"] = str(self.stale_answers)
         values["simulation resets"] = str(self.sim.resets)
         if self.sim.resets:
             level = 2
@@ -102,18 +114,27 @@ class CraneSimNode(Node):
 
     def on_command(self, msg: Float64MultiArray) -> None:
         values = convert.float_array(msg)
-        if self.inputs.accept("effort_commands", values, time.monotonic()):
-            self.u = values.copy()
-            self.answered = True
+        if not self.inputs.accept("effort_commands", values, time.monotonic()):
+            return
+        stamp = convert.command_stamp(msg)
+        if self.lockstep and stamp is not None and not convert.same_stamp(stamp, self.sim.time):
+            self.stale_answers += 1      # answers an earlier state: never applied late
+            if self.u is None:
+                self.u = values.copy()   # but commands flow: lock-step starts with the next state
+            return
+        self.u = values.copy()
+        self.answered = True
 
     def tick(self) -> None:
         now = time.monotonic()
-        timeout = self.inputs.inputs["effort_commands"].timeout
-        if (self.lockstep and self.u is not None and not self.answered
-                and now - self.published_at < timeout):
-            return  # wait for the controller's answer to the last state
-        if (self.u is None or not self.inputs.fresh("effort_commands", now)
-                or (self.lockstep and not self.answered)):
+        if self.lockstep and self.u is not None and not self.answered:
+            if now - self.published_at < self.lockstep_timeout:
+                return  # wait for the controller's answer to the last state
+            self.u = None  # no answer for lockstep_timeout s: real time (hold) until commands flow
+        if self.lockstep and self.answered:
+            u = self.u  # the answer to the last state, however late it came
+        elif (self.u is None or not self.inputs.fresh("effort_commands", now)
+                or self.lockstep):
             _, q, qd = self.sim.state()
             u = hold_command(q[None, :3], qd[None, :3], self.sim.truth.params, LIVE_GAINS,
                              swing=q[None, 3:])[0]

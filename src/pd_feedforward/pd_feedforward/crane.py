@@ -12,6 +12,10 @@ damping, :func:`~cablelab.plants.crane_control.hold_command`) and reports WARN.
 
 ROS parameters: ``kp``, ``kd`` ([slew, luff, hoist]), ``feedforward`` (bool),
 ``reference_source``, ``excitation_seed``, ``reference_timeout`` (s wall).
+
+Each command names the stamp of the state it answers (``layout.dim[0].label = 'joints stamp=<t>'``,
+:func:`cablelab.ros.convert.command_msg`): a lock-step simulator applies only the answer to its
+latest state.
 """
 from __future__ import annotations
 
@@ -132,11 +136,11 @@ class CraneController(Node):
         else:
             self.fallbacks += 1
             u = hold_command(q[None], qd[None], self.params, self.gains, swing)[0]
-            self.pub_cmd.publish(convert.float_array_msg(u))
+            self.pub_cmd.publish(convert.command_msg(u, stamp=t, label="joints"))
             return
         u = control_law(q[None], qd[None], ref[0][None], ref[1][None], ref[2][None], self.params,
                         self.gains, swing, self.feedforward)[0]
-        self.pub_cmd.publish(convert.float_array_msg(u))
+        self.pub_cmd.publish(convert.command_msg(u, stamp=t, label="joints"))
 
     def _q0(self, q):
         if not hasattr(self, "_start"):
