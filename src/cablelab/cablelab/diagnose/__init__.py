@@ -1,10 +1,10 @@
 """Diagnosis: compare metrics (:mod:`.metrics`), where the model fails (:mod:`.localise`,
 :mod:`.whiteness`), which effect is missing and the greedy waterfall (:mod:`.ranking`)."""
 from .localise import derived_regimes, residual_by_regime, worst_segments
-from .metrics import channel_metrics, nmse_objective, nrmse, pearson_objective
+from .metrics import channel_metrics, nrmse
 from .ranking import Diagnosis, cv_error, fold_indices, greedy, rank_candidates, significance
 from .whiteness import whiteness
 
 __all__ = ["Diagnosis", "channel_metrics", "cv_error", "derived_regimes", "fold_indices", "greedy",
-           "nmse_objective", "nrmse", "pearson_objective", "rank_candidates", "residual_by_regime",
+           "nrmse", "rank_candidates", "residual_by_regime",
            "significance", "whiteness", "worst_segments"]

@@ -9,6 +9,9 @@ Definitions (e = measured - model over the valid samples of one channel):
 * ``pearson``: correlation coefficient of y and model (000 eq. 3-7 use its mean as objective).
 * ``mae`` = mean |e|; ``mre`` = sum |e| / sum |y| (mean relative error, robust to y near 0);
   ``max_abs`` = max |e|.
+
+The simulation-fit objectives themselves (the NMSE sum of 003 eq. 28, the mean Pearson
+correlation of 000 eq. 7) are :func:`cablelab.fit.simulation.objective_residual`.
 """
 from __future__ import annotations
 
@@ -69,17 +72,3 @@ def nrmse(y: np.ndarray, y_hat: np.ndarray, valid: np.ndarray | None = None) -> 
     rms_y = np.sqrt(np.mean(y**2, axis=0))
     rms_e = np.sqrt(np.mean((y - yh) ** 2, axis=0))
     return float(np.mean(rms_e / np.where(rms_y > 0, rms_y, 1.0)))
-
-
-def pearson_objective(y: np.ndarray, y_sim: np.ndarray) -> float:
-    """Mean Pearson correlation over channels (000 eq. 3-7): the quantity maximised there."""
-    y, ys = _ok(y, y_sim, None)
-    yc, sc = y - y.mean(axis=0), ys - ys.mean(axis=0)
-    den = np.sqrt(np.sum(yc**2, axis=0) * np.sum(sc**2, axis=0))
-    return float(np.mean(np.sum(yc * sc, axis=0) / np.where(den > 0, den, np.inf)))
-
-
-def nmse_objective(y: np.ndarray, y_sim: np.ndarray) -> float:
-    """Sum over channels of mean(e^2) / var(y) (003 eq. 28)."""
-    y, ys = _ok(y, y_sim, None)
-    return float(np.sum(np.mean((y - ys) ** 2, axis=0) / np.var(y, axis=0)))
