@@ -59,7 +59,7 @@ def main(argv=None) -> int:
         bag = open_bag(path)
 
         def decode_only():
-            bag._cache.clear()
+            bag.clear_cache()
             bag.joint_state("/cdpr/joint_states")
 
         td = bench.time(decode_only, args.repeat)

@@ -274,6 +274,10 @@ class Bag:
         _, raws = self.raw(topic)
         return [ts.deserialize_cdr(r, self.topics[topic]) for r in raws]
 
+    def clear_cache(self) -> None:
+        """Forget the decoded topics (the next read decodes again; for benchmarks)."""
+        self._cache.clear()
+
     def _groups(self, topic: str, msgtype: str):
         self.require(topic, msgtype)
         key = (topic, msgtype)

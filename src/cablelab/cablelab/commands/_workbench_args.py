@@ -70,6 +70,12 @@ def load_from_args(args):
     return plant, desc, ds, model
 
 
+def param_line(name: str, v: dict, tag: str = "") -> str:
+    """``"           M = 95.1 +- 0.3 kg"``: one parameter of a verb's JSON (value, stderr, unit)."""
+    unit = f" {v['unit']}" if "unit" in v else ""
+    return f"  {name:>12} = {v['value']:.6g} +- {v['stderr']:.2g}{unit}{tag}"
+
+
 def _clean(o):
     if isinstance(o, float):
         return o if math.isfinite(o) else None

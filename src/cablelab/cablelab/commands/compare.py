@@ -1,7 +1,7 @@
 """``cablelab compare BAG [--effects a,b] --json``: measured vs model per channel."""
 from __future__ import annotations
 
-from ._workbench_args import add_common, dump_json, load_from_args
+from ._workbench_args import add_common, dump_json, load_from_args, param_line
 
 HELP = "compare the model (nominal effects + --effects, fitted) with the measurement per channel"
 
@@ -25,7 +25,7 @@ def run(args) -> int:
         print(f"  {ch}: NRMSE {100 * m['nrmse']:.2f} %  fit {m['fit_percent']:.1f} %  pearson "
               f"{pearson}  MAE {m['mae']:.4g}  max {m['max_abs']:.4g}")
     for name, v in out["params"].items():
-        print(f"  {name:>12} = {v['value']:.6g} +- {v['stderr']:.2g} {v['unit']}")
+        print(param_line(name, v))
     if "free_run" in out:
         fr = out["free_run"]
         print(f"  free run ({fr['horizon_s']} s windows): {fr['channel']} NRMSE {100 * fr['nrmse']:.2f} %, "

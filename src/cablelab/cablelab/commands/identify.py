@@ -1,7 +1,7 @@
 """``cablelab identify BAG --effects a,b --json``: parameters with uncertainty and fit."""
 from __future__ import annotations
 
-from ._workbench_args import add_common, add_folds, dump_json, load_from_args
+from ._workbench_args import add_common, add_folds, dump_json, load_from_args, param_line
 
 HELP = "identify the parameters of the nominal model + --effects, with standard errors"
 
@@ -28,12 +28,11 @@ def run(args) -> int:
     print(f"plant {out['plant']}, model {' + '.join(out['effects'])}: NRMSE {100 * f['nrmse']:.2f} % "
           f"({held}), rank {f['rank']}, condition {f['condition']:.3g}")
     for name, v in out["params"].items():
-        tag = " (fixed)" if v["fixed"] else ""
-        print(f"  {name:>12} = {v['value']:.6g} +- {v['stderr']:.2g} {v['unit']}{tag}")
+        print(param_line(name, v, " (fixed)" if v["fixed"] else ""))
     if "simulation" in out:
         sim = out["simulation"]
         print(f"simulation-based fit ({sim['objective']}): NMSE {sim['nmse']:.4g}, Pearson "
               f"{sim['pearson']:.5f}, {sim['iterations']} iterations")
         for name, v in sim["params"].items():
-            print(f"  {name:>12} = {v['value']:.6g} +- {v['stderr']:.2g}")
+            print(param_line(name, v))
     return 0
