@@ -17,11 +17,15 @@ from . import register
 COULOMB_DEADBAND = 0.0
 
 
-def coulomb_sign(v: np.ndarray, deadband: float = COULOMB_DEADBAND) -> np.ndarray:
-    """sign(v) with a dead band |v| <= deadband -> 0 (dimension of v)."""
+def coulomb_sign(v, deadband: float = COULOMB_DEADBAND) -> np.ndarray:
+    """sign(v) with a dead band |v| < deadband -> 0 (stiction zone; deadband in the unit of v).
+
+    The Coulomb friction term of every plant (001 eq. 15 winches, the joints of the axis and the
+    crane) and of the live laws built on them."""
+    v = np.asarray(v, dtype=float)
     s = np.sign(v)
     if deadband > 0:
-        s = np.where(np.abs(v) <= deadband, 0.0, s)
+        s = np.where(np.abs(v) < deadband, 0.0, s)
     return s
 
 

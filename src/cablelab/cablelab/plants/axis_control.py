@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..effects.friction import coulomb_sign
+
 PARAMETERS = ("inertia", "viscous", "coulomb", "offset")
 
 
@@ -32,8 +34,7 @@ def regressor(qd, qdd, eps: float = 1e-3) -> np.ndarray:
     """(N, 4) rows ``[qdd, qd, sign(qd), 1]``; ``sign`` is 0 for |qd| < eps (stiction zone)."""
     qd = np.asarray(qd, dtype=float).reshape(-1)
     qdd = np.asarray(qdd, dtype=float).reshape(-1)
-    s = np.where(np.abs(qd) < eps, 0.0, np.sign(qd))
-    return np.column_stack([qdd, qd, s, np.ones_like(qd)])
+    return np.column_stack([qdd, qd, coulomb_sign(qd, eps), np.ones_like(qd)])
 
 
 def gravity_load(q, gravity_moment: float, gravity: float = 9.81):

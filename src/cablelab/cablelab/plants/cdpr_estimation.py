@@ -9,6 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..effects.friction import coulomb_sign
 from .cdpr_geometry import CableGeometry, cable_wrench, cross
 
 __all__ = ["MassCom", "mass_com", "mass_com_batch", "mass_com_from_wrench", "tensions_from_torques",
@@ -115,10 +116,7 @@ def winch_friction(velocity: np.ndarray, coulomb, viscous, deadband: float = 0.0
         deadband: |qdot| below which sign() is taken as 0, rad/s.
     """
     v = np.asarray(velocity, dtype=float)
-    s = np.sign(v)
-    if deadband > 0:
-        s = np.where(np.abs(v) < deadband, 0.0, s)
-    return np.asarray(coulomb, float) * s + np.asarray(viscous, float) * v
+    return np.asarray(coulomb, float) * coulomb_sign(v, deadband) + np.asarray(viscous, float) * v
 
 
 def tensions_from_torques(effort: np.ndarray, velocity: np.ndarray, drum_radius: float,
