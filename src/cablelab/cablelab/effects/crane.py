@@ -26,10 +26,12 @@ from typing import Mapping
 import numpy as np
 
 from ..model import Dataset, Effect, Param
+from ..plants.crane_model import PARAM_GROUPS
 from . import register
 
-#: columns of the 9 groups of 002 eq. 4.2 in the generated regressor
-I_TOT, LB2_MB, LB2_M, LB_M, M, LB_MB, I_B, LC2_MC, LC_MC = range(9)
+#: columns of the 9 groups of 002 eq. 4.2 in the generated regressor (its PARAM_GROUPS order)
+I_TOT, LB2_MB, LB2_M, LB_M, M, LB_MB, I_B, LC2_MC, LC_MC = (PARAM_GROUPS.index(g) for g in (
+    "I_tot", "lb2_mb", "lb2_m", "lb_m", "m", "lb_mb", "I_b", "lc2_mc", "lc_mc"))
 #: default and search range of the counterbalance distance l_c, m
 LC_NOMINAL, LC_BOUNDS = 0.3, (0.02, 2.0)
 

@@ -28,7 +28,7 @@ import numpy as np
 
 from ..conditioning import Conditioning, condition_motion
 from ..errors import CablelabError
-from ..model import Dataset
+from ..model import STANDARD_GRAVITY, Dataset
 from . import Plant, register_plant
 from .crane_dynamics_generated import regressor
 from .crane_freerun import fit_free_run, free_run_compare
@@ -89,7 +89,7 @@ def dataset_from_arrays(t, q_joints, effort, t_mocap, tip, payload, description,
     q5 = np.column_stack([q_joints, th1, th2])
     c = condition_motion(t, q5, np.asarray(effort, float), opts,
                          revolute=[True, True, False, True, True], source=source)
-    g = description.gravity if description is not None else 9.81
+    g = description.gravity if description is not None else STANDARD_GRAVITY
     q, qd, qdd = c["q"], c["qd"], c["qdd"]
     Y = regressor(q, qd, qdd, g)
     return Dataset(
