@@ -2,21 +2,23 @@
 from __future__ import annotations
 
 import itertools
-import os
 
 import pytest
 
 _counter = itertools.count()
 
 
-def _domain_id() -> int:
-    """1..200, distinct across concurrently running test sessions (pid) and tests (counter)."""
-    return 1 + (os.getpid() * 13 + next(_counter) * 37) % 200
-
-
 @pytest.fixture
-def domain_id() -> int:
-    return _domain_id()
+def domain_id():
+    """A ROS_DOMAIN_ID in 1..200 no other process on this machine holds during the test
+    (locked: concurrent test sessions, demos and benchmarks never share one)."""
+    from cablelab.ros.launch import release_domain_id, reserve_domain_id
+
+    d = reserve_domain_id(salt=next(_counter))
+    try:
+        yield d
+    finally:
+        release_domain_id(d)
 
 
 @pytest.fixture

@@ -289,3 +289,55 @@ def test_clock_publisher_is_monotonic_and_throttled(ros_context):
         assert [m.clock.sec + m.clock.nanosec * 1e-9 for m in sent] == pytest.approx([0.0, 0.01, 0.02, 0.031])
     finally:
         node.destroy_node()
+
+
+# ----------------------------------------------------------------------------- launcher hygiene
+def _alive(pid: int) -> bool:
+    """True while ``pid`` runs (a zombie waiting for its new parent to reap it counts as dead)."""
+    try:
+        with open(f"/proc/{pid}/status") as fh:
+            return not any(line.startswith("State:") and "Z" in line.split()[1] for line in fh)
+    except OSError:
+        return False
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="PR_SET_PDEATHSIG is Linux only")
+def test_launched_nodes_die_with_a_killed_launcher(tmp_path):
+    """A test run or demo killed with SIGKILL (no cleanup runs) leaves no orphan node: the
+    children of a Launcher get SIGTERM from the kernel when it dies."""
+    import signal
+    import time
+
+    script = ("import sys, time\nfrom cablelab.ros.launch import Launcher\n"
+              f"la = Launcher(domain_id=1, log_dir={str(tmp_path)!r})\n"
+              "p = la.start('child', [sys.executable, '-c', 'import time; time.sleep(300)'])\n"
+              "print(p.popen.pid, flush=True)\ntime.sleep(300)\n")
+    parent = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True)
+    try:
+        child = int(parent.stdout.readline())
+        assert _alive(child)
+        parent.send_signal(signal.SIGKILL)
+        parent.wait(30)
+        deadline = time.monotonic() + 60
+        while _alive(child) and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert not _alive(child), f"orphan node {child} survived its launcher"
+    finally:
+        parent.kill()
+
+
+def test_domain_ids_are_exclusive_across_processes():
+    """Ids reserved by one process are never handed out to another one while held."""
+    from cablelab.ros.launch import release_domain_id, reserve_domain_id
+
+    mine = [reserve_domain_id(salt=s) for s in range(3)]
+    try:
+        code = ("from cablelab.ros.launch import reserve_domain_id\n"
+                f"print(*[reserve_domain_id(salt=s) for s in range(3)])")
+        out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+        theirs = [int(x) for x in out.stdout.split()]
+        assert len(theirs) == 3 and all(1 <= d <= 200 for d in theirs + mine)
+        assert not set(theirs) & set(mine) and len(set(mine)) == 3
+    finally:
+        for d in mine:
+            release_domain_id(d)

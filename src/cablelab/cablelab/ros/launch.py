@@ -9,7 +9,9 @@ Used by the integration tests, the benchmarks and the demo::
     # on exit: SIGINT to every process, then SIGTERM, then SIGKILL after the grace times
 
 Every child gets ``ROS_DOMAIN_ID`` and ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST`` in its
-environment, unbuffered output, and its stdout+stderr in ``log_dir/<name>.log``.
+environment, unbuffered output, and its stdout+stderr in ``log_dir/<name>.log``; it receives
+SIGTERM if the launching process dies without stopping it (no orphan nodes). Domain ids come from
+:func:`reserve_domain_id` (locked per machine, so parallel runs never share one).
 """
 from __future__ import annotations
 
@@ -25,9 +27,60 @@ from pathlib import Path
 from ..errors import CablelabError
 
 
+_DOMAIN_LOCKS = Path(tempfile.gettempdir()) / "cablelab-ros-domains"
+_held_domains: dict[int, int] = {}  # domain id -> fd of its flock'd lock file
+
+
+def reserve_domain_id(salt: int = 0, lo: int = 1, hi: int = 200) -> int:
+    """A ROS_DOMAIN_ID in ``lo..hi`` that no other process on this machine holds.
+
+    The search starts at a place derived from the pid and ``salt`` and takes the first id whose
+    lock file (``$TMPDIR/cablelab-ros-domains/<id>.lock``) this process can ``flock``: several
+    test runs, demos and benchmarks at once never share a domain (nodes of one run would see
+    the other's topics). The lock is held until :func:`release_domain_id` or the end of the
+    process (the kernel drops it even after SIGKILL). Raises CablelabError if all are taken."""
+    import fcntl
+
+    _DOMAIN_LOCKS.mkdir(mode=0o777, exist_ok=True)
+    n = hi - lo + 1
+    start = (os.getpid() * 7 + salt * 37) % n
+    for k in range(n):
+        d = lo + (start + k) % n
+        if d in _held_domains:
+            continue
+        fd = os.open(_DOMAIN_LOCKS / f"{d}.lock", os.O_RDWR | os.O_CREAT, 0o666)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            os.close(fd)
+            continue
+        _held_domains[d] = fd
+        return d
+    raise CablelabError(f"no free ROS_DOMAIN_ID in {lo}..{hi} (all locked in {_DOMAIN_LOCKS})")
+
+
+def release_domain_id(domain_id: int) -> None:
+    """Give back a domain id from :func:`reserve_domain_id` (no-op for others)."""
+    fd = _held_domains.pop(int(domain_id), None)
+    if fd is not None:
+        os.close(fd)
+
+
 def unique_domain_id(salt: int = 0) -> int:
-    """A ROS_DOMAIN_ID in 1..200 derived from the pid (distinct parallel test runs)."""
-    return 1 + (os.getpid() * 7 + salt) % 200
+    """A ROS_DOMAIN_ID in 1..200 free on this machine, held for the rest of the process
+    (:func:`reserve_domain_id`)."""
+    return reserve_domain_id(salt)
+
+
+def _die_with_parent() -> None:
+    """In the child before exec: SIGTERM when the launching process dies (even by SIGKILL), so a
+    killed test run or demo leaves no orphan nodes behind (Linux prctl PR_SET_PDEATHSIG)."""
+    try:
+        import ctypes
+
+        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGTERM, 0, 0, 0)
+    except (OSError, AttributeError):
+        pass
 
 
 def ros_env(domain_id: int, extra: dict | None = None) -> dict:
@@ -90,7 +143,8 @@ class Launcher:
         log_path = self.log_dir / f"{name}.log"
         fh = open(log_path, "wb")
         popen = subprocess.Popen([str(a) for a in argv], stdout=fh, stderr=subprocess.STDOUT,
-                                 env={**self.env, **(env or {})}, start_new_session=True)
+                                 env={**self.env, **(env or {})}, start_new_session=True,
+                                 preexec_fn=_die_with_parent if sys.platform.startswith("linux") else None)
         proc = Process(name, list(argv), popen, log_path, fh)
         self.procs[name] = proc
         return proc
