@@ -304,6 +304,21 @@ def test_bag_readable_by_mcap_library(tmp_path):
     assert qos["/plant_description"][0]["durability"] == "transient_local"
 
 
+def _write_mcap(path, topic, times, raws, **writer_options):
+    """A ros2-profile MCAP of JointState messages written by the mcap package's own writer."""
+    from mcap.writer import Writer as McapWriter
+
+    msgdef, _ = _ts().generate_msgdef(JOINT_STATE, ros_version=2)
+    with open(path, "wb") as fh:
+        w = McapWriter(fh, **writer_options)
+        w.start(profile="ros2", library="test")
+        sid = w.register_schema(name=JOINT_STATE, encoding="ros2msg", data=msgdef.encode())
+        cid = w.register_channel(topic=topic, message_encoding="cdr", schema_id=sid)
+        for i, (stamp, raw) in enumerate(zip(times.tolist(), raws)):
+            w.add_message(channel_id=cid, log_time=stamp, publish_time=stamp, data=raw, sequence=i)
+        w.finish()
+
+
 def _reference_messages(path):
     """(topic -> list of (log time, bytes)) read with rosbags' general reader (oracle)."""
     from rosbags.rosbag2 import Reader
@@ -329,7 +344,7 @@ def test_fast_index_reader_matches_rosbags_reader(tmp_path):
 def test_compressed_chunks_zstd_and_lz4_from_other_writers(tmp_path):
     """zstd chunks (rosbags writer) and lz4 chunks (the mcap package's writer) decode to the
     same messages through the fast index reader."""
-    from mcap.writer import CompressionType, Writer as McapWriter
+    from mcap.writer import CompressionType
     from rosbags.rosbag2 import Writer
     from rosbags.rosbag2.enums import CompressionFormat, CompressionMode, StoragePlugin
 
@@ -348,16 +363,9 @@ def test_compressed_chunks_zstd_and_lz4_from_other_writers(tmp_path):
         for stamp, raw in zip(times.tolist(), raws):
             wz.write(conn, stamp, raw)
 
-    msgdef, _ = ts.generate_msgdef(JOINT_STATE, ros_version=2)
     (tmp_path / "lz4").mkdir()
-    with open(tmp_path / "lz4" / "x.mcap", "wb") as fh:
-        w4 = McapWriter(fh, compression=CompressionType.LZ4, chunk_size=20000)
-        w4.start(profile="ros2", library="test")
-        sid = w4.register_schema(name=JOINT_STATE, encoding="ros2msg", data=msgdef.encode())
-        cid = w4.register_channel(topic="/js", message_encoding="cdr", schema_id=sid)
-        for i, (stamp, raw) in enumerate(zip(times.tolist(), raws)):
-            w4.add_message(channel_id=cid, log_time=stamp, publish_time=stamp, data=raw, sequence=i)
-        w4.finish()
+    _write_mcap(tmp_path / "lz4" / "x.mcap", "/js", times, raws,
+                compression=CompressionType.LZ4, chunk_size=20000)
 
     for path in (tmp_path / "zstd", tmp_path / "lz4" / "x.mcap"):
         bag = open_bag(path)
@@ -384,7 +392,7 @@ def test_info_verb_json_and_errors(tmp_path, capsys):
 def test_unindexed_mcap_falls_back_to_general_reader(tmp_path):
     """An MCAP without chunks, indexes or statistics (valid per spec) is read by rosbags' reader
     with the same result."""
-    from mcap.writer import CompressionType, IndexType, Writer as McapWriter
+    from mcap.writer import CompressionType, IndexType
 
     from cablelab.mcap_index import read_index
 
@@ -392,17 +400,9 @@ def test_unindexed_mcap_falls_back_to_general_reader(tmp_path):
     with BagWriter(tmp_path / "p") as w:
         w.write_joint_states("/js", t, ["a"], np.arange(300.0)[:, None])
     times, raws = open_bag(tmp_path / "p").raw("/js")
-    msgdef, _ = _ts().generate_msgdef(JOINT_STATE, ros_version=2)
     path = tmp_path / "flat.mcap"
-    with open(path, "wb") as fh:
-        w = McapWriter(fh, index_types=IndexType.NONE, use_summary_offsets=False, use_statistics=False,
-                       use_chunking=False, compression=CompressionType.NONE)
-        w.start(profile="ros2", library="test")
-        sid = w.register_schema(name=JOINT_STATE, encoding="ros2msg", data=msgdef.encode())
-        cid = w.register_channel(topic="/js", message_encoding="cdr", schema_id=sid)
-        for i, (stamp, raw) in enumerate(zip(times.tolist(), raws)):
-            w.add_message(channel_id=cid, log_time=stamp, publish_time=stamp, data=raw, sequence=i)
-        w.finish()
+    _write_mcap(path, "/js", times, raws, index_types=IndexType.NONE, use_summary_offsets=False,
+                use_statistics=False, use_chunking=False, compression=CompressionType.NONE)
     assert read_index(path) is None
     bag = open_bag(path)
     np.testing.assert_array_equal(bag.joint_state("/js").position[:, 0], np.arange(300.0))
