@@ -734,6 +734,12 @@ class BagWriter:
             write(conn, stamp, mv[i * L:(i + 1) * L])
         self.counts[topic] += len(log_ns)
 
+    def _write_encoded(self, topic: str, msgtype: str, tmpl, fills: dict, log_ns: np.ndarray) -> None:
+        """Encode one message per log time from the template and its per-message field values
+        (:func:`cablelab.cdr.encode`) and write them."""
+        flat, L = cdr.encode(msgtype, tmpl, fills, len(log_ns))
+        self._write_batch(topic, msgtype, log_ns, flat, L)
+
     def write_messages(self, topic: str, msgtype: str, t, msgs, transient_local: bool = False) -> None:
         """Write rosbags message objects one by one (slow, general)."""
         ts = cdr.typestore()
@@ -778,8 +784,7 @@ class BagWriter:
         ts = cdr.typestore()
         ns = _ns(t)
         tmpl = ts.types[CLOCK](clock=ts.types["builtin_interfaces/msg/Time"](sec=0, nanosec=0))
-        flat, L = cdr.encode(CLOCK, tmpl, _stamp_fills(ns, "clock"), len(ns))
-        self._write_batch(topic, CLOCK, ns, flat, L)
+        self._write_encoded(topic, CLOCK, tmpl, _stamp_fills(ns, "clock"), ns)
 
     def write_joint_states(self, topic: str, t, names, position=None, velocity=None, effort=None,
                            *, frame_id: str = "", log_time=None) -> None:
@@ -795,8 +800,7 @@ class BagWriter:
             **{f: np.zeros(0 if a is None else k) for f, a in arrays.items()})
         fills = _stamp_fills(ns)
         fills.update({f: a for f, a in arrays.items() if a is not None and k})
-        flat, L = cdr.encode(JOINT_STATE, tmpl, fills, n)
-        self._write_batch(topic, JOINT_STATE, self._log(ns, log_time), flat, L)
+        self._write_encoded(topic, JOINT_STATE, tmpl, fills, self._log(ns, log_time))
 
     def write_poses(self, topic: str, t, position, quaternion, frame_id: str = "world", *,
                     log_time=None) -> None:
@@ -812,8 +816,7 @@ class BagWriter:
             orientation=g["geometry_msgs/msg/Quaternion"](x=0.0, y=0.0, z=0.0, w=1.0)))
         fills = {**_stamp_fills(ns), **_axes_fills("pose.position", p),
                  **_axes_fills("pose.orientation", q, "xyzw")}
-        flat, L = cdr.encode(POSE_STAMPED, tmpl, fills, n)
-        self._write_batch(topic, POSE_STAMPED, self._log(ns, log_time), flat, L)
+        self._write_encoded(topic, POSE_STAMPED, tmpl, fills, self._log(ns, log_time))
 
     def write_inertia(self, topic: str, t, m, com, frame_id: str = "platform", *,
                       log_time=None) -> None:
@@ -828,8 +831,7 @@ class BagWriter:
             m=0.0, com=g["geometry_msgs/msg/Vector3"](x=0.0, y=0.0, z=0.0),
             ixx=0.0, ixy=0.0, ixz=0.0, iyy=0.0, iyz=0.0, izz=0.0))
         fills = {**_stamp_fills(ns), "inertia.m": m, **_axes_fills("inertia.com", c)}
-        flat, L = cdr.encode(INERTIA_STAMPED, tmpl, fills, n)
-        self._write_batch(topic, INERTIA_STAMPED, self._log(ns, log_time), flat, L)
+        self._write_encoded(topic, INERTIA_STAMPED, tmpl, fills, self._log(ns, log_time))
 
     def write_float_arrays(self, topic: str, t, data) -> None:
         """std_msgs/Float64MultiArray: data (N, k), logged at t (the message has no header)."""
@@ -841,8 +843,7 @@ class BagWriter:
         g = ts.types
         tmpl = g[FLOAT64_MULTI_ARRAY](layout=g["std_msgs/msg/MultiArrayLayout"](dim=[], data_offset=0),
                                       data=np.zeros(k))
-        flat, L = cdr.encode(FLOAT64_MULTI_ARRAY, tmpl, {"data": d} if k else {}, n)
-        self._write_batch(topic, FLOAT64_MULTI_ARRAY, ns, flat, L)
+        self._write_encoded(topic, FLOAT64_MULTI_ARRAY, tmpl, {"data": d} if k else {}, ns)
 
     def write_joint_trajectory(self, topic: str, t, names, positions, velocities=None,
                                accelerations=None, *, log_time=None) -> None:
@@ -861,8 +862,7 @@ class BagWriter:
                                    points=[point])
         fills = _stamp_fills(ns)
         fills.update({f"points[0].{f}": a for f, a in arrays.items() if a is not None and k})
-        flat, L = cdr.encode(JOINT_TRAJECTORY, tmpl, fills, n)
-        self._write_batch(topic, JOINT_TRAJECTORY, self._log(ns, log_time), flat, L)
+        self._write_encoded(topic, JOINT_TRAJECTORY, tmpl, fills, self._log(ns, log_time))
 
     def write_multidof_trajectory(self, topic: str, t, position, quaternion, linear_velocity=None,
                                   angular_velocity=None, linear_acceleration=None,
@@ -902,8 +902,7 @@ class BagWriter:
                           (la, "accelerations[0].linear"), (aa, "accelerations[0].angular")):
             if arr is not None:
                 fills.update(_axes_fills(f"points[0].{path}", arr))
-        flat, L = cdr.encode(MULTIDOF_TRAJECTORY, tmpl, fills, n)
-        self._write_batch(topic, MULTIDOF_TRAJECTORY, self._log(ns, log_time), flat, L)
+        self._write_encoded(topic, MULTIDOF_TRAJECTORY, tmpl, fills, self._log(ns, log_time))
 
 
 def _looks_like_bag(path: Path) -> bool:
