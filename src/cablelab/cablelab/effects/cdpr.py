@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..model import Dataset, Effect, Param
-from ..plants.cdpr_geometry import cross
+from ..rotations import cross
 from . import register
 from .friction import coulomb_regressor, viscous_regressor
 

@@ -19,9 +19,10 @@ import numpy as np
 
 from ..errors import CablelabError
 from ..model import Dataset
+from ..rotations import quat_to_matrix, xyzw_to_wxyz
 from . import Plant, register_plant
 from .cdpr_estimation import mass_com, mass_com_batch
-from .cdpr_geometry import cable_geometry, quat_to_matrix, wrench_matrix
+from .cdpr_geometry import cable_geometry, wrench_matrix
 
 JOINT_STATE = "sensor_msgs/msg/JointState"
 TENSIONS = "/cdpr/cable_tensions"
@@ -149,7 +150,7 @@ def load_arrays(bag, description, tensions: str = "dynamometer", pose: str = "de
         want = REFERENCE if pose == "desired" else POSE
         raise CablelabError(f"{bag.path}: no platform pose: topic {want} is not in the bag")
     if np.isfinite(quat).all() and not np.allclose(quat[:, :3], 0.0, atol=1e-9):
-        q = _interp(t, tr, quat[:, [3, 0, 1, 2]])
+        q = _interp(t, tr, xyzw_to_wxyz(quat))
         R = quat_to_matrix(q)
     truth_m, truth_c = None, None
     if bag.has(TRUTH):

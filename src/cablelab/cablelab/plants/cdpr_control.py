@@ -15,8 +15,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..rotations import cross
 from .cdpr_estimation import winch_friction
-from .cdpr_geometry import CableGeometry, cross, wrench_matrix
+from .cdpr_geometry import CableGeometry, wrench_matrix
 
 __all__ = ["PdffConfig", "motor_angles", "motor_rates", "feedforward_tensions", "pdff_torques",
            "cable_lengths_from_motor"]

@@ -10,7 +10,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..effects.friction import coulomb_sign
-from .cdpr_geometry import CableGeometry, cable_wrench, cross
+from ..rotations import cross
+from .cdpr_geometry import CableGeometry, cable_wrench
 
 __all__ = ["MassCom", "mass_com", "mass_com_batch", "mass_com_from_wrench", "tensions_from_torques",
            "torques_from_tensions", "winch_friction"]

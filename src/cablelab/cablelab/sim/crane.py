@@ -25,6 +25,7 @@ import numpy as np
 
 from ..plants.crane_kinematics import gimbal_rates_to_swing, gimbal_to_swing, swing_to_gimbal
 from ..plants.crane_model import CraneParams, gravity_vector, mass_matrix
+from ..rotations import wxyz_to_xyzw
 
 __all__ = ["CraneTruth", "build_model", "set_state", "gravity_in_base", "simulate", "SimResult",
            "reference_trajectory", "QPOS", "contract_acceleration", "truth_accelerations",
@@ -387,9 +388,9 @@ class CraneSim:
         if tr.mocap_dropout > 0 and self.rng.random() < tr.mocap_dropout:
             tip[:] = np.nan
             pay[:] = np.nan
-        wxyz = lambda q: np.array([q[1], q[2], q[3], q[0]])
         return {"joints": s[0:3].copy(), "joint_rates": s[3:6].copy(), "effort": eff,
-                "tip": tip, "tip_quat": wxyz(s[16:20]), "payload": pay, "payload_quat": wxyz(s[23:27])}
+                "tip": tip, "tip_quat": wxyz_to_xyzw(s[16:20]), "payload": pay,
+                "payload_quat": wxyz_to_xyzw(s[23:27])}
 
 
 def write_bag(path, res: SimResult, description_yaml: str, *, overwrite: bool = False) -> None:
@@ -397,14 +398,13 @@ def write_bag(path, res: SimResult, description_yaml: str, *, overwrite: bool = 
     /plant_description); mocap quaternions are stored x, y, z, w."""
     from ..bags import BagWriter
 
-    xyzw = lambda q: np.column_stack([q[:, 1], q[:, 2], q[:, 3], q[:, 0]])
     with BagWriter(path, overwrite=overwrite) as w:
         w.write_description(description_yaml)
         w.write_clock(res.t)
         w.write_joint_states("/crane/joint_states", res.t, ("slew", "luff", "hoist"),
                              position=res.q[:, :3], velocity=res.qd[:, :3], effort=res.effort)
-        w.write_poses("/crane/boom_tip_pose", res.t, res.tip, xyzw(res.tip_quat))
-        w.write_poses("/crane/payload_pose", res.t, res.payload, xyzw(res.payload_quat))
+        w.write_poses("/crane/boom_tip_pose", res.t, res.tip, wxyz_to_xyzw(res.tip_quat))
+        w.write_poses("/crane/payload_pose", res.t, res.payload, wxyz_to_xyzw(res.payload_quat))
         w.write_joint_states("/crane/ground_truth/swing", res.t, ("theta1", "theta2", "rope_length"),
                              position=res.q[:, [3, 4, 2]], velocity=res.qd[:, [3, 4, 2]])
         w.write_joint_trajectory("/crane/reference", res.t, ("slew", "luff", "hoist"), res.q_ref,
