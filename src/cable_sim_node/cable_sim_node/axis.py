@@ -36,7 +36,7 @@ from cablelab.ros import convert
 from cablelab.ros.clock import ClockPublisher
 from cablelab.ros.diagnostics import Diagnostics
 from cablelab.ros.inputs import InputMonitor
-from cablelab.ros.qos import DESCRIPTION_QOS, stream_qos
+from cablelab.ros.qos import DESCRIPTION_QOS, publisher_qos, stream_qos
 
 DEFAULT_DESCRIPTION = ("plant: axis\nname: simulated linear axis\ngravity: 9.81\n"
                        "axis:\n  joint_type: prismatic\n  inertia: 2.0\n")
@@ -64,8 +64,8 @@ class AxisSimNode(Node):
         self.inputs = InputMonitor()
         self.inputs.add("effort_command", timeout=float(p("command_timeout", 0.5).value), length=1)
 
-        self.pub_js = self.create_publisher(JointState, "/axis/joint_states", stream_qos())
-        self.pub_truth = self.create_publisher(JointState, "/axis/ground_truth/joint_states", stream_qos())
+        self.pub_js = self.create_publisher(JointState, "/axis/joint_states", publisher_qos())
+        self.pub_truth = self.create_publisher(JointState, "/axis/ground_truth/joint_states", publisher_qos())
         self.clock = ClockPublisher(self)
         self.pub_desc = self.create_publisher(String, "/plant_description", DESCRIPTION_QOS)
         self.pub_desc.publish(convert.string_msg(self.description.to_yaml()))

@@ -44,7 +44,7 @@ from cablelab.plants.crane_model import JOINTS, CraneParams
 from cablelab.ros import convert
 from cablelab.ros.diagnostics import Diagnostics
 from cablelab.ros.inputs import InputMonitor
-from cablelab.ros.qos import DESCRIPTION_QOS, stream_qos
+from cablelab.ros.qos import DESCRIPTION_QOS, publisher_qos, stream_qos
 from cablelab.sim.crane import CraneSim, CraneTruth
 
 DEFAULT_DESCRIPTION = os.path.join(os.path.dirname(__import__("cablelab").__file__), "data", "crane.yaml")
@@ -89,10 +89,10 @@ class CraneSimNode(Node):
         self.inputs = InputMonitor()
         self.inputs.add("effort_commands", timeout=float(p("command_timeout", 0.5).value), length=3)
 
-        self.pub_js = self.create_publisher(JointState, "/crane/joint_states", stream_qos())
-        self.pub_tip = self.create_publisher(PoseStamped, "/crane/boom_tip_pose", stream_qos())
-        self.pub_pay = self.create_publisher(PoseStamped, "/crane/payload_pose", stream_qos())
-        self.pub_truth = self.create_publisher(JointState, "/crane/ground_truth/swing", stream_qos())
+        self.pub_js = self.create_publisher(JointState, "/crane/joint_states", publisher_qos())
+        self.pub_tip = self.create_publisher(PoseStamped, "/crane/boom_tip_pose", publisher_qos())
+        self.pub_pay = self.create_publisher(PoseStamped, "/crane/payload_pose", publisher_qos())
+        self.pub_truth = self.create_publisher(JointState, "/crane/ground_truth/swing", publisher_qos())
         self.pub_clock = self.create_publisher(Clock, "/clock", stream_qos(10))
         self.pub_desc = self.create_publisher(String, "/plant_description", DESCRIPTION_QOS)
         self.pub_desc.publish(convert.string_msg(self.description.to_yaml()))

@@ -45,7 +45,7 @@ class CraneSwingEstimator(Node):
         self.inputs.add("boom_tip_pose", timeout=pose_timeout, length=3)
         self.inputs.add("payload_pose", timeout=pose_timeout, length=3)
         self.inputs.add("slew", timeout=float(p("slew_timeout", 0.5).value), length=1)
-        self.pub = self.create_publisher(JointState, "/crane/swing_estimate", stream_qos())
+        self.pub = self.create_publisher(JointState, "/crane/swing_estimate", publisher_qos())
         self.create_subscription(JointState, "/crane/joint_states", self.on_joints, stream_qos())
         self.create_subscription(PoseStamped, "/crane/boom_tip_pose", self.on_tip, stream_qos())
         self.create_subscription(PoseStamped, "/crane/payload_pose", self.on_payload, stream_qos())

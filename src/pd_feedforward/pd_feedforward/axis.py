@@ -31,7 +31,7 @@ from cablelab.plants.axis_control import pd_feedforward, sine_reference
 from cablelab.ros import convert
 from cablelab.ros.diagnostics import Diagnostics
 from cablelab.ros.inputs import InputMonitor
-from cablelab.ros.qos import DESCRIPTION_QOS, stream_qos
+from cablelab.ros.qos import DESCRIPTION_QOS, publisher_qos, stream_qos
 
 
 class AxisController(Node):
@@ -55,8 +55,8 @@ class AxisController(Node):
         self.inputs.add("reference", timeout=float(p("reference_timeout", 0.5).value), length=1,
                         required=self.source == "topic")
 
-        self.pub_cmd = self.create_publisher(Float64MultiArray, "/axis/effort_command", stream_qos())
-        self.pub_ref = self.create_publisher(JointTrajectory, "/axis/reference", stream_qos()) \
+        self.pub_cmd = self.create_publisher(Float64MultiArray, "/axis/effort_command", publisher_qos())
+        self.pub_ref = self.create_publisher(JointTrajectory, "/axis/reference", publisher_qos()) \
             if self.source == "sine" else None
         self.create_subscription(JointState, "/axis/joint_states", self.on_state, stream_qos())
         if self.source == "topic":

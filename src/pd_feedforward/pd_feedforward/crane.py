@@ -34,7 +34,7 @@ from cablelab.plants.crane_model import JOINTS, CraneParams
 from cablelab.ros import convert
 from cablelab.ros.diagnostics import Diagnostics
 from cablelab.ros.inputs import WARN, InputMonitor
-from cablelab.ros.qos import DESCRIPTION_QOS, stream_qos
+from cablelab.ros.qos import DESCRIPTION_QOS, publisher_qos, stream_qos
 from cablelab.sim.crane import reference_trajectory
 
 
@@ -66,8 +66,8 @@ class CraneController(Node):
         self.inputs.add("reference", timeout=float(p("reference_timeout", 0.5).value), length=3,
                         required=self.source == "topic")
         self.inputs.add("swing_estimate", timeout=0.5, length=2, required=False)
-        self.pub_cmd = self.create_publisher(Float64MultiArray, "/crane/effort_commands", stream_qos())
-        self.pub_ref = self.create_publisher(JointTrajectory, "/crane/reference", stream_qos()) \
+        self.pub_cmd = self.create_publisher(Float64MultiArray, "/crane/effort_commands", publisher_qos())
+        self.pub_ref = self.create_publisher(JointTrajectory, "/crane/reference", publisher_qos()) \
             if self.source == "excitation" else None
         self.create_subscription(JointState, "/crane/joint_states", self.on_state, stream_qos())
         self.create_subscription(JointState, "/crane/swing_estimate", self.on_swing, stream_qos())

@@ -2,6 +2,9 @@
 
 * ``/plant_description``: reliable, transient-local, keep-last depth 1 (a late joiner gets it);
 * streams (joint states, poses, commands, estimates): reliable, volatile, keep-last ``depth``;
+  publishers keep :data:`PUBLISHER_DEPTH` samples (:func:`publisher_qos`) so that a reliable
+  reader starved by a busy machine (a recorder) catches up instead of losing samples: a
+  keep-last writer overwrites what a reader has not acknowledged yet;
 * recorder subscriptions: reliable keep-all, so a briefly busy recorder delays rather than drops.
 """
 from __future__ import annotations
@@ -18,6 +21,16 @@ def stream_qos(depth: int = 100) -> QoSProfile:
     return QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=depth,
                       reliability=ReliabilityPolicy.RELIABLE,
                       durability=DurabilityPolicy.VOLATILE)
+
+
+PUBLISHER_DEPTH = 2000  # samples: 10 s of a 200 Hz stream
+
+
+def publisher_qos(depth: int = PUBLISHER_DEPTH) -> QoSProfile:
+    """:func:`stream_qos` for a publisher: the same (compatible) policies with a history deep
+    enough to ride out a reliable subscriber (e.g. the recorder) being descheduled for seconds.
+    A subscriber's own keep-last depth still bounds what a slow controller sees."""
+    return stream_qos(depth)
 
 
 def recorder_qos(transient_local: bool = False, reliable: bool = True) -> QoSProfile:
