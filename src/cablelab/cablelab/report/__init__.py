@@ -113,12 +113,13 @@ def build_report(ds: Dataset, model: Model, candidates, out_dir, *, folds: int =
                  + (f"; unidentifiable: {html.escape('; '.join(fin.linear.unidentifiable))}"
                     if fin.linear.unidentifiable else "") + "</p>")
     parts.append("<h2>Measured vs model</h2>")
-    rows = [[ch, _num(100 * mb["nrmse"], "{:.2f} %"), _num(100 * mf["nrmse"], "{:.2f} %"),
-             _num(mf["fit_percent"], "{:.1f} %"), _num(mf["pearson"], "{:.4f}"), _num(mf["mae"]),
-             _num(mf["mre"], "{:.3g}"), _num(mf["max_abs"])]
-            for ch, mb, mf in zip(ds.channels, met_b, met_f)]
-    parts.append(_table(rows, ["channel", "NRMSE nominal", "NRMSE final", "fit", "Pearson",
-                               "MAE", "MRE", "max abs"]))
+    rows = [[html.escape(f"{ch} [{unit}]"), _num(100 * mb["nrmse"], "{:.2f} %"),
+             _num(100 * mf["nrmse"], "{:.2f} %"), _num(mf["fit_percent"], "{:.1f} %"),
+             _num(mf["pearson"], "{:.4f}"), _num(mf["mae"]), _num(mf["mre"], "{:.3g}"),
+             _num(mf["max_abs"])]
+            for ch, unit, mb, mf in zip(ds.channels, ds.units, met_b, met_f)]
+    parts.append(_table(rows, ["channel [unit]", "NRMSE nominal", "NRMSE final", "fit", "Pearson",
+                               "MAE final [unit]", "MRE", "max abs final [unit]"]))
     parts.append("<img src='overlay.png'>")
     parts.append("<h2>Where the nominal model fails</h2><img src='residual_time.png'>")
     rows = [[s["channel"], f"{s['t_start']:.3f}", f"{s['t_end']:.3f}", f"{100 * s['error']:.1f} %"]

@@ -25,17 +25,39 @@ def _save(fig, path) -> None:
     plt.close(fig)
 
 
+def _robust_ylim(ax, *series) -> None:
+    """Zoom the y axis onto the bulk of the data when a few isolated spikes (e.g. one impact or a
+    lock-step hiccup) would otherwise flatten everything; says how many samples are off-scale."""
+    y = np.concatenate([np.asarray(v, dtype=float).ravel() for v in series])
+    y = y[np.isfinite(y)]
+    if y.size < 100:
+        return
+    lo, hi = np.percentile(y, [0.1, 99.9])
+    span = hi - lo
+    if span <= 0 or (y.max() - y.min()) < 1.6 * span:
+        return
+    lo, hi = lo - 0.15 * span, hi + 0.15 * span
+    ax.set_ylim(lo, hi)
+    n = int(np.sum((y < lo) | (y > hi)))
+    if n:
+        ax.text(0.01, 0.97, f"{n} samples off-scale", transform=ax.transAxes, fontsize=7,
+                va="top", color="gray")
+
+
 def overlay(path, t, y_meas, y_base, y_final, channels, units, labels=("nominal", "final")) -> None:
     """Measured vs model output per channel (nominal and final model)."""
     c = len(channels)
-    fig, axes = plt.subplots(c, 1, figsize=(10, 2.6 * c), squeeze=False, sharex=True)
+    fig, axes = plt.subplots(c, 1, figsize=(10, 2.6 * c + 0.4), squeeze=False, sharex=True)
     s = _thin(t.size)
     for i, ax in enumerate(axes[:, 0]):
         ax.plot(t[s], y_meas[s, i], color="k", lw=0.8, label="measured")
         ax.plot(t[s], y_base[s, i], color="tab:orange", lw=0.8, alpha=0.8, label=labels[0])
         ax.plot(t[s], y_final[s, i], color="tab:blue", lw=0.8, alpha=0.8, label=labels[1])
         ax.set_ylabel(f"{channels[i]} [{units[i]}]")
-        ax.legend(loc="upper right", fontsize=8)
+        _robust_ylim(ax, y_meas[:, i], y_base[:, i], y_final[:, i])
+    # one legend above the first panel, out of the data's way
+    axes[0, 0].legend(loc="lower right", bbox_to_anchor=(1.0, 1.0), ncol=3, fontsize=8, frameon=False)
+    axes[0, 0].set_title("measured vs model output", loc="left", fontsize=10)
     axes[-1, 0].set_xlabel("time [s]")
     _save(fig, path)
 
@@ -48,6 +70,7 @@ def residual_time(path, t, residual, segments, channels, units, title="") -> Non
     for i, ax in enumerate(axes[:, 0]):
         ax.plot(t[s], residual[s, i], color="tab:red", lw=0.7)
         ax.axhline(0, color="k", lw=0.5)
+        _robust_ylim(ax, residual[:, i])
         for seg in segments:
             if seg["channel"] == channels[i]:
                 ax.axvspan(seg["t_start"], seg["t_end"], color="gold", alpha=0.35)
@@ -85,9 +108,10 @@ def waterfall(path, steps) -> None:
     ax.bar(x, vals, color=colors)
     for xi, v in zip(x, vals):
         ax.text(xi, v, f"{v:.2f} %", ha="center", va="bottom", fontsize=9)
-    ax.set_xticks(x, labels, rotation=15, fontsize=8)
+    ax.set_ylim(0, 1.15 * max(max(vals), 1e-9))        # room for the value labels under the frame
+    ax.set_xticks(x, labels, rotation=15 if len(vals) > 3 else 0, fontsize=9)
     ax.set_ylabel("held-out NRMSE [%]")
-    ax.set_title("adding the missing effects")
+    ax.set_title("adding the missing effects (greedy, each significant on held-out data)")
     _save(fig, path)
 
 
