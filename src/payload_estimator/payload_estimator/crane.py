@@ -24,7 +24,7 @@ from cablelab.plants.crane_swing import SwingTracker
 from cablelab.ros import convert
 from cablelab.ros.diagnostics import Diagnostics
 from cablelab.ros.inputs import WARN, InputMonitor
-from cablelab.ros.qos import stream_qos
+from cablelab.ros.qos import publisher_qos, stream_qos
 
 NAMES = ["theta1", "theta2", "rope_length"]
 
