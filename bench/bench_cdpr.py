@@ -114,6 +114,20 @@ def estimator_in_process(bench: Bench, n: int = 5000) -> None:
         rclpy.try_shutdown()
 
 
+def _cpu_seconds(pid: int) -> float:
+    """User + system CPU time (s) used so far by process ``pid`` and its threads (Linux /proc)."""
+    import os
+
+    fields = open(f"/proc/{pid}/stat").read().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+def _load() -> str:
+    import os
+
+    return "/".join(f"{x:.1f}" for x in os.getloadavg())
+
+
 class _Client:
     """A plain rclpy node in this process on the launcher's domain."""
 
@@ -149,7 +163,7 @@ class _Client:
         rclpy.try_shutdown(context=self.ctx)
 
 
-def estimator_node(bench: Bench, launch, seconds: float) -> None:
+def estimator_node(bench: Bench, launch, seconds: float, params: dict) -> None:
     from geometry_msgs.msg import InertiaStamped
     from sensor_msgs.msg import JointState
     from std_msgs.msg import String
@@ -165,7 +179,7 @@ def estimator_node(bench: Bench, launch, seconds: float) -> None:
     bench.section(f"estimator node at 1 kHz for {seconds:g} s (separate process, DDS)")
     desc = default_description()
     c = desc.cdpr
-    launch.node("estimator", "payload_estimator", "cdpr", {})
+    launch.node("estimator", "payload_estimator", "cdpr", params)
     cl = _Client(launch.domain_id)
     q = stream_qos(1000)
     pub_d = cl.node.create_publisher(String, "/plant_description", DESCRIPTION_QOS)
@@ -187,6 +201,9 @@ def estimator_node(bench: Bench, launch, seconds: float) -> None:
     T = feedforward_tensions(geom, 615.0, np.zeros((n, 3)))
     names = [f"cable_{i}" for i in range(1, 9)]
     sent = {}
+    pid = launch.procs["estimator"].popen.pid
+    cpu0 = _cpu_seconds(pid)
+    load0 = _load()
     t0 = time.monotonic()
     k = 0
     while k < n:
@@ -203,6 +220,7 @@ def estimator_node(bench: Bench, launch, seconds: float) -> None:
             bench.log(f"  sent {k}/{n}, ETA {max(0.0, seconds - (time.monotonic() - t0)):.0f} s")
     elapsed = time.monotonic() - t0
     cl.spin(3.0)
+    cpu = _cpu_seconds(pid) - cpu0
     lat = np.array([recv[k] - sent[k] for k in recv if k in sent]) * 1e3
     d = cl.diag.get("payload_estimator", {})
     bench.row(case="estimator node: estimates / tension samples", sent=n, received=len(recv),
@@ -211,14 +229,17 @@ def estimator_node(bench: Bench, launch, seconds: float) -> None:
               unit="ms", target="< 1 ms")
     bench.row(case="end-to-end latency publish -> estimate received", value=float(np.median(lat)),
               p99=float(np.quantile(lat, 0.99)), unit="ms (median, p99)", target="")
+    bench.row(case="estimator process CPU per sample (all its threads)", value=1000 * cpu / n, unit="ms",
+              target="")
+    bench.log(f"  load average before/after: {load0} / {_load()}")
     cl.close()
     launch.stop("estimator")
 
 
-def closed_loop_1khz(bench: Bench, launch, seconds: float) -> None:
+def closed_loop_1khz(bench: Bench, launch, seconds: float, params: dict) -> None:
     bench.section(f"closed loop sim -> estimator -> controller -> sim at 1 kHz, real time, {seconds:g} s")
-    launch.node("estimator", "payload_estimator", "cdpr", {})
-    launch.node("controller", "pd_feedforward", "cdpr", {})
+    launch.node("estimator", "payload_estimator", "cdpr", params)
+    launch.node("controller", "pd_feedforward", "cdpr", params)
     cl = _Client(launch.domain_id)
     from sensor_msgs.msg import JointState
     from std_msgs.msg import Float64MultiArray
@@ -234,12 +255,21 @@ def closed_loop_1khz(bench: Bench, launch, seconds: float) -> None:
         cl.spin(0.2)
     launch.node("sim", "cable_sim_node", "cdpr", {"rate": 1000.0, "real_time": True, "payload_mass": 249.0,
                                                   "duration": seconds + 1.0, "settle": 1.0,
-                                                  "extras_every": 10})
+                                                  "extras_every": 10} | params)
+    pids = {name: launch.procs[name].popen.pid for name in ("sim", "estimator", "controller")}
+    cpu0 = {name: _cpu_seconds(pid) for name, pid in pids.items()}
+    load0 = _load()
     t0 = time.monotonic()
+    cpu = {}
     while launch.procs["sim"].alive() and time.monotonic() - t0 < 20 * seconds + 60:
         cl.spin(0.2)
         if "cable_sim_node" in cl.diag:
             last = dict(cl.diag["cable_sim_node"])
+        for name, pid in pids.items():
+            try:
+                cpu[name] = _cpu_seconds(pid) - cpu0[name]
+            except OSError:
+                pass
     wall = time.monotonic() - t0
     sim_t = float(last.get("sim time s", "nan"))
     brakes = int(last.get("brake steps after the first command", "-1"))
@@ -250,6 +280,10 @@ def closed_loop_1khz(bench: Bench, launch, seconds: float) -> None:
               unit="", target="1")
     bench.row(case="simulator steps braked (no fresh command) after the first one", value=brakes, unit=f"of {steps}",
               target="0")
+    bench.row(case="CPU per step: sim / estimator / controller (all threads)",
+              value=" / ".join(f"{1000 * cpu.get(k, float('nan')) / max(steps, 1):.3f}" for k in pids),
+              unit="ms", target="")
+    bench.log(f"  load average before/after: {load0} / {_load()}")
     ctl = cl.diag.get("pd_feedforward", {})
     est = cl.diag.get("payload_estimator", {})
     bench.row(case="controller / estimator processing p99 (in node)",
@@ -313,12 +347,18 @@ def main(argv=None) -> int:
     bench.parser.add_argument("--skip-nodes", action="store_true")
     bench.parser.add_argument("--only-loop", action="store_true", help="only the 1 kHz closed loop")
     bench.parser.add_argument("--paper", action="store_true", help="001 Tables I-II, Fig. 15 instead")
+    bench.parser.add_argument("--executor", choices=("fast", "rclpy"), default="fast",
+                              help="spin the nodes with FastExecutor (default) or rclpy's "
+                                   "SingleThreadedExecutor (fast_executor:=false), for comparison")
+    bench.parser.add_argument("--nodes-only", action="store_true", help="skip the offline parts")
+    bench.parser.add_argument("--rt-priority", type=int, default=0,
+                              help="run the nodes under SCHED_FIFO at this priority (rt_priority)")
     args = bench.parse(argv)
     if args.paper:
         paper_tables(bench)
         bench.done()
         return 0
-    if not args.only_loop:
+    if not args.only_loop and not args.nodes_only:
         offline_estimation(bench, args.samples)
         offline_simulation(bench)
         estimator_in_process(bench)
@@ -328,9 +368,12 @@ def main(argv=None) -> int:
         tmp = Path(tempfile.mkdtemp(prefix="bench-cdpr-"))
         with Launcher(log_dir=tmp / "logs") as launch:
             bench.log(f"ROS_DOMAIN_ID {launch.domain_id}, logs in {launch.log_dir}")
+            params = {} if args.executor == "fast" else {"fast_executor": False}
+            if args.rt_priority:
+                params["rt_priority"] = args.rt_priority
             if not args.only_loop:
-                estimator_node(bench, launch, args.seconds)
-            closed_loop_1khz(bench, launch, args.seconds)
+                estimator_node(bench, launch, args.seconds, params)
+            closed_loop_1khz(bench, launch, args.seconds, params)
     bench.done()
     return 0
 

@@ -20,17 +20,26 @@ def ros_context(domain_id):
     rclpy.try_shutdown()
 
 
+def _capture(out: list, cls):
+    """A stand-in for Publisher.publish that keeps messages (bytes are deserialised as cls)."""
+    from rclpy.serialization import deserialize_message
+
+    return lambda m: out.append(deserialize_message(m, cls) if isinstance(m, bytes) else m)
+
+
 def test_adapters_survive_bad_input(ros_context):
     from cablelab.ros import convert
     from cable_sim_node.cdpr import CdprSimNode
     from payload_estimator.cdpr import CdprPayloadEstimator
     from pd_feedforward.cdpr import CdprController
+    from geometry_msgs.msg import InertiaStamped
     from std_msgs.msg import Float64MultiArray
 
     sim, est, ctl = CdprSimNode(), CdprPayloadEstimator(), CdprController()
     sent, estimates = [], []
-    ctl.pub_cmd.publish = sent.append
-    est.pub.publish = estimates.append
+    # the nodes publish pre-serialised bytes: deserialised here by rclpy (checks the bytes too)
+    ctl.pub_cmd.publish = _capture(sent, Float64MultiArray)
+    est.pub.publish = _capture(estimates, InertiaStamped)
     nan = float("nan")
     try:
         # simulator: bad commands rejected; without a command the brakes hold the platform
@@ -102,6 +111,9 @@ def test_adapters_survive_bad_input(ros_context):
         assert np.all(heavy > nominal)       # more mass -> more torque on every winch
         # every command keeps the cables taut (floor) and is finite
         assert all(np.all(np.isfinite(s.data)) and min(s.data) > 0 for s in sent)
+        # the command names the state it answers; the simulator reads it (lock-step matching)
+        sim.on_command(sent[-1])
+        assert sim.u_stamp == pytest.approx(t, abs=1e-9) and np.array_equal(sim.u, heavy)
     finally:
         for n in (sim, est, ctl):
             n.destroy_node()
@@ -132,8 +144,8 @@ def _wait_until_recorded_caught_up(launcher, bag_dir, timeout: float, quiet: flo
 
 
 def test_closed_loop_over_dds(launcher, tmp_path):
-    """sim (lock-step, as fast as possible) + estimator + controller (PDFF) + recorder as separate
-    processes: the recorded live estimate is the true moving mass (615 kg) within 1 %, one command
+    """sim (lock-step, as fast as possible) -> estimator -> controller (PDFF, waits for the estimate
+    of each state) -> sim, + recorder, as separate processes: the recorded live estimate is the true moving mass (615 kg) within 1 %, one command
     and one estimate per sample, and the platform follows the reference within 5 mm."""
     from cablelab.bags import open_bag
 
@@ -141,7 +153,10 @@ def test_closed_loop_over_dds(launcher, tmp_path):
     launcher.start("recorder", [sys.executable, "-m", "cablelab.cli", "record", "--plant", "cdpr",
                                 "-o", bag_dir, "--quiet"])
     launcher.node("estimator", "payload_estimator", "cdpr", {})
-    launcher.node("controller", "pd_feedforward", "cdpr", {})
+    # lock-step through the estimator too: each command waits for the estimate of its state's
+    # stamp, so a starved estimator delays the loop instead of leaving the feedforward on a stale
+    # (then nominal) mass
+    launcher.node("controller", "pd_feedforward", "cdpr", {"estimate_wait": 5.0})
     launcher.wait_for_topics({"/diagnostics": 2}, timeout=60)
     launcher.node("sim", "cable_sim_node", "cdpr", {"real_time": False, "payload_mass": 249.0,
                                                     "duration": 8.0, "settle": 1.0,

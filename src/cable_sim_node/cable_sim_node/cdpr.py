@@ -23,7 +23,11 @@ ROS parameters: ``description`` (YAML file or text; default CAROCA), ``payload_m
 which the node exits; 0 = run until stopped), ``command_timeout`` (s wall, real time),
 ``lockstep_timeout`` (s wall, lock-step), ``extras_every`` (publish /clock, the measured pose and
 the ground truth every k-th step: lighter at 1 kHz), ``wait_for_subscribers`` (time starts only
-once /cdpr/joint_states has this many subscribers, max 60 s: no sample lost to discovery), ``seed``.
+once /cdpr/joint_states has this many subscribers, max 60 s: no sample lost to discovery), ``seed``,
+``fast_executor`` (default true: spun by :class:`cablelab.ros.fastspin.FastExecutor`; false = rclpy's
+SingleThreadedExecutor), ``rt_priority`` (0 = normal scheduling; 1-99 = SCHED_FIFO in real-time
+mode, ignored in lock-step, see :func:`cablelab.ros.fastspin.set_realtime_priority`). Outgoing messages are pre-serialised templates
+(:class:`cablelab.ros.rawmsg.RawTemplate`): each step only patches stamps and numbers.
 """
 from __future__ import annotations
 
@@ -43,7 +47,9 @@ from cablelab.plants.cdpr_trajectory import pick_and_place
 from cablelab.ros import convert
 from cablelab.ros.diagnostics import Diagnostics
 from cablelab.ros.inputs import WARN, InputMonitor
+from cablelab.ros.fastspin import FastExecutor, set_realtime_priority, supports
 from cablelab.ros.qos import DESCRIPTION_QOS, stream_qos
+from cablelab.ros.rawmsg import RawTemplate
 from cablelab.sim.cdpr import CdprSim, CdprTruth, default_description_path
 
 
@@ -128,10 +134,43 @@ class CdprSimNode(Node):
         self.pub_clock = self.create_publisher(Clock, "/clock", stream_qos(10))
         self.pub_desc = self.create_publisher(String, "/plant_description", DESCRIPTION_QOS)
         self.pub_desc.publish(convert.string_msg(self.description.to_yaml()))
+        self.fast = bool(p("fast_executor", True).value)
+        rt = int(p("rt_priority", 0).value)
+        if rt > 0 and not self.real_time:
+            self.get_logger().warning("rt_priority ignored: lock-step mode runs as fast as possible")
+        elif rt > 0:
+            self.get_logger().info(f"rt_priority: {set_realtime_priority(rt)}")
+        self._templates()
         self.create_subscription(Float64MultiArray, "/cdpr/effort_commands", self.on_command, q)
         self.diag = Diagnostics(self, update=self.status)
         self.timer = self.create_timer(1.0 / self.rate if self.real_time else 0.0002, self.tick)
         self.publish_state()
+
+    def executor_factory(self):
+        """The runner spins this node with :class:`FastExecutor` (unless ``fast_executor`` is
+        false): one prebuilt wait set, queued commands taken in one wake-up."""
+        from rclpy.executors import SingleThreadedExecutor
+
+        return FastExecutor() if self.fast and supports(self) else SingleThreadedExecutor()
+
+    def _templates(self) -> None:
+        """Pre-serialised messages (fixed names and lengths): each step patches the numbers."""
+        z, z3 = np.zeros(self.n), np.zeros(3)
+        self.t_js = RawTemplate(convert.joint_state_msg(0.0, [f"winch_{i}" for i in range(1, self.n + 1)],
+                                                        z, z, z))
+        self.t_ten = RawTemplate(convert.joint_state_msg(0.0, [f"cable_{i}" for i in range(1, self.n + 1)],
+                                                         z, None, z))
+        self.t_ref = RawTemplate(convert.multidof_msg(0.0, z3, [0.0, 0.0, 0.0, 1.0], z3, None, z3, None))
+        self.t_clock = RawTemplate(convert.clock_msg(0.0))
+        self.t_pose = RawTemplate(convert.pose_msg(0.0, z3, [0.0, 0.0, 0.0, 1.0]))
+        self.t_tpose = RawTemplate(convert.pose_msg(0.0, z3, [0.0, 0.0, 0.0, 1.0]))
+        self.t_tpay = RawTemplate(convert.inertia_msg(0.0, 0.0, z3))
+        self.t_tpay["inertia.m"][0] = self.sim.truth.total_mass
+        self.t_tpay.vector("inertia.com")[:] = self.sim.truth.total_com
+        r = self.t_ref
+        self._ref_views = (r.vector("points[0].transforms[0].translation"),
+                           r.vector("points[0].velocities[0].linear"),
+                           r.vector("points[0].accelerations[0].linear"))
 
     # ------------------------------------------------------------------ callbacks
     def status(self):
@@ -224,7 +263,7 @@ class CdprSimNode(Node):
             self.brake_q = None
             self.sim.step(self.u, self.nstep)
         self.k += 1
-        if self.sim.truth_state()["slack"].any():
+        if self.sim.slack().any():
             self.slack_steps += 1
         self.publish_state()
         if self.duration and self.sim.time >= self.duration:
@@ -241,27 +280,48 @@ class CdprSimNode(Node):
         return self.brake_u + kp * (self.brake_q - ms["motor_angle"]) - kd * ms["motor_velocity"]
 
     def publish_state(self) -> None:
+        """One sample of every output topic, from the pre-serialised templates (same bytes as
+        the convert.* messages, built without an rclpy message object per sample)."""
         sim, t = self.sim, self.sim.time
         ms = sim.measure()
-        tp, tq = sim.truth_pose()
         extra = self.k % self.extras_every == 0          # /clock, pose and truth: maybe decimated
         if extra:
-            self.pub_clock.publish(convert.clock_msg(t))
+            self.t_clock.stamp(t, "clock")
+            self.pub_clock.publish(self.t_clock.data())
         if self.publish_reference:
             pos, vel, acc = self.reference(t)
-            self.pub_ref.publish(convert.multidof_msg(t, pos, [0.0, 0.0, 0.0, 1.0], vel, None, acc, None))
-        names = [f"winch_{i}" for i in range(1, self.n + 1)]
-        self.pub_js.publish(convert.joint_state_msg(t, names, ms["motor_angle"], ms["motor_velocity"],
-                                                    ms["motor_torque"]))
-        self.pub_ten.publish(convert.joint_state_msg(t, [f"cable_{i}" for i in range(1, self.n + 1)],
-                                                     ms["cable_length"], None, ms["tension"]))
-        if self.publish_pose and extra:
-            self.pub_pose.publish(convert.pose_msg(t, ms["position"], _wxyz_to_xyzw(ms["quat"])))
+            tr, tv, ta = self._ref_views
+            tr[:], tv[:], ta[:] = pos, vel, acc
+            self.t_ref.stamp(t)
+            self.pub_ref.publish(self.t_ref.data())
+        js = self.t_js
+        js.stamp(t)
+        js["position"][:] = ms["motor_angle"]
+        js["velocity"][:] = ms["motor_velocity"]
+        js["effort"][:] = ms["motor_torque"]
+        self.pub_js.publish(js.data())
+        ten = self.t_ten
+        ten.stamp(t)
+        ten["position"][:] = ms["cable_length"]
+        ten["effort"][:] = ms["tension"]
+        self.pub_ten.publish(ten.data())
         if extra:
-            self.pub_tpose.publish(convert.pose_msg(t, tp, _wxyz_to_xyzw(tq)))
-            self.pub_tpay.publish(convert.inertia_msg(t, sim.truth.total_mass, sim.truth.total_com))
+            if self.publish_pose:
+                self._pose(self.t_pose, t, ms["position"], ms["quat"])
+                self.pub_pose.publish(self.t_pose.data())
+            tp, tq = sim.truth_pose()
+            self._pose(self.t_tpose, t, tp, tq)
+            self.pub_tpose.publish(self.t_tpose.data())
+            self.t_tpay.stamp(t)
+            self.pub_tpay.publish(self.t_tpay.data())
         self._last_pub_wall = time.monotonic()
         self.commands_at_pub = self.commands
+
+    @staticmethod
+    def _pose(tpl: RawTemplate, t: float, position, quat_wxyz) -> None:
+        tpl.stamp(t)
+        tpl.vector("pose.position")[:] = position
+        tpl.vector("pose.orientation", "xyzw")[:] = _wxyz_to_xyzw(quat_wxyz)
 
 
 def make_node(args) -> Node:

@@ -12,7 +12,12 @@ and is reported on /diagnostics; slack cables are reported as WARN.
 ROS parameters: ``description``, ``model`` ("II" | "I"), ``tensions`` ("dynamometer" |
 ``"motor"``), ``pose`` ("desired" | "measured"), ``platform_inertia`` (bool), ``coulomb``,
 ``viscous`` (friction compensation, N m, N m s/rad), ``pulley_radius`` (m, 0 = the
-description's), ``stale_after`` (s of stamps between tension and pose), ``input_timeout`` (s wall).
+description's), ``stale_after`` (s of stamps between tension and pose), ``input_timeout`` (s wall),
+``fast_executor`` (default true: :class:`cablelab.ros.fastspin.FastExecutor`; false = rclpy's
+SingleThreadedExecutor), ``rt_priority`` (0 = normal scheduling; 1-99 = SCHED_FIFO, see
+:func:`cablelab.ros.fastspin.set_realtime_priority`). The estimate goes out as a pre-serialised message
+(:class:`cablelab.ros.rawmsg.RawTemplate`); only the topic the ``tensions`` source needs is
+subscribed (``/cdpr/cable_tensions`` or ``/cdpr/joint_states``).
 """
 from __future__ import annotations
 
@@ -31,7 +36,9 @@ from cablelab.plants.cdpr_live import EstimatorConfig, LiveEstimator
 from cablelab.ros import convert
 from cablelab.ros.diagnostics import Diagnostics
 from cablelab.ros.inputs import ERROR, WARN, InputMonitor
+from cablelab.ros.fastspin import FastExecutor, set_realtime_priority, supports
 from cablelab.ros.qos import DESCRIPTION_QOS, stream_qos
+from cablelab.ros.rawmsg import RawTemplate
 
 
 class CdprPayloadEstimator(Node):
@@ -68,13 +75,29 @@ class CdprPayloadEstimator(Node):
         text = p("description", "").value
         if text:
             self.set_description(load_description(text))
-        self.create_subscription(JointState, "/cdpr/cable_tensions", self.on_tensions, q)
-        self.create_subscription(JointState, "/cdpr/joint_states", self.on_joints, q)
+        # the pose first: when both wait in one wake-up, a tension sample meets the pose of its
+        # stamp (FastExecutor and rclpy's executor take ready topics in creation order)
         if self.config.pose == "desired":
             self.create_subscription(MultiDOFJointTrajectory, "/cdpr/reference", self.on_reference, q)
         else:
             self.create_subscription(PoseStamped, "/cdpr/platform_pose", self.on_pose, q)
+        if self.config.tensions == "motor":        # (1 kHz of traffic nobody reads otherwise)
+            self.create_subscription(JointState, "/cdpr/joint_states", self.on_joints, q)
+        else:
+            self.create_subscription(JointState, "/cdpr/cable_tensions", self.on_tensions, q)
+        self.fast = bool(p("fast_executor", True).value)
+        rt = int(p("rt_priority", 0).value)
+        if rt > 0:
+            self.get_logger().info(f"rt_priority: {set_realtime_priority(rt)}")
+        self.t_est = RawTemplate(convert.inertia_msg(0.0, 0.0, [0.0, 0.0, float("nan")]))
+        self._est_m, self._est_com = self.t_est["inertia.m"], self.t_est.vector("inertia.com")
         self.diag = Diagnostics(self, update=self.status)
+
+    def executor_factory(self):
+        """Spun by :class:`FastExecutor` (unless ``fast_executor`` is false)."""
+        from rclpy.executors import SingleThreadedExecutor
+
+        return FastExecutor() if self.fast and supports(self) else SingleThreadedExecutor()
 
     # ------------------------------------------------------------------ inputs
     def set_description(self, desc) -> None:
@@ -95,11 +118,19 @@ class CdprPayloadEstimator(Node):
                 self.last_problem = f"bad /plant_description: {exc}"
 
     def on_reference(self, msg: MultiDOFJointTrajectory) -> None:
-        d = convert.multidof_arrays(msg)
-        if self.inputs.accept("pose", d["position"], time.monotonic()):
-            q = d["quaternion"]
-            self.pose = (d["t"], d["position"], None if q is None else q[[3, 0, 1, 2]],
-                         d["linear_acceleration"])
+        pts = msg.points
+        if not pts or not pts[0].transforms:
+            self.inputs.accept("pose", None, time.monotonic())        # counted as rejected
+            return
+        pt = pts[0]
+        tr, ro = pt.transforms[0].translation, pt.transforms[0].rotation
+        pos = np.array((tr.x, tr.y, tr.z))
+        if self.inputs.accept("pose", pos, time.monotonic()):
+            acc = None
+            if pt.accelerations:
+                a = pt.accelerations[0].linear
+                acc = np.array((a.x, a.y, a.z))
+            self.pose = (convert.from_stamp(msg.header.stamp), pos, np.array((ro.w, ro.x, ro.y, ro.z)), acc)
 
     def on_pose(self, msg: PoseStamped) -> None:
         t, pos, q = convert.pose_arrays(msg)
@@ -148,7 +179,10 @@ class CdprPayloadEstimator(Node):
             self.last_problem = self.estimator.status[-1][1]
             return
         m, com = res
-        self.pub.publish(convert.inertia_msg(t, m, [com[0], com[1], float("nan")]))
+        self.t_est.stamp(t)                                    # pre-serialised InertiaStamped
+        self._est_m[0] = m
+        self._est_com[:2] = com[:2]
+        self.pub.publish(self.t_est.data())
         self.published += 1
         self.latency.append(time.perf_counter() - t0)
         if len(self.latency) > 100000:

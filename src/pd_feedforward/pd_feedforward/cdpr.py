@@ -13,7 +13,13 @@ ROS parameters: ``description``, ``feedforward`` (bool), ``nominal_mass`` (kg, 0
 description's platform_mass), ``kp`` (N m/rad), ``kd`` (N m s/rad), ``coulomb``, ``viscous``
 (friction compensation), ``min_tension`` (N), ``preload`` (N), ``max_torque`` (N m), ``model``
 ("II" | "I"), ``estimate_timeout`` (s of stamps), ``reference_timeout``, ``state_timeout`` (s wall),
-``sync_wait`` (s wall a state waits for the reference of its stamp before the latest one is used).
+``sync_wait`` (s wall a state waits for the reference of its stamp before the latest one is used),
+``estimate_wait`` (s wall a state waits for the estimate of its stamp, 0 = never: use the latest;
+set it with a lock-step simulator to make sim -> estimator -> controller one deterministic chain),
+``fast_executor`` (default true: :class:`cablelab.ros.fastspin.FastExecutor`; false = rclpy's
+SingleThreadedExecutor), ``rt_priority`` (0 = normal scheduling; 1-99 = SCHED_FIFO, see
+:func:`cablelab.ros.fastspin.set_realtime_priority`). Commands go out as pre-serialised messages
+(:class:`cablelab.ros.rawmsg.RawTemplate`).
 """
 from __future__ import annotations
 
@@ -33,7 +39,9 @@ from cablelab.plants.cdpr_live import ControllerConfig, LiveController
 from cablelab.ros import convert
 from cablelab.ros.diagnostics import Diagnostics
 from cablelab.ros.inputs import ERROR, WARN, InputMonitor
+from cablelab.ros.fastspin import FastExecutor, set_realtime_priority, supports
 from cablelab.ros.qos import DESCRIPTION_QOS, stream_qos
+from cablelab.ros.rawmsg import RawTemplate
 
 
 class CdprController(Node):
@@ -77,8 +85,21 @@ class CdprController(Node):
         self.create_subscription(JointState, "/cdpr/joint_states", self.on_state, q)
         self.pending = None
         self.sync_wait = float(p("sync_wait", 0.005).value)
+        self.estimate_wait = float(p("estimate_wait", 0.0).value)
+        self.est_stamp = None       # newest estimate stamp received (valid or not)
         self.create_timer(0.002, self.on_timer)
+        self.fast = bool(p("fast_executor", True).value)
+        rt = int(p("rt_priority", 0).value)
+        if rt > 0:
+            self.get_logger().info(f"rt_priority: {set_realtime_priority(rt)}")
+        self._cmd_templates = {}        # label length -> (pre-serialised command, data view, label offset)
         self.diag = Diagnostics(self, update=self.status)
+
+    def executor_factory(self):
+        """Spun by :class:`FastExecutor` (unless ``fast_executor`` is false)."""
+        from rclpy.executors import SingleThreadedExecutor
+
+        return FastExecutor() if self.fast and supports(self) else SingleThreadedExecutor()
 
     def set_description(self, desc) -> None:
         if desc.cdpr is None:
@@ -99,19 +120,34 @@ class CdprController(Node):
                 self.last_problem = f"bad /plant_description: {exc}"
 
     def on_reference(self, msg: MultiDOFJointTrajectory) -> None:
-        d = convert.multidof_arrays(msg)
-        if self.inputs.accept("reference", d["position"], time.monotonic()):
-            q = d["quaternion"]
-            self.ref = (d["t"], d["position"], None if q is None else q[[3, 0, 1, 2]],
-                        d["linear_velocity"], d["linear_acceleration"])
+        pts = msg.points
+        if not pts or not pts[0].transforms:
+            self.inputs.accept("reference", None, time.monotonic())   # counted as rejected
+            return
+        pt = pts[0]
+        tr, ro = pt.transforms[0].translation, pt.transforms[0].rotation
+        pos = np.array((tr.x, tr.y, tr.z))
+        if self.inputs.accept("reference", pos, time.monotonic()):
+            vel = acc = None
+            if pt.velocities:
+                v = pt.velocities[0].linear
+                vel = np.array((v.x, v.y, v.z))
+            if pt.accelerations:
+                a = pt.accelerations[0].linear
+                acc = np.array((a.x, a.y, a.z))
+            self.ref = (convert.from_stamp(msg.header.stamp), pos, np.array((ro.w, ro.x, ro.y, ro.z)),
+                        vel, acc)
             self.try_command()
 
     def on_estimate(self, msg: InertiaStamped) -> None:
         t, m, com = convert.inertia_arrays(msg)
+        self.est_stamp = t if self.est_stamp is None else max(self.est_stamp, t)
         if not self.inputs.accept("payload_estimate", [m], time.monotonic()):
+            self.try_command()
             return
         if self.controller is not None and not self.controller.estimate(t, m, com[:2]):
             self.estimates_rejected += 1
+        self.try_command()                  # a state may have been waiting for this estimate
 
     def on_state(self, msg: JointState) -> None:
         """Keep the state; command now if the reference of its stamp is here (else a little later,
@@ -119,18 +155,30 @@ class CdprController(Node):
         self.pending = (msg, time.monotonic())
         self.try_command()
 
+    def _waiting_for(self, t: float) -> tuple[bool, bool]:
+        """(reference of stamp t not here yet, estimate of stamp t awaited and not here yet)."""
+        ref = self.ref is not None and self.ref[0] < t - 1e-9
+        est = (self.estimate_wait > 0 and self.feedforward
+               and (self.est_stamp is None or self.est_stamp < t - 1e-9))
+        return ref, est
+
     def try_command(self, force: bool = False) -> None:
         if self.pending is None:
             return
         msg, _ = self.pending
         t = convert.from_stamp(msg.header.stamp)
-        if not force and self.ref is not None and self.ref[0] < t - 1e-9:
-            return                          # the reference of this stamp is probably on its way
+        if not force and any(self._waiting_for(t)):
+            return                  # the reference (or awaited estimate) of this stamp is on its way
         self.pending = None
         self.command(msg)
 
     def on_timer(self) -> None:
-        if self.pending is not None and time.monotonic() - self.pending[1] > self.sync_wait:
+        if self.pending is None:
+            return
+        age = time.monotonic() - self.pending[1]
+        ref, est = self._waiting_for(convert.from_stamp(self.pending[0].header.stamp))
+        if (ref and age > self.sync_wait) or (not ref and est and age > self.estimate_wait) \
+                or (not ref and not est):
             self.try_command(force=True)
 
     def command(self, msg: JointState) -> None:
@@ -158,14 +206,27 @@ class CdprController(Node):
             self.last_skip = time.monotonic()
             self.last_problem = self.controller.status[-1][1]
             return
-        cmd = convert.float_array_msg(tau)
         # optional: the stamp of the state this command answers (a lock-step simulator matches it)
-        cmd.layout.dim = [MultiArrayDimension(label=f"winch stamp={t:.9f}", size=len(tau), stride=len(tau))]
-        self.pub_cmd.publish(cmd)
+        self.pub_cmd.publish(self._command_bytes(tau, f"winch stamp={t:.9f}"))
         self.sent += 1
         self.latency.append(time.perf_counter() - t0)
         if len(self.latency) > 100000:
             del self.latency[:50000]
+
+    def _command_bytes(self, tau: np.ndarray, label: str) -> bytes:
+        """Serialised Float64MultiArray (data = tau, layout.dim[0].label = label) from a
+        pre-serialised template per label length (only the digits and the torques change)."""
+        entry = self._cmd_templates.get((len(label), len(tau)))
+        if entry is None:
+            msg = convert.float_array_msg(tau)
+            msg.layout.dim = [MultiArrayDimension(label=label, size=len(tau), stride=len(tau))]
+            tpl = RawTemplate(msg)
+            entry = (tpl, tpl["data"], tpl.text_offset(label))
+            self._cmd_templates[(len(label), len(tau))] = entry
+        tpl, data, off = entry
+        data[:] = tau
+        tpl.write_text(off, label)
+        return tpl.data()
 
     def status(self):
         level, msg, values = self.inputs.status(time.monotonic())

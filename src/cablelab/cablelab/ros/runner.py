@@ -6,6 +6,9 @@
 :func:`run_node`. ``--help`` never needs ROS. Standard ROS arguments (``--ros-args -p name:=value
 --params-file f.yaml -r from:=to``) pass through to rclpy.
 
+A node may define ``executor_factory()`` returning the executor to spin it with (e.g.
+:class:`.fastspin.FastExecutor`); default rclpy's SingleThreadedExecutor.
+
 Shutdown: SIGINT and SIGTERM stop the spin loop; the node's ``drain(executor)`` method (if any)
 processes what is already queued, its ``shutdown()`` method (if any) runs
 (e.g. the recorder closes its bag), then the node is destroyed and rclpy shut down; exit code 0.
@@ -67,7 +70,8 @@ def run_node(node_factory, args, ros_args: list[str], prog: str) -> int:
         except CablelabError as exc:
             print(f"{prog}: error: {exc}", file=sys.stderr)
             return 2
-        executor = SingleThreadedExecutor()
+        factory = getattr(node, "executor_factory", None)   # a node may bring a leaner executor
+        executor = factory() if callable(factory) else SingleThreadedExecutor()
         executor.add_node(node)
         while not stop.event.is_set() and rclpy.ok() and not getattr(node, "done", False):
             executor.spin_once(timeout_sec=0.1)

@@ -261,13 +261,17 @@ class CdprSim:
         q = self.data.qpos[self._free_q:self._free_q + 7]
         return q[:3].copy(), q[3:].copy()
 
+    def slack(self) -> np.ndarray:
+        """(n,) True where a cable is slack (shorter than its taut length: the tendon limit)."""
+        return self.data.ten_length < self.model.tendon_range[:, 1] - 1e-6
+
     def truth_state(self) -> dict:
         """Ground truth: pose, twist, tensions, swivel angles, slack flags."""
         d = self.data
         p, q = self.truth_pose()
         tension = -d.sensordata[:self.n] if d.sensordata[:self.n].sum() < 0 else d.sensordata[:self.n].copy()
         out = {"position": p, "quat": q, "velocity": d.qvel[self._free_v:self._free_v + 3].copy(),
-               "tension": np.abs(tension), "slack": d.ten_length < self.model.tendon_range[:, 1] - 1e-6}
+               "tension": np.abs(tension), "slack": self.slack()}
         if self.truth.pulleys:
             out["swivel"] = d.qpos[self._swivel_q].copy()
         return out

@@ -1,0 +1,120 @@
+"""The 1 kHz node helpers: pre-serialised message templates (oracle: rclpy's own serialiser and
+deserialiser) and FastExecutor (every message delivered once, in order, timers and services)."""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+
+
+@pytest.fixture
+def ros_context(domain_id):
+    import rclpy
+
+    rclpy.init(domain_id=domain_id)
+    yield
+    rclpy.try_shutdown()
+
+
+def test_templates_equal_rclpy_serialisation():
+    from geometry_msgs.msg import InertiaStamped, PoseStamped
+    from rclpy.serialization import deserialize_message, serialize_message
+    from sensor_msgs.msg import JointState
+    from std_msgs.msg import Float64MultiArray, MultiArrayDimension
+    from trajectory_msgs.msg import MultiDOFJointTrajectory
+
+    from cablelab.ros import convert
+    from cablelab.ros.rawmsg import RawTemplate
+
+    rng = np.random.default_rng(1)
+    names = [f"winch_{i}" for i in range(1, 9)]
+    z = np.zeros(8)
+    tpl = RawTemplate(convert.joint_state_msg(0.0, names, z, z, z))
+    for t in (0.0, 1.001, 12345.678901234):
+        q, qd, e = rng.normal(size=(3, 8))
+        tpl.stamp(t)
+        tpl["position"][:], tpl["velocity"][:], tpl["effort"][:] = q, qd, e
+        # byte for byte what rclpy serialises for the same message object
+        assert tpl.data() == bytes(serialize_message(convert.joint_state_msg(t, names, q, qd, e)))
+        back = deserialize_message(tpl.data(), JointState)
+        assert back.header.stamp == convert.to_stamp(t) and list(back.name) == names
+        assert np.array_equal(back.position, q) and np.array_equal(back.effort, e)
+
+    ref = RawTemplate(convert.multidof_msg(0.0, np.zeros(3), [0, 0, 0, 1.0], np.zeros(3), None, np.zeros(3), None))
+    p, v, a = rng.normal(size=(3, 3))
+    ref.vector("points[0].transforms[0].translation")[:] = p
+    ref.vector("points[0].velocities[0].linear")[:] = v
+    ref.vector("points[0].accelerations[0].linear")[:] = a
+    ref.stamp(2.5)
+    d = convert.multidof_arrays(deserialize_message(ref.data(), MultiDOFJointTrajectory))
+    assert d["t"] == 2.5 and np.array_equal(d["position"], p)
+    assert np.array_equal(d["linear_velocity"], v) and np.array_equal(d["linear_acceleration"], a)
+    assert np.array_equal(d["quaternion"], [0, 0, 0, 1.0])
+
+    pose = RawTemplate(convert.pose_msg(0.0, np.zeros(3), [0, 0, 0, 1.0]))
+    pose.vector("pose.orientation", "xyzw")[:] = [0.1, 0.2, 0.3, 0.9]
+    o = deserialize_message(pose.data(), PoseStamped).pose.orientation
+    assert (o.x, o.y, o.z, o.w) == (0.1, 0.2, 0.3, 0.9)
+
+    est = RawTemplate(convert.inertia_msg(0.0, 0.0, [0.0, 0.0, float("nan")]))
+    est["inertia.m"][0] = 615.0
+    est.vector("inertia.com")[:2] = [0.06, -0.01]
+    back = deserialize_message(est.data(), InertiaStamped)
+    assert back.inertia.m == 615.0 and back.inertia.com.x == 0.06 and np.isnan(back.inertia.com.z)
+
+    msg = Float64MultiArray(data=[1.0] * 8)
+    msg.layout.dim = [MultiArrayDimension(label="winch stamp=1.000000000", size=8, stride=8)]
+    cmd = RawTemplate(msg)
+    cmd.write_text(cmd.text_offset("winch stamp=1.000000000"), "winch stamp=7.123456789")
+    assert deserialize_message(cmd.data(), Float64MultiArray).layout.dim[0].label == "winch stamp=7.123456789"
+    with pytest.raises(KeyError, match="no numeric field"):
+        RawTemplate(convert.joint_state_msg(0.0, names, z, None, z))["velocity"]   # empty sequence
+
+
+def test_fast_executor_delivers_every_message_in_order(ros_context):
+    from rclpy.node import Node
+    from sensor_msgs.msg import JointState
+    from std_msgs.msg import Float64MultiArray
+
+    from cablelab.ros import convert
+    from cablelab.ros.fastspin import FastExecutor, supports
+    from cablelab.ros.qos import stream_qos
+    from cablelab.ros.rawmsg import RawTemplate
+
+    node = Node("fast_test", start_parameter_services=False)
+    got_js, got_cmd, ticks = [], [], []
+    node.create_subscription(JointState, "/t/js", lambda m: got_js.append(m.header.stamp.nanosec),
+                             stream_qos(1000))
+    node.create_subscription(Float64MultiArray, "/t/cmd", lambda m: got_cmd.append(m.data[0]), stream_qos(1000))
+    node.create_timer(0.01, lambda: ticks.append(time.monotonic()))
+    pub_js = node.create_publisher(JointState, "/t/js", stream_qos(1000))
+    pub_cmd = node.create_publisher(Float64MultiArray, "/t/cmd", stream_qos(1000))
+    assert supports(node)
+    ex = FastExecutor()
+    ex.add_node(node)
+    deadline = time.monotonic() + 30
+    while not (pub_js.get_subscription_count() and pub_cmd.get_subscription_count()):
+        assert time.monotonic() < deadline, "no intra-process match"
+        ex.spin_once(0.05)
+    tpl = RawTemplate(convert.joint_state_msg(0.0, ["a"], [0.0], [0.0], [0.0]))
+    n = 500
+    for k in range(n):            # a backlog on two topics: bytes and message objects
+        tpl.stamp(k * 1e-3)
+        pub_js.publish(tpl.data())
+        pub_cmd.publish(Float64MultiArray(data=[float(k)]))
+    deadline = time.monotonic() + 60
+    while (len(got_js) < n or len(got_cmd) < n or len(ticks) < 3) and time.monotonic() < deadline:
+        ex.spin_once(0.05)
+    assert got_js == [k * 1_000_000 for k in range(n)]        # each once, in order
+    assert got_cmd == [float(k) for k in range(n)]
+    assert len(ticks) >= 3 and ex.taken >= 2 * n
+    # a subscription created later is picked up
+    late = []
+    node.create_subscription(Float64MultiArray, "/t/cmd", lambda m: late.append(m.data[0]), stream_qos(10))
+    deadline = time.monotonic() + 30
+    while not late and time.monotonic() < deadline:
+        pub_cmd.publish(Float64MultiArray(data=[-1.0]))
+        ex.spin_once(0.05)
+    assert late and late[0] == -1.0
+    node.destroy_node()
