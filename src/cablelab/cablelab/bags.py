@@ -318,55 +318,35 @@ class Bag:
             names: joint columns to return (default: the names of the first message). A joint a
                 message lacks gives NaN in that row.
         """
-        groups = self._groups(topic, JOINT_STATE)
-        n = self.counts[topic]
-        if names is None:
-            names = _names(groups[0].layout, "name") if groups else []
-        names = list(names)
-        k = len(names)
-        t = np.full(n, np.nan)
-        out = {f: np.full((n, k), np.nan) for f in ("position", "velocity", "effort")}
-        for g in groups:
-            t[g.rows] = g.stamp()
-            gnames = _names(g.layout, "name")
-            cols = _column_map(gnames, names)
-            for f, arr in out.items():
-                v = g.get(f)
-                if v is None:
-                    continue
-                src, dst = cols
-                valid = src < v.shape[1]
-                arr[np.ix_(g.rows, dst[valid])] = v[:, src[valid]]
+        t, names, out = _named_columns(self._groups(topic, JOINT_STATE), self.counts[topic], names,
+                                       "name", ("position", "velocity", "effort"))
         return JointStateSeries(t=t, names=names, t_receive=self._log_s(topic), **out)
 
     def pose(self, topic: str) -> PoseSeries:
         """Read a geometry_msgs/PoseStamped topic."""
         groups = self._groups(topic, POSE_STAMPED)
         n = self.counts[topic]
-        t = np.full(n, np.nan)
+        t = _stamps(groups, n)
         pos = np.full((n, 3), np.nan)
         quat = np.full((n, 4), np.nan)
         for g in groups:
-            t[g.rows] = g.stamp()
             pos[g.rows] = _stack(g, "pose.position.", "xyz")
             quat[g.rows] = _stack(g, "pose.orientation.", "xyzw")
-        frame = groups[0].layout.strings.get("header.frame_id", "") if groups else ""
-        return PoseSeries(t=t, position=pos, quaternion=quat, frame_id=frame,
+        return PoseSeries(t=t, position=pos, quaternion=quat, frame_id=_frame_id(groups),
                           t_receive=self._log_s(topic))
 
     def inertia(self, topic: str) -> InertiaSeries:
         """Read a geometry_msgs/InertiaStamped topic (mass and centre of mass)."""
         groups = self._groups(topic, INERTIA_STAMPED)
         n = self.counts[topic]
-        t = np.full(n, np.nan)
+        t = _stamps(groups, n)
         m = np.full(n, np.nan)
         com = np.full((n, 3), np.nan)
         for g in groups:
-            t[g.rows] = g.stamp()
             m[g.rows] = g.get("inertia.m")[:, 0]
             com[g.rows] = _stack(g, "inertia.com.", "xyz")
-        frame = groups[0].layout.strings.get("header.frame_id", "") if groups else ""
-        return InertiaSeries(t=t, m=m, com=com, frame_id=frame, t_receive=self._log_s(topic))
+        return InertiaSeries(t=t, m=m, com=com, frame_id=_frame_id(groups),
+                             t_receive=self._log_s(topic))
 
     def float_array(self, topic: str) -> ArraySeries:
         """Read a std_msgs/Float64MultiArray topic (``t`` = log time)."""
@@ -383,30 +363,16 @@ class Bag:
 
     def joint_trajectory(self, topic: str, names: list[str] | None = None) -> JointTrajectorySeries:
         """Read a trajectory_msgs/JointTrajectory topic: the first point of each message."""
-        groups = self._groups(topic, JOINT_TRAJECTORY)
-        n = self.counts[topic]
-        if names is None:
-            names = _names(groups[0].layout, "joint_names") if groups else []
-        names = list(names)
-        k = len(names)
-        t = np.full(n, np.nan)
-        out = {f: np.full((n, k), np.nan) for f in ("positions", "velocities", "accelerations")}
-        for g in groups:
-            t[g.rows] = g.stamp()
-            src, dst = _column_map(_names(g.layout, "joint_names"), names)
-            for f, arr in out.items():
-                v = g.get(f"points[0].{f}")
-                if v is None:
-                    continue
-                valid = src < v.shape[1]
-                arr[np.ix_(g.rows, dst[valid])] = v[:, src[valid]]
+        t, names, out = _named_columns(self._groups(topic, JOINT_TRAJECTORY), self.counts[topic], names,
+                                       "joint_names", ("positions", "velocities", "accelerations"),
+                                       prefix="points[0].")
         return JointTrajectorySeries(t=t, names=names, t_receive=self._log_s(topic), **out)
 
     def multidof_trajectory(self, topic: str) -> MultiDofSeries:
         """Read a trajectory_msgs/MultiDOFJointTrajectory topic: first point, first joint."""
         groups = self._groups(topic, MULTIDOF_TRAJECTORY)
         n = self.counts[topic]
-        t = np.full(n, np.nan)
+        t = _stamps(groups, n)
         fields = {
             "position": ("points[0].transforms[0].translation.", "xyz"),
             "quaternion": ("points[0].transforms[0].rotation.", "xyzw"),
@@ -417,7 +383,6 @@ class Bag:
         }
         out = {f: np.full((n, len(axes)), np.nan) for f, (_, axes) in fields.items()}
         for g in groups:
-            t[g.rows] = g.stamp()
             for f, (prefix, axes) in fields.items():
                 if prefix + axes[0] in g.layout.spans:
                     out[f][g.rows] = _stack(g, prefix, axes)
@@ -435,11 +400,7 @@ class Bag:
 
     def clock(self, topic: str = CLOCK_TOPIC) -> tuple[np.ndarray, np.ndarray]:
         """(clock time s (N,), log time s (N,)) of a rosgraph_msgs/Clock topic."""
-        groups = self._groups(topic, CLOCK)
-        t = np.full(self.counts[topic], np.nan)
-        for g in groups:
-            t[g.rows] = g.stamp("clock")
-        return t, self._log_s(topic)
+        return _stamps(self._groups(topic, CLOCK), self.counts[topic], "clock"), self._log_s(topic)
 
 
 def _names(layout: cdr.Layout, path: str) -> list[str]:
@@ -458,6 +419,39 @@ def _column_map(have: list[str], want: list[str]) -> tuple[np.ndarray, np.ndarra
 
 def _stack(g: cdr.Group, prefix: str, axes: str) -> np.ndarray:
     return np.hstack([g.get(prefix + a) for a in axes])
+
+
+def _stamps(groups, n: int, path: str = "header.stamp") -> np.ndarray:
+    """(n,) time in s of a builtin_interfaces/Time field of every message of a topic."""
+    t = np.full(n, np.nan)
+    for g in groups:
+        t[g.rows] = g.stamp(path)
+    return t
+
+
+def _frame_id(groups) -> str:
+    """header.frame_id of the first message ("" for an empty topic)."""
+    return groups[0].layout.strings.get("header.frame_id", "") if groups else ""
+
+
+def _named_columns(groups, n: int, names, name_field: str, fields, prefix: str = ""):
+    """``(t (n,), names, {field: (n, k)})`` of a message type with a joint-name list
+    (JointState ``name``, JointTrajectory ``joint_names``): columns follow ``names`` (default
+    the first message's); a joint a message lacks gives NaN in its row."""
+    if names is None:
+        names = _names(groups[0].layout, name_field) if groups else []
+    names = list(names)
+    t = _stamps(groups, n)
+    out = {f: np.full((n, len(names)), np.nan) for f in fields}
+    for g in groups:
+        src, dst = _column_map(_names(g.layout, name_field), names)
+        for f, arr in out.items():
+            v = g.get(prefix + f)
+            if v is None:
+                continue
+            valid = src < v.shape[1]
+            arr[np.ix_(g.rows, dst[valid])] = v[:, src[valid]]
+    return t, names, out
 
 
 def open_bag(path, *, recover: bool = False) -> Bag:
