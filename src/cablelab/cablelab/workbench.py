@@ -78,13 +78,19 @@ def _effect_table(ident) -> dict:
                           "fixed": row["fixed"]} for row in ident.table()}
 
 
+def _fit_on_record(model: Model, ds: Dataset):
+    """``(identification, y_meas (N, C) NaN where invalid, metrics per channel)`` of the model
+    fitted on the whole record."""
+    ident = _identify(model, ds)
+    y_meas = np.where(ident.valid[:, None], ident.residual + ident.y_hat, np.nan)
+    return ident, y_meas, channel_metrics(y_meas, ident.y_hat, ident.valid)
+
+
 @blas_single
 def compare(ds: Dataset, model: Model, *, segments: int = 5) -> dict:
     """Inverse-model comparison: fit on the whole record, metrics per channel, worst segments,
     residual by regime and whiteness. JSON of CONTRACT section 5 (``compare``) + extras."""
-    ident = _identify(model, ds)
-    y_meas = np.where(ident.valid[:, None], ident.residual + ident.y_hat, np.nan)
-    mets = channel_metrics(y_meas, ident.y_hat, ident.valid)
+    ident, y_meas, mets = _fit_on_record(model, ds)
     out: dict = {"plant": ds.plant, "effects": list(model.effects), "samples": int(ident.valid.sum())}
     out["channels"] = {}
     for ch, m in zip(ds.channels, mets):
@@ -126,9 +132,7 @@ def identify(ds: Dataset, model: Model, *, folds: int = FOLDS, simulation: str |
 
     With ``simulation`` (``"nmse"`` or ``"pearson"``) the inverse-model result starts a
     simulation-based fit of the plant (if it offers one), reported under ``"simulation"``."""
-    ident = _identify(model, ds)
-    y_meas = np.where(ident.valid[:, None], ident.residual + ident.y_hat, np.nan)
-    mets = channel_metrics(y_meas, ident.y_hat, ident.valid)
+    ident, y_meas, mets = _fit_on_record(model, ds)
     cv = cv_error(model, ds, folds)[0] if folds else None
     out = {
         "plant": ds.plant, "effects": list(model.effects), "samples": int(ident.valid.sum()),
