@@ -340,9 +340,14 @@ class Model:
     def predict(self, ds: Dataset, params: Mapping[str, float]) -> tuple[np.ndarray, np.ndarray]:
         """Model output (N, C) and the valid mask for given parameter values (by name)."""
         ds2 = self.apply_nonlinear(ds, params)
-        phi, cols, y_known = self.regressor(ds2)
+        return self.linear_output(ds2, params), ds2.valid
+
+    def linear_output(self, ds: Dataset, params: Mapping[str, float]) -> np.ndarray:
+        """(N, C) linear part ``Phi theta + y_known`` on a dataset the nonlinear parameters are
+        already applied to (:meth:`apply_nonlinear`)."""
+        phi, cols, y_known = self.regressor(ds)
         theta = np.array([params[c.name] for c in cols]) if cols else np.zeros(0)
-        return phi @ theta + y_known, ds2.valid
+        return phi @ theta + y_known
 
 
 def parse_effect_list(text: str | Sequence[str] | None) -> tuple[str, ...]:

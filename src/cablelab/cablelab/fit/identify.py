@@ -276,6 +276,4 @@ def evaluate(model: Model, ds: Dataset, params: Mapping[str, float]
         where ``valid``.
     """
     ds2 = model.apply_nonlinear(ds, params)
-    phi, cols, y_known = model.regressor(ds2)
-    theta = np.array([params[c.name] for c in cols]) if cols else np.zeros(0)
-    return ds2.y, phi @ theta + y_known, ds2.valid & np.isfinite(ds2.y).all(axis=1)
+    return ds2.y, model.linear_output(ds2, params), ds2.valid & np.isfinite(ds2.y).all(axis=1)
