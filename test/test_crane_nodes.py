@@ -86,7 +86,9 @@ def test_crane_nodes_over_dds(launcher, tmp_path):
     # a recorder still importing on a busy machine would miss the start: wait for its subscriptions
     launcher.wait_for_subscribers(["/crane/joint_states", "/crane/effort_commands",
                                    "/crane/swing_estimate"], timeout=120, node_name="cablelab_recorder")
-    launcher.node("sim", "cable_sim_node", "crane", {"rate": 100.0, "mocap_dropout": 0.02})
+    # (time starts once the recorder, the estimator and the controller are matched on the states)
+    launcher.node("sim", "cable_sim_node", "crane", {"rate": 100.0, "mocap_dropout": 0.02,
+                                                     "wait_for_subscribers": 3})
     launcher.node("estimator", "payload_estimator", "crane", {})
     launcher.node("controller", "pd_feedforward", "crane", {"reference_source": "excitation"})
     # what the checks below read is the bag: wait until it holds the run (8 s of motion)

@@ -15,7 +15,10 @@ commands flow, after publishing a state the simulation waits for the command tha
 before advancing, so a slow or loaded controller slows the simulation down instead of
 destabilising it with delayed commands; an answer is applied however late it comes),
 ``lockstep_timeout`` (s wall, default 10: without an answer for that long the simulation drops
-back to real time, holding the crane, until commands flow again). Without a fresh command the
+back to real time, holding the crane, until commands flow again), ``wait_for_subscribers``
+(int, default 0: time starts only when ``/crane/joint_states`` has that many matched
+subscriptions, at most 60 s, the initial state resent every 0.5 s meanwhile; DDS discovery on a
+busy machine can take seconds, which a recorder would otherwise miss). Without a fresh command the
 drives hold the crane (gravity compensation + damping, like a brake) and the node reports WARN
 on /diagnostics.
 
@@ -82,6 +85,8 @@ class CraneSimNode(Node):
         self.lockstep_timeout = float(p("lockstep_timeout", 10.0).value)
         self.answered = False       # the command answering the last published state arrived
         self.stale_answers = 0      # lock-step: answers to earlier states, ignored
+        self.wait_subs = int(p("wait_for_subscribers", 0).value)
+        self.created = time.monotonic()
         self.published_at = time.monotonic()
         self.sim = CraneSim(truth, q0)
         self.u = None
@@ -127,6 +132,13 @@ class CraneSimNode(Node):
 
     def tick(self) -> None:
         now = time.monotonic()
+        if self.wait_subs:
+            # before time starts: wait for the expected subscribers of the state topic
+            if self.pub_js.get_subscription_count() < self.wait_subs and now - self.created < 60.0:
+                if now - self.published_at > 0.5:
+                    self.publish_state()  # the initial state again, for late joiners
+                return
+            self.wait_subs = 0
         if self.lockstep and self.u is not None and not self.answered:
             if now - self.published_at < self.lockstep_timeout:
                 return  # wait for the controller's answer to the last state

@@ -27,7 +27,7 @@ from cablelab.rls import RecursiveLeastSquares
 from cablelab.ros import convert
 from cablelab.ros.diagnostics import Diagnostics
 from cablelab.ros.inputs import InputMonitor
-from cablelab.ros.qos import DESCRIPTION_QOS, publisher_qos, stream_qos
+from cablelab.ros.qos import DESCRIPTION_QOS, catch_up_qos, publisher_qos
 
 
 class AxisEstimator(Node):
@@ -43,7 +43,7 @@ class AxisEstimator(Node):
         self.inputs = InputMonitor()
         self.inputs.add("joint_states", timeout=0.5, length=2)
         self.pub = self.create_publisher(Float64MultiArray, "/axis/parameter_estimate", publisher_qos())
-        self.create_subscription(JointState, "/axis/joint_states", self.on_state, stream_qos())
+        self.create_subscription(JointState, "/axis/joint_states", self.on_state, catch_up_qos())
         self.create_subscription(String, "/plant_description", self.on_description, DESCRIPTION_QOS)
         self.diag = Diagnostics(self, update=self.status)
 

@@ -24,7 +24,7 @@ from cablelab.plants.crane_swing import SwingTracker
 from cablelab.ros import convert
 from cablelab.ros.diagnostics import Diagnostics
 from cablelab.ros.inputs import WARN, InputMonitor
-from cablelab.ros.qos import publisher_qos, stream_qos
+from cablelab.ros.qos import catch_up_qos, publisher_qos
 
 NAMES = ["theta1", "theta2", "rope_length"]
 
@@ -46,9 +46,9 @@ class CraneSwingEstimator(Node):
         self.inputs.add("payload_pose", timeout=pose_timeout, length=3)
         self.inputs.add("slew", timeout=float(p("slew_timeout", 0.5).value), length=1)
         self.pub = self.create_publisher(JointState, "/crane/swing_estimate", publisher_qos())
-        self.create_subscription(JointState, "/crane/joint_states", self.on_joints, stream_qos())
-        self.create_subscription(PoseStamped, "/crane/boom_tip_pose", self.on_tip, stream_qos())
-        self.create_subscription(PoseStamped, "/crane/payload_pose", self.on_payload, stream_qos())
+        self.create_subscription(JointState, "/crane/joint_states", self.on_joints, catch_up_qos())
+        self.create_subscription(PoseStamped, "/crane/boom_tip_pose", self.on_tip, catch_up_qos())
+        self.create_subscription(PoseStamped, "/crane/payload_pose", self.on_payload, catch_up_qos())
         self.diag = Diagnostics(self, update=self.status)
 
     def status(self):

@@ -33,6 +33,14 @@ def publisher_qos(depth: int = PUBLISHER_DEPTH) -> QoSProfile:
     return stream_qos(depth)
 
 
+def catch_up_qos(depth: int = PUBLISHER_DEPTH) -> QoSProfile:
+    """:func:`stream_qos` for a subscriber that must see every sample, late rather than never
+    (estimators: differences, filters and recursive fits over consecutive stamps). Starved for a
+    few seconds it works through the backlog instead of losing the oldest samples; controllers
+    keep the default depth (a stale state is worth little to them)."""
+    return stream_qos(depth)
+
+
 def recorder_qos(transient_local: bool = False, reliable: bool = True) -> QoSProfile:
     """Keep-all, reliable unless ``reliable=False`` (to match a best-effort publisher);
     transient-local depth 1 (as /plant_description) when ``transient_local``."""
