@@ -72,7 +72,7 @@ def run_nodes(out: Path, duration: float, domain: int, tilt: float) -> Path:
         launch.wait_for_subscribers(["/crane/boom_tip_pose"], timeout=90)
         launch.node("sim", "cable_sim_node", "crane", {
             "rate": rate, "base_tilt": f"[{tilt!r}, 0.0]", "mocap_noise": 0.001,
-            "mocap_dropout": 0.01})
+            "mocap_dropout": 0.01, "wait_for_subscribers": 3})   # recorder, estimator, controller
         t0 = time.monotonic()
         target = int(duration * rate)
         seen = 0
