@@ -58,7 +58,10 @@ def run_nodes(out: Path, name: str, feedforward: bool, duration: float, domain: 
         launch.start("recorder", [sys.executable, "-m", "cablelab.cli", "record", "--plant", "cdpr",
                                   "-o", bag, "--overwrite", "--quiet"])
         launch.node("estimator", "payload_estimator", "cdpr", {"model": "II", "tensions": "dynamometer"})
-        launch.node("controller", "pd_feedforward", "cdpr", {"feedforward": feedforward})
+        # lock-step chain sim -> estimator -> controller: each state waits (up to 5 s wall) for the
+        # live estimate of its own stamp, so a loaded machine cannot starve the feedforward
+        launch.node("controller", "pd_feedforward", "cdpr",
+                    {"feedforward": feedforward, "estimate_wait": 5.0 if feedforward else 0.0})
         launch.wait_for_topics({"/diagnostics": 2}, timeout=90)
         time.sleep(1.0)
         launch.node("sim", "cable_sim_node", "cdpr", {"real_time": False, "payload_mass": PAYLOAD,
