@@ -45,16 +45,13 @@ from cablelab.description import load_description
 from cablelab.errors import CablelabError
 from cablelab.plants.cdpr_trajectory import pick_and_place
 from cablelab.ros import convert
+from cablelab.rotations import wxyz_to_xyzw
 from cablelab.ros.diagnostics import Diagnostics
 from cablelab.ros.inputs import WARN, InputMonitor
 from cablelab.ros.fastspin import FastExecutor, set_realtime_priority, supports
 from cablelab.ros.qos import DESCRIPTION_QOS, stream_qos
 from cablelab.ros.rawmsg import RawTemplate
 from cablelab.sim.cdpr import CdprSim, CdprTruth, default_description_path
-
-
-def _wxyz_to_xyzw(q):
-    return np.asarray(q)[[1, 2, 3, 0]]
 
 
 class CdprSimNode(Node):
@@ -321,7 +318,7 @@ class CdprSimNode(Node):
     def _pose(tpl: RawTemplate, t: float, position, quat_wxyz) -> None:
         tpl.stamp(t)
         tpl.vector("pose.position")[:] = position
-        tpl.vector("pose.orientation", "xyzw")[:] = _wxyz_to_xyzw(quat_wxyz)
+        tpl.vector("pose.orientation", "xyzw")[:] = wxyz_to_xyzw(quat_wxyz)
 
 
 def make_node(args) -> Node:

@@ -29,6 +29,7 @@ import numpy as np
 
 from ..description import Description
 from ..errors import CablelabError
+from ..rotations import wxyz_to_xyzw
 from ..plants.cdpr_geometry import cable_geometry, swivel_reference
 
 __all__ = ["CdprTruth", "CdprSim", "CdprRun", "build_model_xml", "simulate", "write_run_bag", "PAYLOADS",
@@ -441,9 +442,6 @@ def write_run_bag(run: CdprRun, path, *, overwrite: bool = True, pose: bool = Tr
     from ..bags import BagWriter
     from ..description import dump_description
 
-    def xyzw(q):
-        return np.asarray(q)[:, [1, 2, 3, 0]]
-
     n = run.motor_angle.shape[1]
     k = max(1, int(every))                       # keep every k-th sample (smaller reference bags)
     A = {key: (v[::k] if isinstance(v, np.ndarray) and v.ndim and len(v) == len(run.arrays["t"]) else v)
@@ -456,14 +454,14 @@ def write_run_bag(run: CdprRun, path, *, overwrite: bool = True, pose: bool = Tr
                              A["motor_angle"], A["motor_velocity"], A["motor_torque"])
         w.write_joint_states("/cdpr/cable_tensions", t, [f"cable_{i}" for i in range(1, n + 1)],
                              A["cable_length"], None, A["tension"])
-        w.write_multidof_trajectory("/cdpr/reference", t, A["ref_position"], xyzw(A["ref_quat"]),
+        w.write_multidof_trajectory("/cdpr/reference", t, A["ref_position"], wxyz_to_xyzw(A["ref_quat"]),
                                     A["ref_velocity"], None, A["ref_acceleration"], None)
         if pose:
-            w.write_poses("/cdpr/platform_pose", t, A["position"], xyzw(A["quat"]))
+            w.write_poses("/cdpr/platform_pose", t, A["position"], wxyz_to_xyzw(A["quat"]))
         if commands:
             w.write_float_arrays("/cdpr/effort_commands", t, A["command"])
         if ground_truth:
-            w.write_poses("/cdpr/ground_truth/pose", t, A["true_position"], xyzw(A["true_quat"]))
+            w.write_poses("/cdpr/ground_truth/pose", t, A["true_position"], wxyz_to_xyzw(A["true_quat"]))
             com = np.broadcast_to(A["true_com"], (len(t), 3))
             w.write_inertia("/cdpr/ground_truth/payload", t, np.full(len(t), A["true_mass"]), com)
 
