@@ -34,6 +34,7 @@ from cablelab.description import load_description
 from cablelab.errors import CablelabError
 from cablelab.plants.cdpr_live import EstimatorConfig, LiveEstimator
 from cablelab.ros import convert
+from cablelab.rotations import xyzw_to_wxyz
 from cablelab.ros.diagnostics import Diagnostics
 from cablelab.ros.inputs import ERROR, WARN, InputMonitor
 from cablelab.ros.fastspin import FastExecutor, set_realtime_priority, supports
@@ -118,24 +119,14 @@ class CdprPayloadEstimator(Node):
                 self.last_problem = f"bad /plant_description: {exc}"
 
     def on_reference(self, msg: MultiDOFJointTrajectory) -> None:
-        pts = msg.points
-        if not pts or not pts[0].transforms:
-            self.inputs.accept("pose", None, time.monotonic())        # counted as rejected
-            return
-        pt = pts[0]
-        tr, ro = pt.transforms[0].translation, pt.transforms[0].rotation
-        pos = np.array((tr.x, tr.y, tr.z))
-        if self.inputs.accept("pose", pos, time.monotonic()):
-            acc = None
-            if pt.accelerations:
-                a = pt.accelerations[0].linear
-                acc = np.array((a.x, a.y, a.z))
-            self.pose = (convert.from_stamp(msg.header.stamp), pos, np.array((ro.w, ro.x, ro.y, ro.z)), acc)
+        r = convert.multidof_arrays(msg)           # position None (rejected) when empty
+        if self.inputs.accept("pose", r["position"], time.monotonic()):
+            self.pose = (r["t"], r["position"], xyzw_to_wxyz(r["quaternion"]), r["linear_acceleration"])
 
     def on_pose(self, msg: PoseStamped) -> None:
         t, pos, q = convert.pose_arrays(msg)
         if self.inputs.accept("pose", pos, time.monotonic()):
-            self.pose = (t, pos, q[[3, 0, 1, 2]], None)
+            self.pose = (t, pos, xyzw_to_wxyz(q), None)
 
     def on_joints(self, msg: JointState) -> None:
         t, _names, _q, qd, eff = convert.joint_state_arrays(msg)

@@ -37,6 +37,7 @@ from cablelab.errors import CablelabError
 from cablelab.plants.cdpr_control import PdffConfig
 from cablelab.plants.cdpr_live import ControllerConfig, LiveController
 from cablelab.ros import convert
+from cablelab.rotations import xyzw_to_wxyz
 from cablelab.ros.diagnostics import Diagnostics
 from cablelab.ros.inputs import ERROR, WARN, InputMonitor
 from cablelab.ros.fastspin import FastExecutor, set_realtime_priority, supports
@@ -120,23 +121,10 @@ class CdprController(Node):
                 self.last_problem = f"bad /plant_description: {exc}"
 
     def on_reference(self, msg: MultiDOFJointTrajectory) -> None:
-        pts = msg.points
-        if not pts or not pts[0].transforms:
-            self.inputs.accept("reference", None, time.monotonic())   # counted as rejected
-            return
-        pt = pts[0]
-        tr, ro = pt.transforms[0].translation, pt.transforms[0].rotation
-        pos = np.array((tr.x, tr.y, tr.z))
-        if self.inputs.accept("reference", pos, time.monotonic()):
-            vel = acc = None
-            if pt.velocities:
-                v = pt.velocities[0].linear
-                vel = np.array((v.x, v.y, v.z))
-            if pt.accelerations:
-                a = pt.accelerations[0].linear
-                acc = np.array((a.x, a.y, a.z))
-            self.ref = (convert.from_stamp(msg.header.stamp), pos, np.array((ro.w, ro.x, ro.y, ro.z)),
-                        vel, acc)
+        r = convert.multidof_arrays(msg)           # position None (rejected) when empty
+        if self.inputs.accept("reference", r["position"], time.monotonic()):
+            self.ref = (r["t"], r["position"], xyzw_to_wxyz(r["quaternion"]),
+                        r["linear_velocity"], r["linear_acceleration"])
             self.try_command()
 
     def on_estimate(self, msg: InertiaStamped) -> None:
