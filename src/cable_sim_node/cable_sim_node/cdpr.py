@@ -48,7 +48,7 @@ from cablelab.ros import convert
 from cablelab.rotations import wxyz_to_xyzw
 from cablelab.ros.diagnostics import Diagnostics
 from cablelab.ros.inputs import WARN, InputMonitor
-from cablelab.ros.fastspin import FastExecutor, set_realtime_priority, supports
+from cablelab.ros.fastspin import executor_for, set_realtime_priority
 from cablelab.ros.qos import DESCRIPTION_QOS, stream_qos
 from cablelab.ros.rawmsg import RawTemplate
 from cablelab.sim.cdpr import CdprSim, CdprTruth, default_description_path
@@ -146,9 +146,7 @@ class CdprSimNode(Node):
     def executor_factory(self):
         """The runner spins this node with :class:`FastExecutor` (unless ``fast_executor`` is
         false): one prebuilt wait set, queued commands taken in one wake-up."""
-        from rclpy.executors import SingleThreadedExecutor
-
-        return FastExecutor() if self.fast and supports(self) else SingleThreadedExecutor()
+        return executor_for(self, self.fast)
 
     def _templates(self) -> None:
         """Pre-serialised messages (fixed names and lengths): each step patches the numbers."""

@@ -37,7 +37,7 @@ from cablelab.ros import convert
 from cablelab.rotations import xyzw_to_wxyz
 from cablelab.ros.diagnostics import Diagnostics
 from cablelab.ros.inputs import ERROR, WARN, InputMonitor
-from cablelab.ros.fastspin import FastExecutor, set_realtime_priority, supports
+from cablelab.ros.fastspin import executor_for, set_realtime_priority
 from cablelab.ros.qos import DESCRIPTION_QOS, stream_qos
 from cablelab.ros.rawmsg import RawTemplate
 
@@ -96,9 +96,7 @@ class CdprPayloadEstimator(Node):
 
     def executor_factory(self):
         """Spun by :class:`FastExecutor` (unless ``fast_executor`` is false)."""
-        from rclpy.executors import SingleThreadedExecutor
-
-        return FastExecutor() if self.fast and supports(self) else SingleThreadedExecutor()
+        return executor_for(self, self.fast)
 
     # ------------------------------------------------------------------ inputs
     def set_description(self, desc) -> None:

@@ -54,6 +54,14 @@ def supports(node) -> bool:
     return not (list(node.clients) or list(node.guards))
 
 
+def executor_for(node, fast: bool = True):
+    """The executor a node's ``executor_factory`` hook returns: :class:`FastExecutor` when
+    ``fast`` and the node :func:`supports` it, else rclpy's SingleThreadedExecutor."""
+    from rclpy.executors import SingleThreadedExecutor
+
+    return FastExecutor() if fast and supports(node) else SingleThreadedExecutor()
+
+
 class FastExecutor:
     """Spin one rclpy node with a prebuilt wait set (see module docstring).
 
