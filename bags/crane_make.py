@@ -16,8 +16,8 @@ from functools import partial
 import numpy as np
 
 from cablelab.description import load_description
-from cablelab.plants.crane_model import CraneParams
-from cablelab.sim.crane import CraneTruth, reference_trajectory, simulate, write_bag
+from cablelab.plants.crane.model import CraneParams
+from cablelab.plants.crane.sim import CraneTruth, reference_trajectory, simulate, write_bag
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 DESC_FILE = os.path.join(os.path.dirname(__import__("cablelab").__file__), "data", "crane.yaml")

@@ -13,7 +13,7 @@
    because no fresh command came.
 
 ``--paper`` instead prints the reproduction of 001 Tables I-II and Fig. 15 (three payloads, PD and
-PDFF runs of the offline simulation) used in docs/cdpr.md.
+PDFF runs of the offline simulation) used in src/cablelab/cablelab/plants/cdpr/README.md.
 """
 from __future__ import annotations
 
@@ -29,10 +29,10 @@ from harness import Bench  # noqa: E402
 
 
 def offline_estimation(bench: Bench, samples: int) -> None:
-    from cablelab.plants.cdpr_estimation import mass_com, mass_com_batch
-    from cablelab.plants.cdpr_geometry import cable_geometry
-    from cablelab.plants.cdpr_trajectory import pick_and_place
-    from cablelab.sim.cdpr import default_description
+    from cablelab.plants.cdpr.estimation import mass_com, mass_com_batch
+    from cablelab.plants.cdpr.geometry import cable_geometry
+    from cablelab.plants.cdpr.trajectory import pick_and_place
+    from cablelab.plants.cdpr.sim import default_description
 
     bench.section(f"offline estimation, {samples} samples x 8 cables, one core")
     c = default_description().cdpr
@@ -51,7 +51,7 @@ def offline_estimation(bench: Bench, samples: int) -> None:
 
 
 def offline_simulation(bench: Bench) -> None:
-    from cablelab.sim.cdpr import CdprTruth, default_description, simulate
+    from cablelab.plants.cdpr.sim import CdprTruth, default_description, simulate
 
     bench.section("offline closed-loop simulation (60 s test trajectory, 615 kg)")
     desc = default_description()
@@ -69,13 +69,13 @@ def estimator_in_process(bench: Bench, n: int = 5000) -> None:
     with ready messages: the compute part of the latency, without DDS and scheduling."""
     import rclpy
 
-    from cablelab.plants.cdpr_control import feedforward_tensions
-    from cablelab.plants.cdpr_geometry import cable_geometry
-    from cablelab.plants.cdpr_trajectory import pick_and_place
+    from cablelab.plants.cdpr.control import feedforward_tensions
+    from cablelab.plants.cdpr.geometry import cable_geometry
+    from cablelab.plants.cdpr.trajectory import pick_and_place
     from cablelab.ros import convert
-    from cablelab.sim.cdpr import default_description
-    from payload_estimator.cdpr import CdprPayloadEstimator
-    from pd_feedforward.cdpr import CdprController
+    from cablelab.plants.cdpr.sim import default_description
+    from cablelab.plants.cdpr.nodes.estimator import CdprPayloadEstimator
+    from cablelab.plants.cdpr.nodes.controller import CdprController
 
     bench.section("node callbacks in process (compute only: no DDS, no executor)")
     desc = default_description()
@@ -169,12 +169,12 @@ def estimator_node(bench: Bench, launch, seconds: float, params: dict) -> None:
     from std_msgs.msg import String
     from trajectory_msgs.msg import MultiDOFJointTrajectory
 
-    from cablelab.plants.cdpr_control import feedforward_tensions
-    from cablelab.plants.cdpr_geometry import cable_geometry
-    from cablelab.plants.cdpr_trajectory import pick_and_place
+    from cablelab.plants.cdpr.control import feedforward_tensions
+    from cablelab.plants.cdpr.geometry import cable_geometry
+    from cablelab.plants.cdpr.trajectory import pick_and_place
     from cablelab.ros import convert
     from cablelab.ros.qos import DESCRIPTION_QOS, stream_qos
-    from cablelab.sim.cdpr import default_description
+    from cablelab.plants.cdpr.sim import default_description
 
     bench.section(f"estimator node at 1 kHz for {seconds:g} s (separate process, DDS)")
     desc = default_description()
@@ -296,8 +296,8 @@ def closed_loop_1khz(bench: Bench, launch, seconds: float, params: dict) -> None
 
 def paper_tables(bench: Bench) -> None:
     """001 Tables I-II and Fig. 15 from offline closed-loop runs (MP, MP+M1, MP+M2)."""
-    from cablelab.plants.cdpr import estimate_arrays, CdprArrays
-    from cablelab.sim.cdpr import CdprTruth, default_description, simulate, without_pulley_radius
+    from cablelab.plants.cdpr.plant import estimate_arrays, CdprArrays
+    from cablelab.plants.cdpr.sim import CdprTruth, default_description, simulate, without_pulley_radius
 
     desc = default_description()
     desc1 = without_pulley_radius(desc)

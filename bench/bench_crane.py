@@ -15,11 +15,11 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from harness import Bench  # noqa: E402
 
-from cablelab.plants.crane_identify import FIX_002, identify_groups, stacked_regressor  # noqa: E402
-from cablelab.plants.crane_kinematics import boom_tip, payload_position  # noqa: E402
-from cablelab.plants.crane_model import PARAM_GROUPS, CraneParams  # noqa: E402
-from cablelab.plants.crane_swing import estimate_swing  # noqa: E402
-from cablelab.sim.crane import CraneTruth, reference_trajectory, simulate, truth_accelerations  # noqa: E402
+from cablelab.plants.crane.identify import FIX_002, identify_groups, stacked_regressor  # noqa: E402
+from cablelab.plants.crane.kinematics import boom_tip, payload_position  # noqa: E402
+from cablelab.plants.crane.model import PARAM_GROUPS, CraneParams  # noqa: E402
+from cablelab.plants.crane.swing import estimate_swing  # noqa: E402
+from cablelab.plants.crane.sim import CraneTruth, reference_trajectory, simulate, truth_accelerations  # noqa: E402
 
 
 def main() -> int:
@@ -79,9 +79,9 @@ def main() -> int:
     from cablelab.description import load_description
     from cablelab.diagnose import rank_candidates
     from cablelab.model import Model
-    from cablelab.plants import crane as C
+    from cablelab.plants.crane import plant as C
 
-    desc = load_description(os.path.join(os.path.dirname(C.__file__), "..", "data", "crane.yaml"))
+    desc = load_description(os.path.join(os.path.dirname(C.__file__), "data", "crane.yaml"))
     r = simulate(CraneTruth(params=p, base_tilt=(-0.058, 0.0)), 60.0, decimate=10)
     ds = C.dataset_from_arrays(r.t, r.q[:, :3], r.effort, r.t, r.tip, r.payload, desc)
     t_diag = bench.time(lambda: rank_candidates(Model("crane", C.baseline(desc), {"l_c": 0.3}), ds,

@@ -1,17 +1,14 @@
-"""``cable_sim_node --plant {cdpr,crane,axis}``: the MuJoCo simulator node of a plant.
+"""``cable_sim_node --plant PLANT``: the MuJoCo simulator node of a plant.
 
-The plant's adapter is the module ``cable_sim_node.<plant>`` (``make_node(args)``); see
+The node is the plant's ``nodes/sim.py`` (``make_node(args)``; any plant of the registry); see
 :func:`cablelab.ros.runner.plant_main` and docs/nodes.md.
 """
 import sys
 
-from cablelab.ros.runner import plant_main
+from cablelab.ros.runner import role_main
 
-
-def main(argv=None) -> int:
-    return plant_main("cable_sim_node", argv, "MuJoCo simulator of a cablelab plant: publishes "
-                      "its joint states, sensors, /clock and /plant_description.")
-
+main = role_main("cable_sim_node", "sim", "MuJoCo simulator of a cablelab plant: publishes "
+                   "its joint states, sensors, /clock and /plant_description.")
 
 if __name__ == "__main__":
     sys.exit(main())

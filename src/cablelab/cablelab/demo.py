@@ -1,30 +1,16 @@
-"""``./run demo``: the main job: CAROCA (001) and the boom crane (002) through real nodes, then
-the analysis.
+"""``./run demo``: the main job: every plant that brings a demo part runs through real nodes over
+DDS, then its analysis; finally a table per plant with the papers' numbers side by side and
+``<out>/index.html`` linking every plant's page and report.
 
-CDPR part:
+A plant's demo part is ``DEMO`` (a :class:`DemoPart`) in its package's ``demo`` module
+(``plants/<plant>/demo.py``): ``record`` runs the nodes (main thread: rclpy wants it) and
+``analyse`` the recorded bags (in a worker thread, overlapping the next part's DDS run). Parts run
+in their ``order``; today: CAROCA (001, :mod:`cablelab.plants.cdpr.demo`) and the boom crane on a
+hidden tilted base (002, :mod:`cablelab.plants.crane.demo`).
 
-1. Two closed-loop runs of the pick-and-place test trajectory (001 sec. II-C, A -> E -> A) with
-   the heaviest payload (366 + 249 kg, CoM offset along x_p as 001 Fig. 11): simulator,
-   payload estimator, PD/PDFF controller and recorder as separate processes over DDS (unique
-   ROS_DOMAIN_ID, simulator in lock-step as fast as possible). Bags: ``bags/demo/cdpr_pdff`` and
-   ``bags/demo/cdpr_pd``.
-2. ``cablelab estimate`` on the PDFF bag: Model I vs Model II with dynamometers (001 Table I),
-   motor torques raw vs friction compensated (001 Table II); PD vs PDFF z error (001 Fig. 15).
-3. ``cablelab diagnose`` starting from Model I (pulleys unknown), and from motor torques without
-   friction: which effect is missing; ``cablelab report`` (HTML) of the first, plus a CDPR page
-   with the mass estimates and the z errors (``bags/demo/report/``).
-
-Crane part (:mod:`cablelab.demo_crane`): the crane on a hidden tilted base (002 sec. 6.5) with
-swing estimator and PD + gravity feedforward over DDS into ``bags/demo/crane/run``; live and
-offline swing angles vs ground truth, diagnosis (``base_tilt`` first) and report in
-``bags/demo/crane/report/``.
-
-Finally a short table per plant with the papers' numbers side by side, and
-``bags/demo/index.html`` linking both plants' pages and reports.
-
-Options: ``--out DIR`` (default bags/demo), ``--duration S`` (simulated s of the CDPR PDFF run,
-default 61 = 1 s settle + A -> E -> A), ``--skip-pd``, ``--crane-duration S`` (default 30),
-``--skip-cdpr``, ``--skip-crane``, ``--quick`` (short runs: a smoke test), ``--folds K``.
+Options: ``--out DIR`` (default bags/demo), ``--skip-<plant>``, ``--quick`` (short runs: a smoke
+test), ``--folds K``, and each part's own options (``--duration``, ``--skip-pd``,
+``--crane-duration``; see ``./run demo --help`` and docs/demo.md).
 """
 from __future__ import annotations
 
@@ -32,195 +18,66 @@ import argparse
 import os
 import sys
 import time
+from dataclasses import dataclass, field
 from pathlib import Path
-
-import numpy as np
-
-PAYLOAD = 249.0
-TRUE_MASS = 366.0 + PAYLOAD
-PAPER = {  # 001 Tables I-II and Fig. 15, MP + M2 (615 kg)
-    "model1_err": 4.5, "model2_err": 0.7, "model1_std": 6.2, "model2_std": 4.3,
-    "raw_std": 78.5, "friction_std": 31.3, "dyn_std": 4.3, "pd_z": 20.0, "pdff_z": 5.0,
-}
+from typing import Callable
 
 
 def log(msg: str) -> None:
     print(f"[demo] {msg}", file=sys.stderr, flush=True)
 
 
-def run_nodes(out: Path, name: str, feedforward: bool, duration: float, domain: int) -> Path:
-    """One closed-loop run through the four node processes; returns the bag directory."""
-    from .ros.launch import Launcher
+@dataclass
+class PartResult:
+    """What a plant's demo part shows: table rows ``[quantity, cablelab, paper]``, bags, the
+    report index, the plant page, the first effect the diagnosis found, analysis seconds."""
 
-    bag = out / name
-    logs = out / "logs" / name
-    with Launcher(domain_id=domain, log_dir=logs) as launch:
-        launch.start("recorder", [sys.executable, "-m", "cablelab.cli", "record", "--plant", "cdpr",
-                                  "-o", bag, "--overwrite", "--quiet"])
-        launch.node("estimator", "payload_estimator", "cdpr", {"model": "II", "tensions": "dynamometer"})
-        # lock-step chain sim -> estimator -> controller: each state waits (up to 5 s wall) for the
-        # live estimate of its own stamp, so a loaded machine cannot starve the feedforward
-        launch.node("controller", "pd_feedforward", "cdpr",
-                    {"feedforward": feedforward, "estimate_wait": 5.0 if feedforward else 0.0})
-        launch.wait_for_topics({"/diagnostics": 2}, timeout=90)
-        time.sleep(1.0)
-        launch.node("sim", "cable_sim_node", "cdpr", {"real_time": False, "payload_mass": PAYLOAD,
-                                                      "duration": duration, "settle": 1.0,
-                                                      "wait_for_subscribers": 3})
-        t0 = time.monotonic()
-        last = 0.0
-        while launch.procs["sim"].alive():
-            time.sleep(0.5)
-            launch.check_alive()
-            el = time.monotonic() - t0
-            if el - last >= 10.0:
-                last = el
-                eta = duration / 1.5 - el
-                log(f"{name}: running {el:.0f} s, {duration:.0f} s to simulate " +
-                    (f"(ETA ~{eta:.0f} s at ~1.5x real time)" if eta > 0 else
-                     "(slower than 1.5x real time: the machine is loaded; lock-step keeps it exact)"))
-            if el > 20 * duration + 60:
-                raise RuntimeError(f"{name}: simulator did not finish; logs in {logs}")
-        time.sleep(1.5)                     # let the recorder take the last messages
-        codes = launch.stop_all()
-    bad = {k: v for k, v in codes.items() if v != 0}
-    if bad:
-        raise RuntimeError(f"{name}: processes exited with {bad}; logs in {logs}")
-    log(f"{name}: recorded {bag} in {time.monotonic() - t0:.0f} s")
-    return bag
+    rows: list = field(default_factory=list)
+    bags: list = field(default_factory=list)
+    report: str = ""
+    page: str = ""
+    first: str = ""
+    seconds: float = 0.0
 
 
-def z_error(bag: Path) -> tuple[np.ndarray, np.ndarray]:
-    """(t, z_true - z_ref) of a run, m (after the 1 s settle)."""
-    from .bags import open_bag
+@dataclass(frozen=True)
+class DemoPart:
+    """One plant's part of the demo.
 
-    b = open_bag(bag)
-    gt = b.pose("/cdpr/ground_truth/pose")
-    ref = b.multidof_trajectory("/cdpr/reference")
-    zr = np.interp(gt.t, ref.t, ref.position[:, 2])
-    sel = gt.t > 1.0
-    return gt.t[sel] - 1.0, gt.position[sel, 2] - zr[sel]
+    Args:
+        plant: plant name; title: heading of its table.
+        order: parts run in increasing order.
+        add_arguments: ``fn(argparse group)`` adding the part's own options.
+        record: ``fn(out_dir, args) -> runs``: the DDS run(s) (main thread).
+        analyse: ``fn(out_dir, args, runs) -> PartResult`` (may run in a worker thread).
+        quick: ``fn(args)`` shortening the options for ``--quick``.
+        subdir: the part's directory under ``--out`` ("" = ``--out`` itself).
+    """
 
-
-def cdpr_page(out: Path, bag: Path, pd_bag: Path | None, rows: list, report_index: str) -> str:
-    """A small HTML page with the 001 reproductions (mass estimates, Fig. 15 z errors)."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from .plants.cdpr import estimate_bag
-
-    rep = out / "report"
-    rep.mkdir(parents=True, exist_ok=True)
-    fig, ax = plt.subplots(2, 1, figsize=(9, 7), sharex=True)
-    for label, kw in (("Model I, dynamometers", {"effects": (), "description": _model1(bag)}),
-                      ("Model II, dynamometers", {}),
-                      ("Model II, motor torques raw", {"tensions": "motor"}),
-                      ("Model II, motor torques - friction", {"tensions": "motor", "effects":
-                       ("winch_coulomb_friction", "winch_viscous_friction")})):
-        e = estimate_bag(bag, kw.pop("description", None), **kw)
-        ax[0].plot(e.t - 1.0, e.mass, lw=0.8, label=label)     # t = 0 at the end of the 1 s settle
-    ax[0].axhline(TRUE_MASS, color="k", ls="--", lw=1, label="true 615 kg")
-    ax[0].set_ylabel("estimated mass (kg)")
-    ax[0].set_ylim(TRUE_MASS - 230, TRUE_MASS + 150)       # room for the legend under the curves
-    ax[0].legend(fontsize=8, ncol=3, loc="lower center")
-    ax[0].set_title("001 Fig. 7 / Fig. 13: mass of MP + M2 along the test trajectory")
-    t, ez = z_error(bag)
-    ax[1].plot(t, 1000 * ez, label="PDFF (live mass feedforward)")
-    if pd_bag is not None:
-        t2, ez2 = z_error(pd_bag)
-        ax[1].plot(t2, 1000 * ez2, label="PD (no feedforward)")
-    ax[1].axhline(-5, color="gray", ls=":", lw=1)
-    ax[1].axhline(5, color="gray", ls=":", lw=1)
-    ax[1].set_ylabel("z error (mm)")
-    ax[1].set_xlabel("t (s)")
-    ax[1].legend(fontsize=8)
-    ax[1].set_title("001 Fig. 15 (right): platform z error, 615 kg")
-    fig.tight_layout()
-    fig.savefig(rep / "cdpr_001.png", dpi=110)
-    plt.close(fig)
-    table = "".join(f"<tr><td>{r[0]}</td><td>{r[1]}</td><td>{r[2]}</td></tr>" for r in rows)
-    html = (f"<html><head><meta charset='utf-8'><title>CAROCA demo</title></head><body>"
-            f"<h1>CAROCA (001) through real nodes</h1><p>Bag: {bag}</p>"
-            f"<table border=1 cellpadding=4><tr><th>quantity</th><th>cablelab</th><th>001</th></tr>"
-            f"{table}</table><img src='cdpr_001.png'>"
-            f"<p>Diagnosis report (Model I baseline, dynamometers): <a href='index.html'>index.html</a></p>"
-            f"</body></html>")
-    path = rep / "cdpr.html"
-    path.write_text(html)
-    return str(path)
+    plant: str
+    title: str
+    order: int
+    add_arguments: Callable
+    record: Callable
+    analyse: Callable
+    quick: Callable = lambda args: None
+    subdir: str = ""
 
 
-def _model1(bag: Path):
-    """The bag's description without the pulley radius (Model I)."""
-    from .bags import open_bag
-    from .sim.cdpr import without_pulley_radius
+def demo_parts() -> list[DemoPart]:
+    """The demo part of every plant that has one, in order."""
+    from .registry import available_plants, plant_module
 
-    return without_pulley_radius(open_bag(bag).description)
-
-
-def cdpr_runs(out: Path, a) -> tuple[Path, Path | None]:
-    """Step 1 for CAROCA: the PDFF and PD runs over DDS; returns their bags."""
-    from .ros.launch import unique_domain_id
-
-    log("CAROCA (001): 8 cables, 2-DoF pulleys r = 0.15 m, 366 kg platform + 249 kg payload")
-    pdff = run_nodes(out, "cdpr_pdff", True, a.duration, unique_domain_id(1))
-    pd = None if a.skip_pd else run_nodes(out, "cdpr_pd", False, min(a.duration, 31.0),
-                                          unique_domain_id(2))
-    return pdff, pd
-
-
-def cdpr_analysis(out: Path, a, pdff: Path, pd: Path | None) -> dict:
-    """Steps 2-3 for CAROCA; returns the table rows, bags and report paths."""
-    from .plants.cdpr import estimate_bag
-
-    t0 = time.monotonic()
-    log("estimating (cablelab estimate) ...")
-    m1 = estimate_bag(pdff, _model1(pdff)).summary()
-    m2 = estimate_bag(pdff).summary()
-    raw = estimate_bag(pdff, tensions="motor").summary()
-    fr = estimate_bag(pdff, tensions="motor",
-                      effects=("winch_coulomb_friction", "winch_viscous_friction")).summary()
-    _, ez = z_error(pdff)
-    ez_pd = z_error(pd)[1] if pd is not None else None
-
-    log("diagnosing (cablelab diagnose) ...")
-    from .workbench import build_model, diagnose, load
-    from .plants import get_plant
-    plant = get_plant("cdpr")
-    _, desc, ds = load(pdff, None, {"tensions": "dynamometer"})
-    base1 = build_model(plant, desc, (), ("cdpr_gravity",))
-    _, _, dsm = load(pdff, None, {"tensions": "motor"})
-    d2 = diagnose(dsm, build_model(plant, desc), plant.candidates(desc), folds=a.folds)
-
-    log("writing the report (cablelab report) ...")
-    from .report import build_report
-    rep = build_report(ds, base1, plant.candidates(desc), out / "report", folds=a.folds,
-                       title="CAROCA demo: dynamometers, Model I baseline")
-    d1 = rep["steps"][0]                # the report's first greedy step is the diagnosis
-
-    def err(s):
-        return 100 * (s["mass"]["mean"] - TRUE_MASS) / TRUE_MASS
-
-    rows = [
-        ["mass error, Model I, dynamometers (%)", f"{err(m1):+.2f}", f"-{PAPER['model1_err']}"],
-        ["mass error, Model II, dynamometers (%)", f"{err(m2):+.2f}", f"+{PAPER['model2_err']}"],
-        ["mass std, Model I / II (kg)", f"{m1['mass']['std']:.1f} / {m2['mass']['std']:.1f}",
-         f"{PAPER['model1_std']} / {PAPER['model2_std']}"],
-        ["mass std, motor raw / - friction / dyn (kg)",
-         f"{raw['mass']['std']:.1f} / {fr['mass']['std']:.1f} / {m2['mass']['std']:.1f}",
-         f"{PAPER['raw_std']} / {PAPER['friction_std']} / {PAPER['dyn_std']}"],
-        ["CoM x_G, y_G (mm), Model II (true 60.7, 0)",
-         f"{1000 * m2['com']['x']:.1f}, {1000 * m2['com']['y']:.1f}", "offset along x_p (Fig. 10)"],
-        ["max |z error| PD / PDFF (mm)",
-         f"{'-' if ez_pd is None else f'{1000 * np.abs(ez_pd).max():.1f}'} / {1000 * np.abs(ez).max():.1f}",
-         f"~{PAPER['pd_z']:.0f} / < {PAPER['pdff_z']:.0f}"],
-        ["diagnose, Model I + dynamometers: first effect", d1["ranking"][0]["effect"], "pulleys (sec. V-A)"],
-        ["diagnose, motor torques: first effect", d2["ranking"][0]["effect"], "friction (eq. 15)"],
-    ]
-    page = cdpr_page(out, pdff, pd, rows, rep["index"])
-    return {"rows": rows, "bags": [b for b in (pdff, pd) if b is not None], "report": rep["index"],
-            "page": page, "first": d1["ranking"][0]["effect"], "seconds": time.monotonic() - t0}
+    parts = []
+    for name in available_plants():
+        try:
+            mod = plant_module(name, "demo")
+        except ModuleNotFoundError:
+            continue
+        part = getattr(mod, "DEMO", None)
+        if part is not None:   # (no isinstance: under ``python -m`` this module is __main__)
+            parts.append(part)
+    return sorted(parts, key=lambda p: (p.order, p.plant))
 
 
 def index_page(out: Path, parts: dict) -> str:
@@ -231,12 +88,12 @@ def index_page(out: Path, parts: dict) -> str:
             "estimator, controller, recorder); the analysis is <code>cablelab estimate / diagnose / "
             "report</code> on the recorded bags.</p>"]
     for title, part in parts.items():
-        rel = {k: os.path.relpath(part[k], out) for k in ("report", "page")}
+        rel = {k: os.path.relpath(getattr(part, k), out) for k in ("report", "page")}
         rows = "".join("<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in r) + "</tr>"
-                       for r in part["rows"])
+                       for r in part.rows)
         body.append(f"<h2>{html.escape(title)}</h2><p><a href='{rel['page']}'>demo page</a> | "
                     f"<a href='{rel['report']}'>diagnosis report</a> | bags: "
-                    f"{html.escape(', '.join(os.path.relpath(b, out) for b in part['bags']))}</p>"
+                    f"{html.escape(', '.join(os.path.relpath(b, out) for b in part.bags))}</p>"
                     f"<table border=1 cellpadding=4><tr><th>quantity</th><th>cablelab</th>"
                     f"<th>paper</th></tr>{rows}</table>")
     path = out / "index.html"
@@ -256,66 +113,59 @@ def print_table(title: str, rows: list) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
+    parts = demo_parts()
     p = argparse.ArgumentParser(prog="./run demo", description=__doc__.split("\n\n")[0])
     p.add_argument("--out", default="bags/demo", help="output directory (default bags/demo)")
-    p.add_argument("--duration", type=float, default=61.0, help="CDPR: simulated s of the PDFF run")
-    p.add_argument("--skip-pd", action="store_true", help="CDPR: only the PDFF run")
-    p.add_argument("--crane-duration", type=float, default=30.0, help="crane: simulated s")
-    p.add_argument("--skip-cdpr", action="store_true", help="only the crane part")
-    p.add_argument("--skip-crane", action="store_true", help="only the CDPR part")
-    p.add_argument("--quick", action="store_true",
-                   help="short runs (CDPR 12 s PDFF only, crane 12 s, 3 folds): a smoke test")
+    p.add_argument("--quick", action="store_true", help="short runs and 3 folds: a smoke test")
     p.add_argument("--folds", type=int, default=5)
+    for part in parts:
+        g = p.add_argument_group(part.title)
+        g.add_argument(f"--skip-{part.plant}", action="store_true", help=f"leave out {part.plant}")
+        part.add_arguments(g)
     a = p.parse_args(argv)
     if a.quick:
-        a.duration, a.skip_pd, a.crane_duration, a.folds = min(a.duration, 12.0), True, \
-            min(a.crane_duration, 12.0), 3
+        a.folds = 3
+        for part in parts:
+            part.quick(a)
+    chosen = [part for part in parts if not getattr(a, f"skip_{part.plant}")]
     from concurrent.futures import ThreadPoolExecutor
 
-    from . import demo_crane
     from .errors import CablelabError
-    from .ros.launch import unique_domain_id
 
     t_start = time.monotonic()
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
-    parts, errors = {}, []
-    cdpr_title, crane_title = "CAROCA CDPR (001), payload M2, 615 kg", "Boom crane (002), hidden tilted base"
+    results, errors = {}, []
 
-    def attempt(title, fn, *args, **kw):
+    def attempt(title, fn, *args):
         try:
-            return fn(*args, **kw)
+            return fn(*args)
         except (CablelabError, RuntimeError) as exc:
             errors.append(f"{title}: {exc}")
             return None
 
-    runs = None if a.skip_cdpr else attempt(cdpr_title, cdpr_runs, out, a)
     with ThreadPoolExecutor(1) as pool:
-        # the CDPR analysis (numpy, in a worker thread) overlaps the crane's DDS run (main thread:
-        # rclpy wants it), so the demo takes the time of the longer of the two
-        fut = pool.submit(attempt, cdpr_title, cdpr_analysis, out, a, *runs) if runs else None
-        crane_bag = None if a.skip_crane else attempt(
-            crane_title, demo_crane.record, out / "crane", duration=a.crane_duration,
-            domain=unique_domain_id(3))
-        cdpr = fut.result() if fut else None
-    if cdpr:
-        parts[cdpr_title] = cdpr
-    if crane_bag is not None:
-        t0 = time.monotonic()
-        cr = attempt(crane_title, demo_crane.analyse, out / "crane", crane_bag, folds=a.folds)
-        if cr is not None:
-            parts[crane_title] = {"rows": cr.rows, "bags": [cr.bag], "report": cr.report,
-                                  "page": cr.page, "first": cr.first,
-                                  "seconds": time.monotonic() - t0}
-    index = index_page(out, parts) if parts else None
-    for title, part in parts.items():
+        # each part's analysis (numpy, in a worker thread) overlaps the next part's DDS run (main
+        # thread: rclpy wants it), so the demo takes about the time of the DDS runs
+        futures = []
+        for part in chosen:
+            where = out / part.subdir if part.subdir else out
+            runs = attempt(part.title, part.record, where, a)
+            if runs is not None:
+                futures.append((part, pool.submit(attempt, part.title, part.analyse, where, a, runs)))
+        for part, fut in futures:
+            res = fut.result()
+            if res is not None:
+                results[part.title] = res
+    index = index_page(out, results) if results else None
+    for title, res in results.items():
         print_table(f"{title}: sim + estimator + controller + recorder over DDS "
-                    f"(analysis {part['seconds']:.0f} s)", part["rows"])
+                    f"(analysis {res.seconds:.0f} s)", res.rows)
     print()
-    for title, part in parts.items():
-        print(f"{title.split(' (')[0]}: bags {', '.join(str(b) for b in part['bags'])}")
-        print(f"    report {os.path.abspath(part['report'])}")
-        print(f"    page   {os.path.abspath(part['page'])}")
+    for title, res in results.items():
+        print(f"{title.split(' (')[0]}: bags {', '.join(str(b) for b in res.bags)}")
+        print(f"    report {os.path.abspath(res.report)}")
+        print(f"    page   {os.path.abspath(res.page)}")
     if index:
         print(f"index:  {os.path.abspath(index)}")
     print(f"({time.monotonic() - t_start:.0f} s)")

@@ -18,81 +18,42 @@ import yaml
 
 from .errors import CablelabError
 
-PLANTS = ("cdpr", "crane", "axis", "suspended", "leg")
-
-
-@dataclass(frozen=True)
-class Cable:
-    """One cable: exit point A_i (world), anchor point B_i (platform frame), pulley swivel axis."""
-
-    exit_point: np.ndarray
-    anchor_point: np.ndarray
-    swivel_axis: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, 1.0]))
-
-
-@dataclass(frozen=True)
-class CdprDescription:
-    """CDPR geometry and drives (001 sec. II). Lengths in m, masses in kg."""
-
-    drum_radius: float
-    gear_ratio: float
-    cables: tuple[Cable, ...]
-    platform_mass: float | None = None
-    pulley_radius: float = 0.0  # 0 = pulleys unknown / treated as points (Model I)
-
-    @property
-    def exit_points(self) -> np.ndarray:
-        """(n, 3) exit points A_i in world."""
-        return np.array([c.exit_point for c in self.cables])
-
-    @property
-    def anchor_points(self) -> np.ndarray:
-        """(n, 3) anchor points B_i in the platform frame."""
-        return np.array([c.anchor_point for c in self.cables])
-
-    @property
-    def swivel_axes(self) -> np.ndarray:
-        """(n, 3) unit swivel axes."""
-        return np.array([c.swivel_axis for c in self.cables])
-
-
-@dataclass(frozen=True)
-class Counterbalance:
-    mass: float
-    distance: float
-
-
-@dataclass(frozen=True)
-class CraneDescription:
-    """Boom crane of 002: boom length l_b (m), masses (kg), optional counterbalance."""
-
-    boom_length: float
-    payload_mass: float | None = None
-    boom_mass: float | None = None
-    counterbalance: Counterbalance | None = None
-
-
-@dataclass(frozen=True)
-class AxisDescription:
-    """Single drive: prismatic (m, kg, N) or revolute (rad, kg m^2, N m)."""
-
-    joint_type: str
-    inertia: float | None = None
-    gravity_moment: float = 0.0  # m*c in kg m; load torque m*c*g*sin(q), q = 0 hanging down
+#: keys of the description's top level besides the plant sections
+COMMON_KEYS = ("plant", "name", "gravity")
 
 
 @dataclass(frozen=True)
 class Description:
-    """A validated plant description (CONTRACT section 3)."""
+    """A validated plant description (CONTRACT section 3).
+
+    ``sections`` maps a plant name to its parsed section (the dataclass its plant's
+    ``section`` parser returns; a plain mapping for a plant without a parser). A section is
+    also an attribute: ``desc.cdpr`` is ``desc.sections.get("cdpr")`` for every known plant.
+    """
 
     plant: str
     name: str = ""
     gravity: float = 9.81
-    cdpr: CdprDescription | None = None
-    crane: CraneDescription | None = None
-    axis: AxisDescription | None = None
-    extra: dict = field(default_factory=dict)  # sections of plants without a schema yet
+    sections: dict = field(default_factory=dict)
     yaml_text: str = ""
+
+    def __getattr__(self, key: str):
+        if key.startswith("_"):
+            raise AttributeError(key)
+        from .registry import available_plants
+
+        if key in self.sections or key in available_plants():
+            return self.sections.get(key)
+        raise AttributeError(f"description has no section or field {key!r}")
+
+    @property
+    def section(self):
+        """The section of the plant the description is for."""
+        return self.sections.get(self.plant)
+
+    def with_section(self, name: str, section) -> "Description":
+        """A copy with plant section ``name`` replaced (the YAML text is regenerated)."""
+        return dataclasses.replace(self, sections={**self.sections, name: section}, yaml_text="")
 
     def to_yaml(self) -> str:
         """The description as YAML (the original text when it was loaded from text)."""
@@ -158,91 +119,34 @@ def _vector(obj: dict, key: str, path: str, n: int = 3, default=None) -> np.ndar
 
 # ----------------------------------------------------------------------------- plant sections
 
-def _cdpr(obj: Any) -> CdprDescription:
-    path = "cdpr"
-    obj = _mapping(obj, path)
-    _check_keys(obj, path, ("drum_radius", "gear_ratio", "cables"), ("platform_mass", "pulley_radius"))
-    cables_raw = obj["cables"]
-    if not isinstance(cables_raw, list) or not cables_raw:
-        raise _fail("cdpr.cables", "expected a non-empty list of cables")
-    cables = []
-    for i, c in enumerate(cables_raw):
-        cp = f"cdpr.cables[{i}]"
-        c = _mapping(c, cp)
-        _check_keys(c, cp, ("exit_point", "anchor_point"), ("swivel_axis",))
-        axis = _vector(c, "swivel_axis", cp, default=[0.0, 0.0, 1.0])
-        norm = float(np.linalg.norm(axis))
-        if norm < 1e-9:
-            raise _fail(f"{cp}.swivel_axis", "must not be the zero vector")
-        cables.append(Cable(_vector(c, "exit_point", cp), _vector(c, "anchor_point", cp), axis / norm))
-    return CdprDescription(
-        drum_radius=_number(obj, "drum_radius", path, positive=True),
-        gear_ratio=_number(obj, "gear_ratio", path, positive=True),
-        cables=tuple(cables),
-        platform_mass=_number(obj, "platform_mass", path, positive=True),
-        pulley_radius=_number(obj, "pulley_radius", path, nonneg=True, default=0.0),
-    )
-
-
-def _crane(obj: Any) -> CraneDescription:
-    path = "crane"
-    obj = _mapping(obj, path)
-    _check_keys(obj, path, ("boom_length",), ("payload_mass", "boom_mass", "counterbalance"))
-    cb = None
-    if obj.get("counterbalance") is not None:
-        cbo = _mapping(obj["counterbalance"], "crane.counterbalance")
-        _check_keys(cbo, "crane.counterbalance", ("mass", "distance"), ())
-        cb = Counterbalance(_number(cbo, "mass", "crane.counterbalance", nonneg=True),
-                            _number(cbo, "distance", "crane.counterbalance", nonneg=True))
-    return CraneDescription(
-        boom_length=_number(obj, "boom_length", path, positive=True),
-        payload_mass=_number(obj, "payload_mass", path, positive=True),
-        boom_mass=_number(obj, "boom_mass", path, nonneg=True),
-        counterbalance=cb,
-    )
-
-
-def _axis(obj: Any) -> AxisDescription:
-    path = "axis"
-    obj = _mapping(obj, path)
-    _check_keys(obj, path, ("joint_type",), ("inertia", "gravity_moment"))
-    jt = obj["joint_type"]
-    if jt not in ("revolute", "prismatic"):
-        raise _fail("axis.joint_type", f"expected 'revolute' or 'prismatic', got {jt!r}")
-    gm = _number(obj, "gravity_moment", path, default=0.0)
-    if jt == "prismatic" and gm:
-        raise _fail("axis.gravity_moment", "only applies to a revolute joint")
-    return AxisDescription(joint_type=jt, inertia=_number(obj, "inertia", path, positive=True),
-                           gravity_moment=gm)
-
-
-_SECTIONS = {"cdpr": _cdpr, "crane": _crane, "axis": _axis}
-
-
 def parse_description(data: Any, source: str = "description") -> Description:
-    """Validate an already-parsed YAML mapping; ``source`` prefixes nothing, it is for messages."""
+    """Validate an already-parsed YAML mapping; ``source`` prefixes nothing, it is for messages.
+
+    Each plant section is parsed by its plant's ``section`` function (found through
+    :mod:`cablelab.registry`); the section of the plant named by ``plant`` is required."""
+    from .registry import available_plants, get_plant
+
     data = _mapping(data, source)
-    _check_keys(data, "", ("plant",), ("name", "gravity") + PLANTS)
+    plants = tuple(available_plants())
+    _check_keys(data, "", ("plant",), COMMON_KEYS[1:] + plants)
     plant = data["plant"]
-    if plant not in PLANTS:
-        raise _fail("plant", f"unknown plant {plant!r} (expected one of {', '.join(PLANTS)})")
-    if plant in _SECTIONS and plant not in data:
-        raise _fail(plant, "missing required key (the section of the plant named by 'plant')")
+    if plant not in plants:
+        raise _fail("plant", f"unknown plant {plant!r} (expected one of {', '.join(plants)})")
     name = data.get("name", "")
     if name is None:
         name = ""
     if not isinstance(name, str):
         raise _fail("name", f"expected text, got {name!r}")
     gravity = _number(data, "gravity", "", nonneg=True, default=9.81)
-    kwargs: dict[str, Any] = {}
-    extra = {}
-    for key in PLANTS:
+    parser = get_plant(plant).section
+    if parser is not None and data.get(plant) is None:
+        raise _fail(plant, "missing required key (the section of the plant named by 'plant')")
+    sections: dict[str, Any] = {}
+    for key in plants:
         if key in data and data[key] is not None:
-            if key in _SECTIONS:
-                kwargs[key] = _SECTIONS[key](data[key])
-            else:
-                extra[key] = _mapping(data[key], key)
-    return Description(plant=plant, name=name, gravity=gravity, extra=extra, **kwargs)
+            parse = get_plant(key).section
+            sections[key] = parse(data[key]) if parse is not None else _mapping(data[key], key)
+    return Description(plant=plant, name=name, gravity=gravity, sections=sections)
 
 
 def load_description(src: str | os.PathLike) -> Description:
@@ -279,33 +183,32 @@ def load_description(src: str | os.PathLike) -> Description:
     return dataclasses.replace(desc, yaml_text=text)
 
 
-def _plain(obj: Any) -> Any:
+def plain(obj: Any) -> Any:
+    """``obj`` with numpy arrays, dataclasses and tuples turned into YAML-ready lists/mappings
+    (``None`` fields of dataclasses dropped)."""
     if isinstance(obj, np.ndarray):
         return [float(x) for x in obj]
     if dataclasses.is_dataclass(obj):
-        return {k: _plain(v) for k, v in dataclasses.asdict(obj).items() if v is not None}
+        return {k: plain(getattr(obj, k)) for k in (f.name for f in dataclasses.fields(obj))
+                if getattr(obj, k) is not None}
     if isinstance(obj, (list, tuple)):
-        return [_plain(x) for x in obj]
+        return [plain(x) for x in obj]
     if isinstance(obj, dict):
-        return {k: _plain(v) for k, v in obj.items()}
+        return {k: plain(v) for k, v in obj.items()}
     return obj
 
 
 def description_dict(desc: Description) -> dict:
     """The description as a plain mapping in the YAML schema of CONTRACT section 3."""
+    from .registry import get_plant
+
     out: dict[str, Any] = {"plant": desc.plant}
     if desc.name:
         out["name"] = desc.name
     out["gravity"] = desc.gravity
-    for key in ("cdpr", "crane", "axis"):
-        sec = getattr(desc, key)
-        if sec is not None:
-            d = _plain(dataclasses.asdict(sec))
-            d = {k: v for k, v in d.items() if v is not None}
-            if key == "cdpr":
-                d["cables"] = [{k: _plain(v) for k, v in vars(c).items()} for c in sec.cables]
-            out[key] = d
-    out.update(desc.extra)
+    for key, sec in desc.sections.items():
+        dump = get_plant(key).dump_section if dataclasses.is_dataclass(sec) else None
+        out[key] = dump(sec) if dump is not None else plain(sec)
     return out
 
 

@@ -1,43 +1,16 @@
 """The contract topics of each plant (CONTRACT section 2) with their message types.
 
-ROS-free: used by the recorder to pick a plant's topic set and by tools that check bags.
-Additions beyond the contract tables are marked (documented in docs/nodes.md).
+ROS-free: used by the recorder to pick a plant's topic set and by tools that check bags. Each
+plant declares its own set (:attr:`cablelab.registry.Plant.contract_topics`, additions beyond the
+contract tables documented in docs/nodes.md); this module adds the topics every plant shares.
 """
 from __future__ import annotations
+
+from .registry import available_plants, get_plant
 
 COMMON = {
     "/clock": "rosgraph_msgs/msg/Clock",
     "/plant_description": "std_msgs/msg/String",
-}
-
-PLANT_TOPICS: dict[str, dict[str, str]] = {
-    "cdpr": {
-        "/cdpr/joint_states": "sensor_msgs/msg/JointState",
-        "/cdpr/cable_tensions": "sensor_msgs/msg/JointState",
-        "/cdpr/platform_pose": "geometry_msgs/msg/PoseStamped",
-        "/cdpr/reference": "trajectory_msgs/msg/MultiDOFJointTrajectory",
-        "/cdpr/effort_commands": "std_msgs/msg/Float64MultiArray",
-        "/cdpr/payload_estimate": "geometry_msgs/msg/InertiaStamped",
-        "/cdpr/ground_truth/pose": "geometry_msgs/msg/PoseStamped",
-        "/cdpr/ground_truth/payload": "geometry_msgs/msg/InertiaStamped",
-    },
-    "crane": {
-        "/crane/joint_states": "sensor_msgs/msg/JointState",
-        "/crane/boom_tip_pose": "geometry_msgs/msg/PoseStamped",
-        "/crane/payload_pose": "geometry_msgs/msg/PoseStamped",
-        "/crane/reference": "trajectory_msgs/msg/JointTrajectory",
-        "/crane/effort_commands": "std_msgs/msg/Float64MultiArray",
-        "/crane/swing_estimate": "sensor_msgs/msg/JointState",
-        "/crane/ground_truth/swing": "sensor_msgs/msg/JointState",
-    },
-    "axis": {
-        "/axis/joint_states": "sensor_msgs/msg/JointState",
-        "/axis/reference": "trajectory_msgs/msg/JointTrajectory",
-        # additions (docs/nodes.md): command input, live parameter estimate, simulation truth
-        "/axis/effort_command": "std_msgs/msg/Float64MultiArray",
-        "/axis/parameter_estimate": "std_msgs/msg/Float64MultiArray",
-        "/axis/ground_truth/joint_states": "sensor_msgs/msg/JointState",
-    },
 }
 
 
@@ -48,9 +21,9 @@ def plant_topics(plant: str) -> dict[str, str]:
     Raises:
         CablelabError: unknown plant.
     """
-    from .errors import CablelabError
+    return {**COMMON, **get_plant(plant).contract_topics}
 
-    if plant not in PLANT_TOPICS:
-        raise CablelabError(f"unknown plant {plant!r} (topic sets exist for: "
-                            f"{', '.join(sorted(PLANT_TOPICS))})")
-    return {**COMMON, **PLANT_TOPICS[plant]}
+
+def all_plant_topics() -> dict[str, dict[str, str]]:
+    """plant -> its contract topics (without the common ones), for every plant found."""
+    return {p: dict(get_plant(p).contract_topics) for p in available_plants()}

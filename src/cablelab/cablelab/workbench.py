@@ -30,7 +30,7 @@ def load(bag_path, description_path=None, options: dict | None = None):
         CablelabError: unreadable bag, no description, missing topics (one line each).
     """
     from .bags import open_bag
-    from .plants import get_plant
+    from .registry import get_plant
 
     bag = open_bag(bag_path)
     desc = load_bag_description(bag_path, description_path, bag)
@@ -109,7 +109,7 @@ def compare(ds: Dataset, model: Model, *, segments: int = 5) -> dict:
 
 
 def _plant_of(ds: Dataset):
-    from .plants import get_plant
+    from .registry import get_plant
 
     try:
         return get_plant(ds.plant)

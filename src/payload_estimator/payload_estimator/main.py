@@ -1,17 +1,14 @@
-"""``payload_estimator --plant {cdpr,crane,axis}``: estimator node of a plant.
+"""``payload_estimator --plant PLANT``: estimator node of a plant.
 
-The plant's adapter is the module ``payload_estimator.<plant>`` (``make_node(args)``); see
+The node is the plant's ``nodes/estimator.py`` (``make_node(args)``; any plant of the registry); see
 :func:`cablelab.ros.runner.plant_main` and docs/nodes.md.
 """
 import sys
 
-from cablelab.ros.runner import plant_main
+from cablelab.ros.runner import role_main
 
-
-def main(argv=None) -> int:
-    return plant_main("payload_estimator", argv, "Live estimator of a cablelab plant (CDPR payload "
-                      "mass and CoM, crane swing angles, axis parameters).")
-
+main = role_main("payload_estimator", "estimator", "Live estimator of a cablelab plant (CDPR payload "
+                   "mass and CoM, crane swing angles, axis parameters).")
 
 if __name__ == "__main__":
     sys.exit(main())

@@ -1,17 +1,14 @@
-"""``pd_feedforward --plant {cdpr,crane,axis}``: PD + feedforward controller node of a plant.
+"""``pd_feedforward --plant PLANT``: PD + feedforward controller node of a plant.
 
-The plant's adapter is the module ``pd_feedforward.<plant>`` (``make_node(args)``); see
+The node is the plant's ``nodes/controller.py`` (``make_node(args)``; any plant of the registry); see
 :func:`cablelab.ros.runner.plant_main` and docs/nodes.md.
 """
 import sys
 
-from cablelab.ros.runner import plant_main
+from cablelab.ros.runner import role_main
 
-
-def main(argv=None) -> int:
-    return plant_main("pd_feedforward", argv, "PD + feedforward controller of a cablelab plant: "
-                      "follows the plant's reference, publishes effort commands.")
-
+main = role_main("pd_feedforward", "controller", "PD + feedforward controller of a cablelab plant: "
+                   "follows the plant's reference, publishes effort commands.")
 
 if __name__ == "__main__":
     sys.exit(main())

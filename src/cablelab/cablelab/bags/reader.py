@@ -132,10 +132,10 @@ class Bag:
     def contract_mismatches(self) -> list[tuple[str, str, str]]:
         """(topic, type in the bag, contract type) of every contract topic (CONTRACT section 2,
         :mod:`cablelab.topics`) recorded with another type."""
-        from ..topics import COMMON, PLANT_TOPICS
+        from ..topics import COMMON, all_plant_topics
 
         contract = dict(COMMON)
-        for table in PLANT_TOPICS.values():
+        for table in all_plant_topics().values():
             contract.update(table)
         return [(t, have, contract[t]) for t, have in sorted(self.topics.items())
                 if t in contract and have != contract[t]]

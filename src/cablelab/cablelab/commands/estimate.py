@@ -1,13 +1,12 @@
 """``cablelab estimate BAG [--tensions {dynamometer,motor}] [--effects a,b] [--out BAG2] --json``.
 
-Dispatches on the plant of the bag's description to ``cablelab.plants.<plant>.estimate_bag(bag,
+Dispatches on the plant of the bag's description to its registered ``estimate(bag,
 description, tensions=..., effects=..., pose=..., out=...)``, which returns a dict or an object
 with ``summary() -> dict`` (CONTRACT section 5: cdpr ``{"plant", "samples", "mass": {"mean",
 "std", "max_abs_dev"}, "com": {"x", "y"}}``; crane: swing-angle statistics).
 """
 from __future__ import annotations
 
-import importlib
 import inspect
 
 from ..errors import CablelabError
@@ -33,13 +32,13 @@ def run(args) -> int:
     from ..workbench import load_bag_description
 
     desc = load_bag_description(args.bag, args.description)
-    try:
-        mod = importlib.import_module(f"cablelab.plants.{desc.plant}")
-    except ModuleNotFoundError:
-        mod = None
-    fn = getattr(mod, "estimate_bag", None)
+    from ..registry import available_plants, get_plant
+
+    fn = get_plant(desc.plant).estimate
     if fn is None:
-        raise CablelabError(f"plant {desc.plant}: no estimator (cablelab estimate supports cdpr and crane)")
+        able = [p for p in available_plants() if get_plant(p).estimate is not None]
+        raise CablelabError(f"plant {desc.plant}: no estimator (cablelab estimate supports "
+                            f"{', '.join(able)})")
     kwargs = {"tensions": args.tensions, "effects": parse_effect_list(args.effects),
               "pose": args.pose, "out": args.out}
     accepted = inspect.signature(fn).parameters

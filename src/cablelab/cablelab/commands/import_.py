@@ -17,18 +17,14 @@ from ..errors import CablelabError
 
 HELP = "import a CSV or MAT time series into a contract bag (with /plant_description)"
 
-#: plant -> (joint-state topic, joint names)
-JOINT_TOPICS = {
-    "axis": ("/axis/joint_states", ("joint",)),
-    "crane": ("/crane/joint_states", ("slew", "luff", "hoist")),
-    "cdpr": ("/cdpr/joint_states", tuple(f"winch_{i}" for i in range(1, 9))),
-}
 FIELDS = ("position", "velocity", "effort")
 
 
 def add_arguments(p) -> None:
     p.add_argument("file", help="CSV (header row) or MATLAB .mat file")
-    p.add_argument("--plant", required=True, choices=sorted(JOINT_TOPICS))
+    from ..registry import available_plants
+
+    p.add_argument("--plant", required=True, choices=available_plants())
     p.add_argument("--map", required=True, metavar="SPEC",
                    help="e.g. time=t,position=qm,effort=35.15*vir (multi-joint: position.slew=...)")
     p.add_argument("--description", metavar="YAML",
@@ -111,12 +107,23 @@ def evaluate(field: str, factors, table: dict[str, np.ndarray], source: str) -> 
     return np.asarray(value, dtype=float)
 
 
+def joint_topic(plant: str) -> tuple[str, tuple[str, ...]]:
+    """The plant's joint-state topic and joint names (its :class:`~cablelab.registry.Plant`)."""
+    from ..registry import get_plant
+
+    p = get_plant(plant)
+    if not p.joint_topic or not p.joints:
+        raise CablelabError(f"import --plant {plant}: the plant declares no fixed joint-state topic "
+                            "to import into")
+    return p.joint_topic, tuple(p.joints)
+
+
 def import_series(path: str, plant: str, spec: str) -> dict:
     """Read ``path`` and evaluate ``spec`` into ``{"t", "names", "position", "velocity", "effort"}``
     arrays (N, k) (None for an unmapped field)."""
     table = read_table(path)
     fields = parse_spec(spec)
-    topic, joints = JOINT_TOPICS[plant]
+    topic, joints = joint_topic(plant)
     if "time" not in fields:
         raise CablelabError(f"--map: missing 'time=' (e.g. time=t)")
     t = evaluate("time", fields.pop("time"), table, path)

@@ -10,7 +10,9 @@ HELP = "record a plant's contract topics (or --topics) into a rosbag2 MCAP bag"
 
 def add_arguments(p) -> None:
     p.add_argument("-o", "--output", required=True, help="bag directory to create")
-    p.add_argument("--plant", choices=["cdpr", "crane", "axis"],
+    from ..registry import available_plants
+
+    p.add_argument("--plant", choices=available_plants(),
                    help="record this plant's contract topics (+ /clock, /plant_description)")
     p.add_argument("--topics", help="comma-separated topics to record (types discovered)")
     p.add_argument("--duration", type=float, default=0.0, help="stop after this many s (0: on signal)")

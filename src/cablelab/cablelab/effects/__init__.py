@@ -1,11 +1,13 @@
-"""Effect registry (CONTRACT section 4): every physical effect is one :class:`~cablelab.model.Effect`
-registered by its stable id.
+"""Effect registry (CONTRACT section 4): every physical effect is one
+:class:`~cablelab.effects.base.Effect` registered by its stable id.
 
-Effects live in the modules of this package and register themselves at import with
-:func:`register`: the generic per-actuator effects in ``friction.py``, ``offset.py``,
-``delay.py``; plant-specific effects in a module named for the plant (``axis.py``, ``cdpr.py``,
-``crane.py``). Every module of the package is imported on first lookup, so adding an effect means
-adding one :class:`Effect` in one module (see docs/workbench.md "Adding an effect").
+The generic per-actuator effects live in this package (``friction.py``, ``offset.py``,
+``delay.py``) and apply to any plant whose datasets offer what they need (a plant declares
+``capabilities`` in its :class:`~cablelab.registry.Plant`); plant-specific effects live in their
+plant's package (``plants/<plant>/effects.py``) and register when it is imported. Looking up an
+id imports the generic modules and every plant found by :mod:`cablelab.registry` once, so adding
+an effect means adding one :class:`Effect` in one module (see docs/workbench.md "Adding an
+effect").
 """
 from __future__ import annotations
 
@@ -13,7 +15,7 @@ import importlib
 import pkgutil
 
 from ..errors import CablelabError
-from ..model import Effect
+from .base import Effect, Param
 
 _REGISTRY: dict[str, Effect] = {}
 _LOADED = False
@@ -34,8 +36,24 @@ def _load_all() -> None:
         return
     _LOADED = True
     for info in pkgutil.iter_modules(__path__):
-        if not info.name.startswith("_"):
+        if not info.name.startswith("_") and info.name != "base":
             importlib.import_module(f"{__name__}.{info.name}")
+    from ..registry import available_plants, get_plant
+
+    for name in available_plants():
+        try:
+            get_plant(name)  # importing a plant registers its effects
+        except CablelabError:
+            pass
+
+
+def _capabilities(plant: str | None) -> frozenset:
+    from ..registry import get_plant
+
+    try:
+        return get_plant(plant).capabilities if plant else frozenset()
+    except CablelabError:
+        return frozenset()
 
 
 def all_effects() -> dict[str, Effect]:
@@ -46,7 +64,8 @@ def all_effects() -> dict[str, Effect]:
 
 def effects_for(plant: str) -> list[str]:
     """Ids of the effects applicable to ``plant`` (sorted)."""
-    return sorted(e.id for e in all_effects().values() if e.applies_to(plant))
+    caps = _capabilities(plant)
+    return sorted(e.id for e in all_effects().values() if e.applies_to(plant, caps))
 
 
 def get_effect(effect_id: str, plant: str | None = None) -> Effect:
@@ -56,17 +75,18 @@ def get_effect(effect_id: str, plant: str | None = None) -> Effect:
         CablelabError: unknown id, or an id that does not apply to ``plant``; the message lists
             the valid ids.
     """
-    effects = all_effects()
-    eff = effects.get(effect_id)
+    eff = _REGISTRY.get(effect_id)
     if eff is None:
-        valid = effects_for(plant) if plant else sorted(effects)
+        eff = all_effects().get(effect_id)
+    if eff is None:
+        valid = effects_for(plant) if plant else sorted(all_effects())
         where = f" for plant {plant}" if plant else ""
         raise CablelabError(f"unknown effect {effect_id!r}; valid effects{where}: {', '.join(valid)}")
-    if plant is not None and not eff.applies_to(plant):
+    if plant is not None and not eff.applies_to(plant, _capabilities(plant)):
         raise CablelabError(f"effect {effect_id!r} does not apply to plant {plant} (it applies to "
-                            f"{', '.join(eff.plants)}); valid effects for {plant}: "
+                            f"{eff.applies_doc()}); valid effects for {plant}: "
                             f"{', '.join(effects_for(plant))}")
     return eff
 
 
-__all__ = ["Effect", "all_effects", "effects_for", "get_effect", "register"]
+__all__ = ["Effect", "Param", "all_effects", "effects_for", "get_effect", "register"]

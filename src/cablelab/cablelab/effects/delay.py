@@ -16,7 +16,8 @@ from typing import Mapping
 
 import numpy as np
 
-from ..model import Dataset, Effect, Param
+from ..dataset import Dataset
+from .base import Effect, Param
 from . import register
 
 #: search range of tau, s

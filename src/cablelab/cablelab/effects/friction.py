@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..model import Effect, Param, RegressorFn
+from .base import Effect, Param, RegressorFn
 from . import register
 
 #: velocities below this magnitude (in the actuator's unit/s) count as "at rest" for sign(v):
@@ -44,7 +44,8 @@ def coulomb_regressor(effect_id: str) -> RegressorFn:
 
 JOINT_VISCOUS_FRICTION = register(Effect(
     id="joint_viscous_friction",
-    plants=("axis", "crane"),
+    plants=("*",),
+    requires="joint_actuators",
     params=(Param("Fv", "{effort} s/{position}", 0.0, 0.0, np.inf, "viscous friction coefficient"),),
     explanation="a force opposing motion in proportion to the actuator velocity",
     signature="residual grows in proportion to velocity",
@@ -55,7 +56,8 @@ JOINT_VISCOUS_FRICTION = register(Effect(
 
 JOINT_COULOMB_FRICTION = register(Effect(
     id="joint_coulomb_friction",
-    plants=("axis", "crane"),
+    plants=("*",),
+    requires="joint_actuators",
     params=(Param("Fc", "{effort}", 0.0, 0.0, np.inf, "Coulomb (dry) friction level"),),
     explanation="a constant force opposing motion, changing sign with the velocity",
     signature="residual jumps at velocity reversals",

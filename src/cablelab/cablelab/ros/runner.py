@@ -1,9 +1,9 @@
 """Run an rclpy node: argument parsing (``--plant``, ``--ros-args``), spin, clean shutdown.
 
-``plant_main(package, argv)`` is the whole ``main`` of every node package: it parses
-``--plant``, imports ``<package>.<plant>`` (the plant's adapter module, which exposes
-``make_node(args) -> rclpy Node`` and optionally ``add_arguments(parser)``) and runs it with
-:func:`run_node`. ``--help`` never needs ROS. Standard ROS arguments (``--ros-args -p name:=value
+``plant_main(package, role, argv)`` is the whole ``main`` of every node package: it parses
+``--plant`` (any plant of :mod:`cablelab.registry`), imports the plant's node module for the
+role (``<plant package>.nodes.<role>``, which exposes ``make_node(args) -> rclpy Node`` and
+optionally ``add_arguments(parser)``) and runs it with :func:`run_node`. ``--help`` never needs ROS. Standard ROS arguments (``--ros-args -p name:=value
 --params-file f.yaml -r from:=to``) pass through to rclpy.
 
 A node may define ``executor_factory()`` returning the executor to spin it with (e.g.
@@ -17,7 +17,6 @@ A :class:`~cablelab.errors.CablelabError` while building the node prints one lin
 from __future__ import annotations
 
 import argparse
-import importlib
 import signal
 import sys
 import threading
@@ -100,9 +99,38 @@ def run_node(node_factory, args, ros_args: list[str], prog: str) -> int:
     return code
 
 
-def plant_main(package: str, argv: list[str] | None, description: str,
-               plants: tuple[str, ...] = ("cdpr", "crane", "axis")) -> int:
-    """``main`` of a node package: ``--plant P`` selects the module ``<package>.<P>``."""
+#: node role of each node package (its executable is ``main(role)`` over the plant registry)
+ROLES = {"cable_sim_node": "sim", "payload_estimator": "estimator", "pd_feedforward": "controller"}
+
+
+def node_module(plant: str, role: str):
+    """The module of a plant's node for ``role`` (``sim``, ``estimator``, ``controller``):
+    ``<plant package>.nodes.<role>``, which exposes ``make_node(args)`` and optionally
+    ``add_arguments(parser)``. None when the plant has no node for that role."""
+    from ..registry import plant_module
+
+    try:
+        return plant_module(plant, f"nodes.{role}")
+    except ModuleNotFoundError as exc:
+        if exc.name and exc.name.endswith((".nodes", f".nodes.{role}")):
+            return None
+        raise
+
+
+def role_main(package: str, role: str, description: str):
+    """The ``main(argv=None)`` of a node package: :func:`plant_main` for its role."""
+    def main(argv: list[str] | None = None) -> int:
+        return plant_main(package, role, argv, description)
+
+    main.__doc__ = f"``{package} --plant PLANT``: {description}"
+    return main
+
+
+def plant_main(package: str, role: str, argv: list[str] | None, description: str) -> int:
+    """``main`` of a node package: ``--plant P`` selects plant P's node for ``role``."""
+    from ..registry import available_plants
+
+    plants = available_plants()
     argv = list(sys.argv[1:] if argv is None else argv)
     user, ros_args = split_ros_args(argv)
     parser = argparse.ArgumentParser(
@@ -116,14 +144,13 @@ def plant_main(package: str, argv: list[str] | None, description: str,
     module = None
     if known.plant:
         try:
-            module = importlib.import_module(f"{package}.{known.plant}")
-        except ModuleNotFoundError as exc:
-            if exc.name != f"{package}.{known.plant}":
-                raise
-            if "-h" not in user and "--help" not in user:
-                print(f"{package}: error: plant {known.plant!r} is not available yet "
-                      f"(module {package}.{known.plant} not built)", file=sys.stderr)
-                return 2
+            module = node_module(known.plant, role)
+        except CablelabError as exc:
+            print(f"{package}: error: {exc}", file=sys.stderr)
+            return 2
+        if module is None and "-h" not in user and "--help" not in user:
+            print(f"{package}: error: plant {known.plant!r} has no {role} node", file=sys.stderr)
+            return 2
         if module is not None and hasattr(module, "add_arguments"):
             module.add_arguments(parser)
     args = parser.parse_args(user)

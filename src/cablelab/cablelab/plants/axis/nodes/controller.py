@@ -1,0 +1,95 @@
+"""Axis PD + feedforward controller node.
+
+On every ``/axis/joint_states`` message (event-driven, in the measurement's own time base) it
+computes ``u = M_ff qdd_ref + Kp (q_ref - q) + Kd (qd_ref - qd)``
+(:func:`cablelab.plants.axis.control.pd_feedforward`) and publishes it on
+``/axis/effort_command``. The reference is the latest ``/axis/reference`` (``reference_source:
+topic``, default) or a built-in sine evaluated at the measurement stamp (``reference_source:
+sine``, also published on ``/axis/reference`` so recordings hold it).
+
+ROS parameters: ``kp`` (N/m), ``kd`` (N s/m), ``inertia`` (feedforward M_ff; default the
+description's ``axis.inertia`` from /plant_description, else 0), ``reference_source``,
+``amplitude``, ``frequency`` (Hz), ``offset``, ``reference_timeout`` (s wall).
+
+Each command names the stamp of the state it answers (``layout.dim[0].label = 'joint stamp=<t>'``,
+:func:`cablelab.ros.convert.command_msg`): a lock-step simulator applies only the answer to its
+latest state.
+"""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+from sensor_msgs.msg import JointState
+from std_msgs.msg import Float64MultiArray
+from trajectory_msgs.msg import JointTrajectory
+
+from ..control import pd_feedforward, sine_reference
+from ....ros import convert
+from ....ros.plant_node import PlantNode
+from ....ros.qos import publisher_qos, stream_qos
+
+
+class AxisController(PlantNode):
+    def __init__(self):
+        super().__init__("pd_feedforward")
+        p = self.param
+        self.kp = float(p("kp", 400.0))
+        self.kd = float(p("kd", 40.0))
+        self.inertia_param = float(p("inertia", float("nan")))
+        self.inertia = 0.0 if np.isnan(self.inertia_param) else self.inertia_param
+        self.source = self.choice("reference_source", "topic", ("topic", "sine"))
+        self.amplitude = float(p("amplitude", 0.2))
+        self.frequency = float(p("frequency", 0.5))
+        self.offset = float(p("offset", 0.0))
+        self.ref = None  # (q, qd, qdd) from the topic
+        self.inputs.add("joint_states", timeout=0.5, length=1)
+        self.inputs.add("reference", timeout=float(p("reference_timeout", 0.5)), length=1,
+                        required=self.source == "topic")
+
+        self.pub_cmd = self.create_publisher(Float64MultiArray, "/axis/effort_command", publisher_qos())
+        self.pub_ref = self.create_publisher(JointTrajectory, "/axis/reference", publisher_qos()) \
+            if self.source == "sine" else None
+        self.create_subscription(JointState, "/axis/joint_states", self.on_state, stream_qos())
+        if self.source == "topic":
+            self.create_subscription(JointTrajectory, "/axis/reference", self.on_reference, stream_qos())
+        self.listen_for_description()
+        self.start_diagnostics()
+
+    def extend_status(self, level, msg, values):
+        values["feedforward inertia"] = f"{self.inertia:g}"
+        return level, msg, values
+
+    def set_description(self, desc) -> None:
+        super().set_description(desc)
+        if np.isnan(self.inertia_param) and desc.axis is not None and desc.axis.inertia:
+            self.inertia = float(desc.axis.inertia)
+
+    def on_reference(self, msg: JointTrajectory) -> None:
+        _, _, q, qd, qdd = convert.joint_trajectory_point(msg)
+        if self.inputs.accept("reference", q, time.monotonic()):
+            zero = np.zeros(1)
+            self.ref = (float(q[0]), float((qd if qd is not None else zero)[0]),
+                        float((qdd if qdd is not None else zero)[0]))
+
+    def on_state(self, msg: JointState) -> None:
+        t, _names, q, qd, _eff = convert.joint_state_arrays(msg)
+        now = time.monotonic()
+        if not self.inputs.accept("joint_states", q, now):
+            return
+        if qd is None or qd.size != q.size or not np.isfinite(qd).all():
+            qd = np.zeros_like(q)
+        if self.source == "sine":
+            q_ref, qd_ref, qdd_ref = (float(v) for v in sine_reference(t, self.amplitude, self.frequency,
+                                                                        self.offset))
+            self.pub_ref.publish(convert.joint_trajectory_msg(t, ["joint"], [q_ref], [qd_ref], [qdd_ref]))
+        elif self.ref is not None and self.inputs.fresh("reference", now):
+            q_ref, qd_ref, qdd_ref = self.ref
+        else:
+            return  # no reference: command nothing, the simulator's command timeout stops the drive
+        u = pd_feedforward(q[0], qd[0], q_ref, qd_ref, qdd_ref, self.kp, self.kd, self.inertia)
+        self.pub_cmd.publish(convert.command_msg([u], stamp=t, label="joint"))
+
+
+def make_node(args) -> PlantNode:
+    return AxisController()

@@ -1,0 +1,112 @@
+"""Axis simulator node: MuJoCo single axis driven by ``/axis/effort_command``.
+
+Publishes ``/axis/joint_states`` (name ``joint``: position, velocity, effort = applied command +
+sensor offset), ``/axis/ground_truth/joint_states`` (effort = true applied force), ``/clock``
+and ``/plant_description`` (transient-local). Physics: :mod:`cablelab.plants.axis.sim`.
+
+ROS parameters: ``description`` (YAML file or text; default a prismatic 2 kg axis),
+``inertia``, ``viscous``, ``coulomb``, ``offset`` (true values, SI), ``timestep`` (s),
+``rate`` (Hz of publishing = command sampling), ``command_timeout`` (s wall; a stale command
+falls back to 0 and the node reports WARN), ``lockstep`` (bool, default false: the simulation
+advances one period only after the command answering the last published state arrived, so a
+loaded machine slows the run down instead of delaying the control loop; the state is
+republished every ``lockstep_resend`` s while waiting, e.g. before the controller connected),
+``wait_for_subscribers`` (int, default 0: time starts only when ``/axis/joint_states`` has that
+many matched subscriptions, at most 60 s, so a recorder started with the run misses nothing).
+
+Lock-step matching: a command that names the stamp of the state it answers
+(:func:`cablelab.ros.convert.command_msg`, as the cablelab controllers send) is applied only if
+it answers the latest state; an answer to an earlier one (e.g. to a state resent while waiting)
+is counted on /diagnostics and ignored, so resends can never add a control delay. A command that
+names no stamp answers whatever state was published last.
+
+The effort reported with a state is the command held over the period that ends at that state.
+"""
+from __future__ import annotations
+
+import time
+
+from sensor_msgs.msg import JointState
+from std_msgs.msg import Float64MultiArray
+
+from ....description import load_description
+from ..sim import AxisSim, AxisTruth
+from ....ros import convert
+from ....ros.clock import ClockPublisher
+from ....ros.plant_node import PlantNode
+from ....ros.qos import publisher_qos, stream_qos
+
+DEFAULT_DESCRIPTION = ("plant: axis\nname: simulated linear axis\ngravity: 9.81\n"
+                       "axis:\n  joint_type: prismatic\n  inertia: 2.0\n")
+
+
+class AxisSimNode(PlantNode):
+    def __init__(self):
+        super().__init__("cable_sim_node")
+        p = self.declare_parameter
+        text = p("description", "").value or DEFAULT_DESCRIPTION
+        self.description = load_description(text)
+        nominal = self.description.axis.inertia if self.description.axis else None
+        truth = AxisTruth(inertia=p("inertia", float(nominal or 2.0)).value,
+                          viscous=p("viscous", 5.0).value, coulomb=p("coulomb", 1.0).value,
+                          offset=p("offset", 0.0).value, timestep=p("timestep", 0.001).value)
+        self.rate = float(p("rate", 200.0).value)
+        self.lockstep = bool(p("lockstep", False).value)
+        self.resend = float(p("lockstep_resend", 0.25).value)
+        self.answered = False  # lockstep: the command answering the last published state arrived
+        self.stale_answers = 0  # lockstep: answers to earlier states, ignored
+        self.start_gate()
+        self.last_publish = time.monotonic()
+        self.sim = AxisSim(self.description, truth)
+        self.u = 0.0
+        self.inputs.add("effort_command", timeout=float(p("command_timeout", 0.5).value), length=1)
+
+        self.pub_js = self.create_publisher(JointState, "/axis/joint_states", publisher_qos())
+        self.pub_truth = self.create_publisher(JointState, "/axis/ground_truth/joint_states", publisher_qos())
+        self.clock = ClockPublisher(self)
+        self.publish_description(self.description)
+        self.create_subscription(Float64MultiArray, "/axis/effort_command", self.on_command, stream_qos())
+        self.start_diagnostics()
+        self.timer = self.create_timer(1.0 / self.rate, self.tick)
+        self.publish_state()
+
+    def extend_status(self, level, msg, values):
+        values["sim time s"] = f"{self.sim.t:.3f}"
+        values["stale answers ignored (lock-step)"] = str(self.stale_answers)
+        return level, msg, values
+
+    def on_command(self, msg: Float64MultiArray) -> None:
+        values = convert.float_array(msg)
+        if not self.inputs.accept("effort_command", values, time.monotonic()):
+            return
+        stamp = convert.command_stamp(msg)
+        if self.lockstep and stamp is not None and not convert.same_stamp(stamp, self.sim.t):
+            self.stale_answers += 1  # answers an earlier state (already stepped past it)
+            return
+        self.u = float(values[0])
+        self.answered = True
+
+    def tick(self) -> None:
+        now = time.monotonic()
+        if self.waiting_for_subscribers(self.pub_js, self.last_publish, self.publish_state, self.resend):
+            return
+        if self.lockstep and not self.answered:
+            if now - self.last_publish > self.resend:
+                self.publish_state()  # the controller may have missed it (not connected yet)
+            return
+        if not self.lockstep and not self.inputs.fresh("effort_command", now):
+            self.u = 0.0  # no (fresh) command: the drive is switched off
+        self.sim.advance(self.u, 1.0 / self.rate)
+        self.publish_state()
+
+    def publish_state(self) -> None:
+        self.answered = False
+        self.last_publish = time.monotonic()
+        t, q, qd = self.sim.state()
+        self.clock.publish(t)
+        self.pub_js.publish(convert.joint_state_msg(t, ["joint"], [q], [qd], [self.sim.measured_effort(self.u)]))
+        self.pub_truth.publish(convert.joint_state_msg(t, ["joint"], [q], [qd], [self.u]))
+
+
+def make_node(args) -> PlantNode:
+    return AxisSimNode()

@@ -1,0 +1,127 @@
+"""CDPR effects (CONTRACT section 4) on the wrench-balance channels of the CDPR dataset.
+
+The CDPR dataset (:mod:`cablelab.plants.cdpr`) measures the cable wrench y = W(x) t (6 channels:
+forces N, moments N m about the platform origin, world axes) from the measured tensions t and the
+wrench matrix W at the desired (or measured) pose. The model explains it as (001 eq. 10-13)
+
+    W t = [m g_up; (m x_G R e_x + m y_G R e_y) x g_up]      (cdpr_gravity: m, mx, my)
+          + [m_a a; 0]                                      (platform_inertia)
+          + W (R/r) (F_c sign(qdot) + F_v qdot)             (winch friction, motor tensions only)
+          + W b                                             (tension_sensor_offset, dynamometers)
+
+``pulley_geometry`` is the switch from Model I (point exits, the dataset's W) to Model II (001
+eq. 6-9). The measured channels stay W_I t (so every candidate is scored on the same data) and the
+pulleys enter as W_I t = w_model - r_p S t, S = (W_II(r_ref) - W_I) / r_ref the secant slope of
+the wrench matrix in the sheave radius (r_ref = the description's r_p, else 0.15 m): linear in
+r_p, exact at r_ref. ``cablelab estimate`` then uses the exact Model II with the fitted r_p.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ...model import Dataset, Effect, Param
+from ...rotations import cross
+from ...effects import register
+from ...effects.friction import coulomb_regressor, viscous_regressor
+
+#: search range of the sheave radius r_p, m
+PULLEY_BOUNDS = (0.0, 0.4)
+
+
+def _gravity(ds: Dataset) -> np.ndarray:
+    g = ds.gravity
+    n = ds.n
+    up = np.zeros((n, 3))
+    up[:, 2] = g
+    R = ds.signals.get("R")
+    ex = np.broadcast_to([1.0, 0.0, 0.0], (n, 3)) if R is None else R[:, :, 0]
+    ey = np.broadcast_to([0.0, 1.0, 0.0], (n, 3)) if R is None else R[:, :, 1]
+    out = np.zeros((n, 6, 3))
+    out[:, :3, 0] = up
+    out[:, 3:, 1] = cross(ex, up)
+    out[:, 3:, 2] = cross(ey, up)
+    return out
+
+
+def _inertia(ds: Dataset) -> np.ndarray:
+    a = ds.require_signal("acc")
+    out = np.zeros((ds.n, 6, 1))
+    out[:, :3, 0] = a
+    return out
+
+
+def _pulley(ds: Dataset) -> np.ndarray:
+    # W_I t = w_model - r_p S t with S = (W(r_ref) - W(0)) / r_ref (the dataset's "pulley_slope"):
+    # exact at r_p = r_ref, second order in (r_p - r_ref) elsewhere
+    return -ds.require_signal("pulley_slope")[:, :, None]
+
+
+def _tension_offset(ds: Dataset) -> np.ndarray:
+    return ds.require_signal("W")
+
+
+CDPR_GRAVITY = register(Effect(
+    id="cdpr_gravity",
+    plants=("cdpr",),
+    params=(Param("m", "kg", 366.0, 0.0, np.inf, "total moving mass (platform + payload)"),
+            Param("mx", "kg m", 0.0, -np.inf, np.inf, "first moment m x_G (platform frame)"),
+            Param("my", "kg m", 0.0, -np.inf, np.inf, "first moment m y_G (platform frame)")),
+    explanation="the cables carry the weight of the platform and payload at its centre of mass",
+    signature="the whole static wrench",
+    reference="001 eq. 11-13",
+    regressor=_gravity,
+))
+
+PLATFORM_INERTIA = register(Effect(
+    id="platform_inertia",
+    plants=("cdpr",),
+    params=(Param("m_a", "kg", 366.0, 0.0, np.inf, "mass accelerated with the platform"),),
+    explanation="the cables also accelerate the moving mass (m a in the force balance)",
+    signature="mass estimate swings with the vertical acceleration (lift and lower phases)",
+    reference="001 eq. 10",
+    regressor=_inertia,
+))
+
+PULLEY_GEOMETRY = register(Effect(
+    id="pulley_geometry",
+    plants=("cdpr",),
+    params=(Param("r_p", "m", 0.15, PULLEY_BOUNDS[0], PULLEY_BOUNDS[1], "sheave radius"),),
+    explanation="cables leave the swivel pulleys at the moving tangent point of a sheave of "
+                "radius r_p, not at a fixed point (Model II)",
+    signature="mass underestimated by a pose-dependent factor; horizontal force imbalance",
+    reference="001 eq. 6-9, Table I",
+    regressor=_pulley,
+))
+
+WINCH_COULOMB_FRICTION = register(Effect(
+    id="winch_coulomb_friction",
+    plants=("cdpr",),
+    params=(Param("Fc", "{effort}", 0.0, 0.0, np.inf, "Coulomb friction of the winch, motor side"),),
+    explanation="a constant motor torque is lost to dry friction, changing sign with the winch",
+    signature="mass estimate from motor torques jumps when winches reverse",
+    reference="001 eq. 15, Table II",
+    regressor=coulomb_regressor("winch_coulomb_friction"),
+    per_actuator=True,
+))
+
+WINCH_VISCOUS_FRICTION = register(Effect(
+    id="winch_viscous_friction",
+    plants=("cdpr",),
+    params=(Param("Fv", "{effort} s/{position}", 0.0, 0.0, np.inf, "viscous friction of the winch"),),
+    explanation="motor torque lost in proportion to the winch speed",
+    signature="mass estimate from motor torques drifts with the cable speeds",
+    reference="001 eq. 15",
+    regressor=viscous_regressor("winch_viscous_friction"),
+    per_actuator=True,
+))
+
+TENSION_SENSOR_OFFSET = register(Effect(
+    id="tension_sensor_offset",
+    plants=("cdpr",),
+    params=(Param("b", "N", 0.0, -np.inf, np.inf, "constant bias of the dynamometer"),),
+    explanation="a dynamometer reads its cable tension plus a constant bias",
+    signature="wrench residual constant in the platform frame, also at rest",
+    reference="001 sec. II-B (dynamometer calibration)",
+    regressor=_tension_offset,
+    per_actuator=True,
+))

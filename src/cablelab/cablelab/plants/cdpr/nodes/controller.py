@@ -1,0 +1,217 @@
+"""CDPR controller node: PD on motor angles + mass feedforward (PDFF, 001 Fig. 6, eq. 14-15).
+
+Each ``/cdpr/joint_states`` sample gives one ``/cdpr/effort_commands`` (motor torques, N m, order
+winch_1..n) from :class:`cablelab.plants.cdpr.live.LiveController`: motor-angle PD with the
+inverse geometric model of the reference ``/cdpr/reference``, feedforward of 001 eq. 14 with the
+live ``/cdpr/payload_estimate`` (``feedforward`` true, PDFF) or none (PD), friction compensation
+(eq. 15) and a minimum-tension floor. A stale or implausible estimate falls back to the nominal
+mass (WARN on /diagnostics). Each command carries the stamp of the state it answers in
+``layout.dim[0].label`` (``winch stamp=<s>``, optional; a lock-step simulator matches it). Without a reference (or with a bad motor state) nothing is
+published (the simulator's brakes hold) and /diagnostics says why.
+
+ROS parameters: ``description``, ``feedforward`` (bool), ``nominal_mass`` (kg, 0 = the
+description's platform_mass), ``kp`` (N m/rad), ``kd`` (N m s/rad), ``coulomb``, ``viscous``
+(friction compensation), ``min_tension`` (N), ``preload`` (N), ``max_torque`` (N m), ``model``
+("II" | "I"), ``estimate_timeout`` (s of stamps), ``reference_timeout``, ``state_timeout`` (s wall),
+``sync_wait`` (s wall a state waits for the reference of its stamp before the latest one is used),
+``estimate_wait`` (s wall a state waits for the estimate of its stamp, 0 = never: use the latest;
+set it with a lock-step simulator to make sim -> estimator -> controller one deterministic chain),
+``fast_executor`` (default true: :class:`cablelab.ros.fastspin.FastExecutor`; false = rclpy's
+SingleThreadedExecutor), ``rt_priority`` (0 = normal scheduling; 1-99 = SCHED_FIFO, see
+:func:`cablelab.ros.fastspin.set_realtime_priority`). Commands go out as pre-serialised messages
+(:class:`cablelab.ros.rawmsg.RawTemplate`).
+"""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+from geometry_msgs.msg import InertiaStamped
+from sensor_msgs.msg import JointState
+from std_msgs.msg import Float64MultiArray, MultiArrayDimension
+from trajectory_msgs.msg import MultiDOFJointTrajectory
+
+from ....errors import CablelabError
+from ..control import PdffConfig
+from ..live import ControllerConfig, LiveController
+from ....ros import convert
+from ....rotations import xyzw_to_wxyz
+from ....ros.inputs import ERROR, WARN
+from ....ros.plant_node import PlantNode
+from ....ros.qos import stream_qos
+from ....ros.rawmsg import RawTemplate
+
+
+class CdprController(PlantNode):
+    def __init__(self):
+        super().__init__("pd_feedforward", start_parameter_services=False)  # smaller wait set
+        p = self.declare_parameter
+        d = PdffConfig()
+        self.gains = PdffConfig(kp=float(p("kp", d.kp).value), kd=float(p("kd", d.kd).value),
+                                coulomb=float(p("coulomb", 0.3).value),
+                                viscous=float(p("viscous", 0.002).value),
+                                min_tension=float(p("min_tension", d.min_tension).value),
+                                preload=float(p("preload", d.preload).value),
+                                max_torque=float(p("max_torque", d.max_torque).value))
+        self.feedforward = bool(p("feedforward", True).value)
+        self.nominal = float(p("nominal_mass", 0.0).value)
+        self.model = str(p("model", "II").value)
+        if self.model not in ("I", "II"):
+            raise CablelabError("pd_feedforward: parameter model must be I or II")
+        self.estimate_timeout = float(p("estimate_timeout", 2.0).value)
+        self.controller = None
+        self.ref = None
+        self.sent = 0
+        self.skipped = 0
+        self.estimates_rejected = 0
+        self.last_problem = ""
+        self.last_skip = -1e9     # wall time of the last skipped sample
+        self.latency = []
+        self.inputs.add("joint_states", timeout=float(p("state_timeout", 0.5).value))
+        self.inputs.add("reference", timeout=float(p("reference_timeout", 0.5).value))
+        self.inputs.add("payload_estimate", timeout=self.estimate_timeout, length=1,
+                        required=False)
+        q = stream_qos(1000)     # deep queue: a busy moment delays samples instead of dropping them
+        self.pub_cmd = self.create_publisher(Float64MultiArray, "/cdpr/effort_commands", q)
+        self.keep_first_description = True   # the first valid description configures the law
+        self.listen_for_description(p("description", "").value)
+        self.create_subscription(MultiDOFJointTrajectory, "/cdpr/reference", self.on_reference, q)
+        self.create_subscription(InertiaStamped, "/cdpr/payload_estimate", self.on_estimate, q)
+        self.create_subscription(JointState, "/cdpr/joint_states", self.on_state, q)
+        self.pending = None
+        self.sync_wait = float(p("sync_wait", 0.005).value)
+        self.estimate_wait = float(p("estimate_wait", 0.0).value)
+        self.est_stamp = None       # newest estimate stamp received (valid or not)
+        self.create_timer(0.002, self.on_timer)
+        self.use_fast_executor()
+        self._cmd_templates = {}        # label length -> (pre-serialised command, data view, label offset)
+        self.start_diagnostics()
+
+    def set_description(self, desc) -> None:
+        if desc.cdpr is None:
+            self.last_problem = "plant description has no cdpr section"
+            return
+        super().set_description(desc)
+        nominal = self.nominal or desc.cdpr.platform_mass or 366.0
+        cfg = ControllerConfig(feedforward=self.feedforward, nominal_mass=nominal,
+                               estimate_timeout=self.estimate_timeout, gains=self.gains,
+                               model=self.model)
+        self.controller = LiveController(desc.cdpr, desc.gravity, cfg)
+        self.inputs.set_length("joint_states", len(desc.cdpr.cables))
+
+    def on_reference(self, msg: MultiDOFJointTrajectory) -> None:
+        r = convert.multidof_arrays(msg)           # position None (rejected) when empty
+        if self.inputs.accept("reference", r["position"], time.monotonic()):
+            self.ref = (r["t"], r["position"], xyzw_to_wxyz(r["quaternion"]),
+                        r["linear_velocity"], r["linear_acceleration"])
+            self.try_command()
+
+    def on_estimate(self, msg: InertiaStamped) -> None:
+        t, m, com = convert.inertia_arrays(msg)
+        self.est_stamp = t if self.est_stamp is None else max(self.est_stamp, t)
+        if not self.inputs.accept("payload_estimate", [m], time.monotonic()):
+            self.try_command()
+            return
+        if self.controller is not None and not self.controller.estimate(t, m, com[:2]):
+            self.estimates_rejected += 1
+        self.try_command()                  # a state may have been waiting for this estimate
+
+    def on_state(self, msg: JointState) -> None:
+        """Keep the state; command now if the reference of its stamp is here (else a little later,
+        see :meth:`on_timer`: DDS does not order samples across topics)."""
+        self.pending = (msg, time.monotonic())
+        self.try_command()
+
+    def _waiting_for(self, t: float) -> tuple[bool, bool]:
+        """(reference of stamp t not here yet, estimate of stamp t awaited and not here yet)."""
+        ref = self.ref is not None and self.ref[0] < t - 1e-9
+        est = (self.estimate_wait > 0 and self.feedforward
+               and (self.est_stamp is None or self.est_stamp < t - 1e-9))
+        return ref, est
+
+    def try_command(self, force: bool = False) -> None:
+        if self.pending is None:
+            return
+        msg, _ = self.pending
+        t = convert.from_stamp(msg.header.stamp)
+        if not force and any(self._waiting_for(t)):
+            return                  # the reference (or awaited estimate) of this stamp is on its way
+        self.pending = None
+        self.command(msg)
+
+    def on_timer(self) -> None:
+        if self.pending is None:
+            return
+        age = time.monotonic() - self.pending[1]
+        ref, est = self._waiting_for(convert.from_stamp(self.pending[0].header.stamp))
+        if (ref and age > self.sync_wait) or (not ref and est and age > self.estimate_wait) \
+                or (not ref and not est):
+            self.try_command(force=True)
+
+    def command(self, msg: JointState) -> None:
+        t0 = time.perf_counter()
+        t, _names, q, qd, _eff = convert.joint_state_arrays(msg)
+        if self.controller is None:
+            self.skipped += 1
+            self.last_skip = time.monotonic()
+            self.last_problem = "waiting for /plant_description"
+            return
+        if not self.inputs.accept("joint_states", q, time.monotonic()) or qd is None or qd.size != q.size:
+            self.skipped += 1
+            self.last_skip = time.monotonic()
+            self.last_problem = "bad motor state (NaN, empty or wrong length)"
+            return
+        if self.ref is None or not self.inputs.fresh("reference", time.monotonic()):
+            self.skipped += 1
+            self.last_skip = time.monotonic()
+            self.last_problem = "no fresh reference: not commanding (brakes hold)"
+            return
+        _, pos, quat, vel, acc = self.ref
+        tau = self.controller.update(t, q, qd, pos, quat, vel, acc)
+        if tau is None:
+            self.skipped += 1
+            self.last_skip = time.monotonic()
+            self.last_problem = self.controller.status[-1][1]
+            return
+        # optional: the stamp of the state this command answers (a lock-step simulator matches it)
+        self.pub_cmd.publish(self._command_bytes(tau, f"winch stamp={t:.9f}"))
+        self.sent += 1
+        self.latency.append(time.perf_counter() - t0)
+        if len(self.latency) > 100000:
+            del self.latency[:50000]
+
+    def _command_bytes(self, tau: np.ndarray, label: str) -> bytes:
+        """Serialised Float64MultiArray (data = tau, layout.dim[0].label = label) from a
+        pre-serialised template per label length (only the digits and the torques change)."""
+        entry = self._cmd_templates.get((len(label), len(tau)))
+        if entry is None:
+            msg = convert.float_array_msg(tau)
+            msg.layout.dim = [MultiArrayDimension(label=label, size=len(tau), stride=len(tau))]
+            tpl = RawTemplate(msg)
+            entry = (tpl, tpl["data"], tpl.text_offset(label))
+            self._cmd_templates[(len(label), len(tau))] = entry
+        tpl, data, off = entry
+        data[:] = tau
+        tpl.write_text(off, label)
+        return tpl.data()
+
+    def extend_status(self, level, msg, values):
+        ctl = self.controller
+        if ctl is None:
+            level, msg = ERROR, self.last_problem or "waiting for /plant_description"
+        elif ctl.status and ctl.status[-1][0] > 0:
+            level = max(level, ctl.status[-1][0])
+            msg = ctl.status[-1][1] if msg == "ok" else f"{msg}; {ctl.status[-1][1]}"
+        if time.monotonic() - self.last_skip < 2.0 and self.last_problem:
+            level = max(level, WARN)
+            msg = self.last_problem if msg == "ok" else f"{msg}; {self.last_problem}"
+        values.update({"mode": "PDFF" if self.feedforward else "PD", "commands": str(self.sent),
+                       "skipped": str(self.skipped), "estimates rejected": str(self.estimates_rejected),
+                       "feedforward mass kg": "-" if ctl is None or ctl.mass is None else f"{ctl.mass:.1f}"})
+        if self.latency:
+            values["latency p99 ms"] = f"{1000 * np.percentile(np.asarray(self.latency[-1000:]), 99):.3f}"
+        return level, msg, values
+
+
+def make_node(args) -> PlantNode:
+    return CdprController()

@@ -1,0 +1,179 @@
+"""CDPR payload estimator node: mass and CoM (x_G, y_G) per sample (001 eq. 12-13), live.
+
+Inputs: ``/cdpr/cable_tensions`` (dynamometers) or ``/cdpr/joint_states`` (motor torques,
+friction compensated, 001 eq. 15), and the pose for the wrench matrix: ``/cdpr/reference``
+(desired, 001's real-time choice) or ``/cdpr/platform_pose`` (measured). The description comes
+from the ``description`` parameter or ``/plant_description``. Each tension sample gives one
+``/cdpr/payload_estimate`` (InertiaStamped, m = total moving mass, com = (x_G, y_G, NaN), frame
+``platform``) stamped like it, computed by :class:`cablelab.plants.cdpr.live.LiveEstimator`.
+Bad input (NaN, wrong length, negative tension, ill-conditioned W, stale pose) publishes nothing
+and is reported on /diagnostics; slack cables are reported as WARN.
+
+ROS parameters: ``description``, ``model`` ("II" | "I"), ``tensions`` ("dynamometer" |
+``"motor"``), ``pose`` ("desired" | "measured"), ``platform_inertia`` (bool), ``coulomb``,
+``viscous`` (friction compensation, N m, N m s/rad), ``pulley_radius`` (m, 0 = the
+description's), ``stale_after`` (s of stamps between tension and pose), ``input_timeout`` (s wall),
+``fast_executor`` (default true: :class:`cablelab.ros.fastspin.FastExecutor`; false = rclpy's
+SingleThreadedExecutor), ``rt_priority`` (0 = normal scheduling; 1-99 = SCHED_FIFO, see
+:func:`cablelab.ros.fastspin.set_realtime_priority`). The estimate goes out as a pre-serialised message
+(:class:`cablelab.ros.rawmsg.RawTemplate`); only the topic the ``tensions`` source needs is
+subscribed (``/cdpr/cable_tensions`` or ``/cdpr/joint_states``).
+"""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+from geometry_msgs.msg import InertiaStamped, PoseStamped
+from sensor_msgs.msg import JointState
+from trajectory_msgs.msg import MultiDOFJointTrajectory
+
+from ....errors import CablelabError
+from ..live import EstimatorConfig, LiveEstimator
+from ....ros import convert
+from ....rotations import xyzw_to_wxyz
+from ....ros.inputs import ERROR, WARN
+from ....ros.plant_node import PlantNode
+from ....ros.qos import stream_qos
+from ....ros.rawmsg import RawTemplate
+
+
+class CdprPayloadEstimator(PlantNode):
+    def __init__(self):
+        super().__init__("payload_estimator", start_parameter_services=False)  # smaller wait set
+        p = self.declare_parameter
+        r = float(p("pulley_radius", 0.0).value)
+        self.config = EstimatorConfig(
+            model=str(p("model", "II").value), tensions=str(p("tensions", "dynamometer").value),
+            pose=str(p("pose", "desired").value), platform_inertia=bool(p("platform_inertia", False).value),
+            coulomb=float(p("coulomb", 0.0).value), viscous=float(p("viscous", 0.0).value),
+            stale_after=float(p("stale_after", 0.5).value), pulley_radius=r if r > 0 else None)
+        if self.config.model not in ("I", "II") or self.config.tensions not in ("dynamometer", "motor") \
+                or self.config.pose not in ("desired", "measured"):
+            raise CablelabError("payload_estimator: parameters model in {I, II}, tensions in "
+                                "{dynamometer, motor}, pose in {desired, measured}")
+        timeout = float(p("input_timeout", 0.5).value)
+        self.estimator = None
+        self.pose = None        # (t, position, quat wxyz, acceleration)
+        self.motor = None       # (t, velocity, effort)
+        self.published = 0
+        self.skipped = 0
+        self.last_problem = ""
+        self.last_skip = -1e9     # wall time of the last skipped sample
+        self.latency = []       # processing times, s (for the benchmark)
+        self.inputs.add("tensions", timeout=timeout)
+        self.inputs.add("pose", timeout=timeout)
+        if self.config.tensions == "motor":
+            self.inputs.add("joint_states", timeout=timeout)
+        q = stream_qos(1000)     # deep queue: a busy moment delays samples instead of dropping them
+        self.pub = self.create_publisher(InertiaStamped, "/cdpr/payload_estimate", q)
+        self.keep_first_description = True   # the first valid description configures the law
+        self.listen_for_description(p("description", "").value)
+        # the pose first: when both wait in one wake-up, a tension sample meets the pose of its
+        # stamp (FastExecutor and rclpy's executor take ready topics in creation order)
+        if self.config.pose == "desired":
+            self.create_subscription(MultiDOFJointTrajectory, "/cdpr/reference", self.on_reference, q)
+        else:
+            self.create_subscription(PoseStamped, "/cdpr/platform_pose", self.on_pose, q)
+        if self.config.tensions == "motor":        # (1 kHz of traffic nobody reads otherwise)
+            self.create_subscription(JointState, "/cdpr/joint_states", self.on_joints, q)
+        else:
+            self.create_subscription(JointState, "/cdpr/cable_tensions", self.on_tensions, q)
+        self.use_fast_executor()
+        self.t_est = RawTemplate(convert.inertia_msg(0.0, 0.0, [0.0, 0.0, float("nan")]))
+        self._est_m, self._est_com = self.t_est["inertia.m"], self.t_est.vector("inertia.com")
+        self.start_diagnostics()
+
+    # ------------------------------------------------------------------ inputs
+    def set_description(self, desc) -> None:
+        if desc.cdpr is None:
+            self.last_problem = "plant description has no cdpr section"
+            return
+        super().set_description(desc)
+        self.estimator = LiveEstimator(desc.cdpr, desc.gravity, self.config)
+        n = len(desc.cdpr.cables)
+        self.inputs.set_length("tensions", n)
+        if "joint_states" in self.inputs.inputs:
+            self.inputs.set_length("joint_states", n)
+
+    def on_reference(self, msg: MultiDOFJointTrajectory) -> None:
+        r = convert.multidof_arrays(msg)           # position None (rejected) when empty
+        if self.inputs.accept("pose", r["position"], time.monotonic()):
+            self.pose = (r["t"], r["position"], xyzw_to_wxyz(r["quaternion"]), r["linear_acceleration"])
+
+    def on_pose(self, msg: PoseStamped) -> None:
+        t, pos, q = convert.pose_arrays(msg)
+        if self.inputs.accept("pose", pos, time.monotonic()):
+            self.pose = (t, pos, xyzw_to_wxyz(q), None)
+
+    def on_joints(self, msg: JointState) -> None:
+        t, _names, _q, qd, eff = convert.joint_state_arrays(msg)
+        if self.config.tensions != "motor":
+            return
+        if self.inputs.accept("joint_states", eff, time.monotonic()) and qd is not None:
+            self.motor = (t, qd, eff)
+            self.estimate(t, None)
+
+    def on_tensions(self, msg: JointState) -> None:
+        if self.config.tensions != "dynamometer":
+            return
+        t, _names, _q, _qd, eff = convert.joint_state_arrays(msg)
+        self.inputs.accept("tensions", eff, time.monotonic())
+        self.estimate(t, eff)
+
+    # ------------------------------------------------------------------ estimate
+    def estimate(self, t: float, tensions) -> None:
+        """One estimate at stamp t; nothing is published unless every check passes."""
+        t0 = time.perf_counter()
+        if self.estimator is None:
+            self.skipped += 1
+            self.last_skip = time.monotonic()
+            self.last_problem = "waiting for /plant_description"
+            return
+        if self.pose is None:
+            self.skipped += 1
+            self.last_skip = time.monotonic()
+            self.last_problem = f"no {self.config.pose} pose yet"
+            return
+        tp, pos, quat, acc = self.pose
+        kw = {"tensions": tensions}
+        times = {"pose": tp}
+        if self.config.tensions == "motor":
+            _, qd, eff = self.motor
+            kw = {"effort": eff, "motor_velocity": qd}
+        res = self.estimator.update(t, position=pos, quat=quat, acceleration=acc, input_times=times, **kw)
+        if res is None:
+            self.skipped += 1
+            self.last_skip = time.monotonic()
+            self.last_problem = self.estimator.status[-1][1]
+            return
+        m, com = res
+        self.t_est.stamp(t)                                    # pre-serialised InertiaStamped
+        self._est_m[0] = m
+        self._est_com[:2] = com[:2]
+        self.pub.publish(self.t_est.data())
+        self.published += 1
+        self.latency.append(time.perf_counter() - t0)
+        if len(self.latency) > 100000:
+            del self.latency[:50000]
+
+    def extend_status(self, level, msg, values):
+        est_status = self.estimator.status if self.estimator is not None else [(ERROR, self.last_problem)]
+        worst = max((s[0] for s in est_status), default=0)
+        if worst > 0:
+            level = max(level, worst)
+            msg = est_status[-1][1] if msg == "ok" else f"{msg}; {est_status[-1][1]}"
+        elif time.monotonic() - self.last_skip < 2.0 and self.last_problem and level == 0:
+            level, msg = WARN, f"skipped samples ({self.last_problem})"
+        values.update({"published": str(self.published), "skipped": str(self.skipped),
+                       "last problem": self.last_problem or "none",
+                       "model": self.config.model, "tensions": self.config.tensions,
+                       "pose": self.config.pose})
+        if self.latency:
+            lat = np.asarray(self.latency[-1000:])
+            values["latency p99 ms"] = f"{1000 * np.percentile(lat, 99):.3f}"
+        return level, msg, values
+
+
+def make_node(args) -> PlantNode:
+    return CdprPayloadEstimator()

@@ -1,0 +1,304 @@
+"""CDPR simulator node: the MuJoCo CAROCA of 001 (real pulleys, friction winches) driven by
+``/cdpr/effort_commands``.
+
+Publishes (CONTRACT sec. 2) ``/cdpr/joint_states`` (winch_1..n: motor angle, rate, torque from
+current), ``/cdpr/cable_tensions`` (cable_1..n: paid-out length, dynamometer tension),
+``/cdpr/platform_pose`` (optional), ``/cdpr/reference`` (the pick-and-place s-curve of 001 sec.
+II-C, unless ``publish_reference`` is false and another node publishes it), the ground truth
+``/cdpr/ground_truth/{pose,payload}``, ``/clock`` and ``/plant_description``. Physics:
+:class:`cablelab.plants.cdpr.sim.CdprSim`.
+
+Modes: ``real_time`` true steps at ``rate`` Hz of wall time; false runs as fast as possible in
+lock-step with the controller (a step as soon as the command answering the last published state
+arrived, or after ``lockstep_timeout`` s without one). Without a fresh command the winch brakes
+lock the motor angles (the last torque + a stiff PD about the locked angles), reported as WARN on
+/diagnostics; slack cables are reported too.
+
+ROS parameters: ``description`` (YAML file or text; default CAROCA), ``payload_mass`` (kg),
+``payload_com`` [x, y, z] (m), ``pulleys`` (bool), ``winch_coulomb`` (N m), ``winch_viscous``
+(N m s/rad), ``motor_inertia`` (kg m^2), ``tension_noise`` (N), ``tension_bias`` [n] (N),
+``torque_noise`` (N m), ``pose_noise`` (m), ``timestep`` (s; 0 = min(2 ms, 1/rate)), ``rate`` (Hz), ``real_time``,
+``publish_reference``, ``publish_pose``, ``trajectory_speed`` (time scale of the s-curve),
+``settle`` (s held at A before the trajectory starts), ``duration`` (s of simulated time after
+which the node exits; 0 = run until stopped), ``command_timeout`` (s wall, real time),
+``lockstep_timeout`` (s wall, lock-step), ``extras_every`` (publish /clock, the measured pose and
+the ground truth every k-th step: lighter at 1 kHz), ``wait_for_subscribers`` (time starts only
+once /cdpr/joint_states has this many subscribers, max 60 s: no sample lost to discovery), ``seed``,
+``fast_executor`` (default true: spun by :class:`cablelab.ros.fastspin.FastExecutor`; false = rclpy's
+SingleThreadedExecutor), ``rt_priority`` (0 = normal scheduling; 1-99 = SCHED_FIFO in real-time
+mode, ignored in lock-step, see :func:`cablelab.ros.fastspin.set_realtime_priority`). Outgoing messages are pre-serialised templates
+(:class:`cablelab.ros.rawmsg.RawTemplate`): each step only patches stamps and numbers.
+"""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+from geometry_msgs.msg import InertiaStamped, PoseStamped
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import JointState
+from std_msgs.msg import Float64MultiArray
+from trajectory_msgs.msg import MultiDOFJointTrajectory
+
+from ....description import load_description
+from ....errors import CablelabError
+from ..trajectory import pick_and_place
+from ....ros import convert
+from ....rotations import wxyz_to_xyzw
+from ....ros.inputs import WARN
+from ....ros.plant_node import PlantNode
+from ....ros.qos import stream_qos
+from ....ros.rawmsg import RawTemplate
+from ..sim import CdprSim, CdprTruth, default_description_path
+
+
+class CdprSimNode(PlantNode):
+    def __init__(self):
+        super().__init__("cable_sim_node", start_parameter_services=False)  # smaller wait set
+        p = self.declare_parameter
+        self.description = load_description(p("description", "").value or default_description_path())
+        c = self.description.cdpr
+        if c is None:
+            raise CablelabError("cable_sim_node --plant cdpr: the description has no cdpr section")
+        self.n = len(c.cables)
+        bias = list(p("tension_bias", [0.0]).value)
+        if len(bias) not in (1, self.n):
+            raise CablelabError(f"cable_sim_node: parameter tension_bias: expected 1 or {self.n} values")
+        truth = CdprTruth(
+            pulleys=bool(p("pulleys", True).value),
+            payload_mass=float(p("payload_mass", 0.0).value),
+            payload_com=tuple(float(x) for x in p("payload_com", [0.15, 0.0, -0.6]).value),
+            winch_coulomb=float(p("winch_coulomb", 0.3).value),
+            winch_viscous=float(p("winch_viscous", 0.002).value),
+            motor_inertia=float(p("motor_inertia", 2e-4).value),
+            tension_noise=float(p("tension_noise", 5.0).value),
+            tension_bias=tuple(float(b) for b in bias) if any(bias) else None,
+            torque_noise=float(p("torque_noise", 0.02).value),
+            pose_noise=float(p("pose_noise", 0.0).value),
+            timestep=float(p("timestep", 0.0).value) or min(0.002, 1.0 / float(p("rate", 100.0).value)),
+            seed=int(p("seed", 0).value))
+        self.rate = float(self.get_parameter("rate").value)
+        self.real_time = bool(p("real_time", True).value)
+        self.publish_reference = bool(p("publish_reference", True).value)
+        self.publish_pose = bool(p("publish_pose", True).value)
+        self.speed = float(p("trajectory_speed", 1.0).value)
+        self.settle = float(p("settle", 1.0).value)
+        self.duration = float(p("duration", 0.0).value)
+        self.extras_every = max(1, int(p("extras_every", 1).value))
+        self.start_gate()
+        self.command_timeout = float(p("command_timeout", 0.5).value)
+        self.lockstep_timeout = float(p("lockstep_timeout", 10.0).value)
+        if self.rate <= 0 or self.speed <= 0:
+            raise CablelabError("cable_sim_node: parameters rate and trajectory_speed must be > 0")
+        start = pick_and_place(np.array([0.0])).position[0]
+        self.sim = CdprSim(self.description, truth, start)
+        self.nstep = max(1, int(round(1.0 / (self.rate * self.sim.truth.timestep))))
+        # winch brakes: lock each motor angle where it was when the commands stopped, holding the
+        # last torque that carried the load (stiff PD about the locked angle)
+        self.brake_gains = (5.0, 0.05)       # N m/rad, N m s/rad
+        self.brake_q = None
+        self.brake_u = None
+        self.u = None
+        self.commands = 0           # good commands received
+        self.commands_at_pub = 0    # ... when the last state was published (lock-step)
+        self.u_stamp = None         # stamp of the state the last command answers, if it says
+        self.fallbacks = 0
+        self.fallbacks_running = 0  # ... after the first command (not the start-up wait)
+        self.slack_steps = 0
+        self.k = 0
+        self.done = False
+        # the robot is switched on hanging on its locked winch brakes at A: settle that first, so
+        # the first published state already carries the load (sim time restarts at 0)
+        for _ in range(int(round(0.5 / self.sim.truth.timestep))):
+            self.sim.step(self.brake(), 1)
+        self.sim.data.time = 0.0
+        self.brake_q = None
+        self.inputs.add("effort_commands", timeout=self.command_timeout, length=self.n)
+        self._last_pub_wall = time.monotonic()
+        self._wall0 = None          # wall time of sim time 0 (real-time mode)
+
+        q = stream_qos()
+        self.pub_js = self.create_publisher(JointState, "/cdpr/joint_states", q)
+        self.pub_ten = self.create_publisher(JointState, "/cdpr/cable_tensions", q)
+        self.pub_pose = self.create_publisher(PoseStamped, "/cdpr/platform_pose", q)
+        self.pub_ref = self.create_publisher(MultiDOFJointTrajectory, "/cdpr/reference", q)
+        self.pub_tpose = self.create_publisher(PoseStamped, "/cdpr/ground_truth/pose", q)
+        self.pub_tpay = self.create_publisher(InertiaStamped, "/cdpr/ground_truth/payload", q)
+        self.pub_clock = self.create_publisher(Clock, "/clock", stream_qos(10))
+        self.publish_description(self.description)
+        if not self.real_time and int(p("rt_priority", 0).value) > 0:
+            self.get_logger().warning("rt_priority ignored: lock-step mode runs as fast as possible")
+        self.use_fast_executor()
+        self._templates()
+        self.create_subscription(Float64MultiArray, "/cdpr/effort_commands", self.on_command, q)
+        self.start_diagnostics()
+        self.timer = self.create_timer(1.0 / self.rate if self.real_time else 0.0002, self.tick)
+        self.publish_state()
+
+    def _templates(self) -> None:
+        """Pre-serialised messages (fixed names and lengths): each step patches the numbers."""
+        z, z3 = np.zeros(self.n), np.zeros(3)
+        self.t_js = RawTemplate(convert.joint_state_msg(0.0, [f"winch_{i}" for i in range(1, self.n + 1)],
+                                                        z, z, z))
+        self.t_ten = RawTemplate(convert.joint_state_msg(0.0, [f"cable_{i}" for i in range(1, self.n + 1)],
+                                                         z, None, z))
+        self.t_ref = RawTemplate(convert.multidof_msg(0.0, z3, [0.0, 0.0, 0.0, 1.0], z3, None, z3, None))
+        self.t_clock = RawTemplate(convert.clock_msg(0.0))
+        self.t_pose = RawTemplate(convert.pose_msg(0.0, z3, [0.0, 0.0, 0.0, 1.0]))
+        self.t_tpose = RawTemplate(convert.pose_msg(0.0, z3, [0.0, 0.0, 0.0, 1.0]))
+        self.t_tpay = RawTemplate(convert.inertia_msg(0.0, 0.0, z3))
+        self.t_tpay["inertia.m"][0] = self.sim.truth.total_mass
+        self.t_tpay.vector("inertia.com")[:] = self.sim.truth.total_com
+        r = self.t_ref
+        self._ref_views = (r.vector("points[0].transforms[0].translation"),
+                           r.vector("points[0].velocities[0].linear"),
+                           r.vector("points[0].accelerations[0].linear"))
+
+    # ------------------------------------------------------------------ callbacks
+    def extend_status(self, level, msg, values):
+        st = self.sim.truth_state()
+        slack = [str(i + 1) for i in np.flatnonzero(st["slack"])]
+        values.update({"sim time s": f"{self.sim.time:.3f}", "brake (fallback) steps": str(self.fallbacks),
+                       "brake steps after the first command": str(self.fallbacks_running),
+                       "slack cable steps": str(self.slack_steps), "mode": "real time" if self.real_time
+                       else "as fast as possible (lock-step)"})
+        if slack:
+            level = max(level, WARN)
+            extra = "slack cable(s) " + ", ".join(slack)
+            msg = extra if msg == "ok" else f"{msg}; {extra}"
+        return level, msg, values
+
+    def on_command(self, msg: Float64MultiArray) -> None:
+        values = convert.float_array(msg)
+        if self.inputs.accept("effort_commands", values, time.monotonic()):
+            self.u = values.copy()
+            self.commands += 1
+            self.u_stamp = None
+            if msg.layout.dim and "stamp=" in msg.layout.dim[0].label:
+                try:
+                    self.u_stamp = float(msg.layout.dim[0].label.split("stamp=")[1])
+                except ValueError:
+                    pass
+
+    def reference(self, t: float):
+        """Desired pose/twist/acceleration of the s-curve at sim time t (held at A while
+        settling, at A after the return); tabulated once at the publishing rate."""
+        if getattr(self, "_ref_table", None) is None:
+            end = self.settle + 60.0 / self.speed + 1.0
+            grid = np.arange(int(end * self.rate) + 2) / self.rate
+            tt = np.maximum(0.0, grid - self.settle) * self.speed
+            tr = pick_and_place(tt)
+            self._ref_table = (tr.position, tr.velocity * self.speed, tr.acceleration * self.speed ** 2)
+        k = int(round(t * self.rate))
+        pos, vel, acc = self._ref_table
+        if k < len(pos) and abs(k / self.rate - t) < 1e-9:
+            return pos[k], vel[k], acc[k]
+        tr = pick_and_place(np.array([max(0.0, t - self.settle) * self.speed]))
+        return tr.position[0], tr.velocity[0] * self.speed, tr.acceleration[0] * self.speed ** 2
+
+    def tick(self) -> None:
+        """Timer: lock-step, one step when answered; real time, as many steps as the wall clock
+        says are due (catching up after a late timer, at most 20 at once)."""
+        if self.k == 0 and self.wait_subs:
+            if self.waiting_for_subscribers(self.pub_js, self._last_pub_wall, self.publish_state):
+                return
+            self.publish_state()
+        if not self.real_time:
+            self.step_once()
+            return
+        now = time.monotonic()
+        if self._wall0 is None:
+            self._wall0 = now - self.k / self.rate
+        due = min(20, int((now - self._wall0) * self.rate) - self.k)
+        if due > 19:                                   # far behind: do not try to catch up forever
+            self._wall0 = now - self.k / self.rate
+        for _ in range(max(0, due)):
+            self.step_once()
+            if self.done:
+                return
+
+    def step_once(self) -> None:
+        now = time.monotonic()
+        if not self.real_time:
+            if self.u_stamp is not None:      # the controller says which state it answers
+                answered = abs(self.u_stamp - self.sim.time) < 1e-6
+            else:
+                answered = self.commands > self.commands_at_pub
+            if not answered and now - self._last_pub_wall < self.lockstep_timeout:
+                return                                  # lock-step: wait for the controller
+            fresh = answered and self.u is not None     # an answer is fresh however late it came
+        else:
+            fresh = self.u is not None and self.inputs.fresh("effort_commands", now)
+        if not fresh:
+            for _ in range(self.nstep):        # brakes act continuously: every physics step
+                self.sim.step(self.brake(), 1)
+            self.fallbacks += 1
+            if self.commands:
+                self.fallbacks_running += 1
+        else:
+            self.brake_q = None
+            self.sim.step(self.u, self.nstep)
+        self.k += 1
+        if self.sim.slack().any():
+            self.slack_steps += 1
+        self.publish_state()
+        if self.duration and self.sim.time >= self.duration:
+            self.done = True
+
+    def brake(self) -> np.ndarray:
+        """Torques of the locked winch brakes (the plant's own safety behaviour)."""
+        ms = self.sim.measure()
+        if self.brake_q is None:
+            self.brake_q = ms["motor_angle"].copy()
+            k = self.description.cdpr.drum_radius / self.description.cdpr.gear_ratio
+            self.brake_u = self.u.copy() if self.u is not None else k * self.sim.truth_state()["tension"]
+        kp, kd = self.brake_gains
+        return self.brake_u + kp * (self.brake_q - ms["motor_angle"]) - kd * ms["motor_velocity"]
+
+    def publish_state(self) -> None:
+        """One sample of every output topic, from the pre-serialised templates (same bytes as
+        the convert.* messages, built without an rclpy message object per sample)."""
+        sim, t = self.sim, self.sim.time
+        ms = sim.measure()
+        extra = self.k % self.extras_every == 0          # /clock, pose and truth: maybe decimated
+        if extra:
+            self.t_clock.stamp(t, "clock")
+            self.pub_clock.publish(self.t_clock.data())
+        if self.publish_reference:
+            pos, vel, acc = self.reference(t)
+            tr, tv, ta = self._ref_views
+            tr[:], tv[:], ta[:] = pos, vel, acc
+            self.t_ref.stamp(t)
+            self.pub_ref.publish(self.t_ref.data())
+        js = self.t_js
+        js.stamp(t)
+        js["position"][:] = ms["motor_angle"]
+        js["velocity"][:] = ms["motor_velocity"]
+        js["effort"][:] = ms["motor_torque"]
+        self.pub_js.publish(js.data())
+        ten = self.t_ten
+        ten.stamp(t)
+        ten["position"][:] = ms["cable_length"]
+        ten["effort"][:] = ms["tension"]
+        self.pub_ten.publish(ten.data())
+        if extra:
+            if self.publish_pose:
+                self._pose(self.t_pose, t, ms["position"], ms["quat"])
+                self.pub_pose.publish(self.t_pose.data())
+            tp, tq = sim.truth_pose()
+            self._pose(self.t_tpose, t, tp, tq)
+            self.pub_tpose.publish(self.t_tpose.data())
+            self.t_tpay.stamp(t)
+            self.pub_tpay.publish(self.t_tpay.data())
+        self._last_pub_wall = time.monotonic()
+        self.commands_at_pub = self.commands
+
+    @staticmethod
+    def _pose(tpl: RawTemplate, t: float, position, quat_wxyz) -> None:
+        tpl.stamp(t)
+        tpl.vector("pose.position")[:] = position
+        tpl.vector("pose.orientation", "xyzw")[:] = wxyz_to_xyzw(quat_wxyz)
+
+
+def make_node(args) -> PlantNode:
+    return CdprSimNode()

@@ -1,0 +1,557 @@
+"""MuJoCo model of a suspended CDPR built from any plant description (CONTRACT section 3).
+
+Physics (all MuJoCo, no formula pasted on top):
+
+* platform: free body (mass, inertia of a box, CoM offset), optional payload welded under it with
+  its own CoM offset (001 Fig. 11);
+* each cable is a spatial tendon from a winch carriage, up the swivel axis to the sheave, over
+  the sheave (a cylinder on a free swivel hinge through A_i) and down to the anchor B_i. A rim
+  via-site on the top of the sheave between two wraps of the same cylinder makes the path
+  shortest when the sheave plane contains B_i, so the cable tension itself turns the swivel
+  (a single wrap would turn it away). Without the ``pulleys`` truth effect the cable runs through
+  a fixed point A_i (Model I physics);
+* the cable is inextensible but can go slack: the tendon's upper length limit (a unilateral,
+  slightly soft MuJoCo limit constraint) holds the paid-out length; its force is the tension;
+* winch drive: a slide joint along the swivel axis whose position is the reeled-in cable s,
+  driven by the motor torque through gear R and drum radius r (actuator gear R/r), with the motor
+  rotor inertia J (armature J (R/r)^2), Coulomb friction F_c (frictionloss F_c R/r) and viscous
+  friction F_v (damping F_v (R/r)^2), i.e. 001 eq. 15 on the motor side.
+
+Sensors (:meth:`CdprSim.measure`): dynamometer tensions (noise, optional bias), motor torque from
+current = applied torque (+ noise; includes what friction eats), motor angles and rates, platform
+pose (+ noise), and the ground truth. Every truth effect is a switch in :class:`CdprTruth`.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from ...description import Description
+from ...errors import CablelabError
+from ...rotations import wxyz_to_xyzw
+from .geometry import cable_geometry, swivel_reference
+
+__all__ = ["CdprTruth", "CdprSim", "CdprRun", "build_model_xml", "simulate", "write_run_bag", "PAYLOADS",
+           "default_description", "default_description_path", "scaled_reference",
+           "without_pulley_radius"]
+
+#: 001 sec. II-C: the empty platform and the two payloads M1, M2 (kg)
+PAYLOADS = {"MP": 0.0, "MP+M1": 122.0, "MP+M2": 249.0}
+
+
+@dataclass(frozen=True)
+class CdprTruth:
+    """What the simulated robot really is. Each effect can be switched off.
+
+    Args:
+        pulleys: cables run over swivel pulleys of radius ``pulley_radius`` (effect
+            ``pulley_geometry``); False = fixed point exits (Model I physics).
+        pulley_radius: sheave radius, m (None = the description's, or 0.15 when it has none).
+        platform_mass: kg (None = the description's, else 366).
+        platform_size: box (x, y, z) giving the platform inertia, m.
+        platform_com: platform CoM in the platform frame, m.
+        payload_mass: added mass, kg (001: 122 or 249).
+        payload_com: payload CoM in the platform frame, m (offset along x_p, 001 Fig. 11).
+        winch_coulomb: F_c per motor, N m (0 = effect off).
+        winch_viscous: F_v per motor, N m s/rad.
+        motor_inertia: rotor inertia, kg m^2.
+        tension_noise: dynamometer noise std, N.
+        tension_bias: per-dynamometer constant offset, N (effect ``tension_sensor_offset``).
+        torque_noise: motor torque (current) noise std, N m.
+        pose_noise: measured pose noise std, m.
+        cable_timeconst: time constant of the cable limit constraint (stiffness), s.
+        timestep: physics step, s (2 ms resolves the cable and PD dynamics: halving it changes
+            no reported number at the 0.01 mm / 0.01 kg level).
+        seed: noise seed.
+    """
+
+    pulleys: bool = True
+    pulley_radius: float | None = None
+    platform_mass: float | None = None
+    platform_size: tuple = (1.5, 1.5, 1.0)
+    platform_com: tuple = (0.0, 0.0, 0.0)
+    payload_mass: float = 0.0
+    payload_com: tuple = (0.15, 0.0, -0.6)
+    winch_coulomb: float = 0.3
+    winch_viscous: float = 0.002
+    motor_inertia: float = 2e-4
+    tension_noise: float = 5.0
+    tension_bias: tuple | None = None
+    torque_noise: float = 0.02
+    pose_noise: float = 0.0
+    cable_timeconst: float = 0.004
+    timestep: float = 0.002
+    seed: int = 0
+
+    def resolved(self, desc: Description) -> "CdprTruth":
+        """Fill the None defaults from the description."""
+        c = desc.cdpr
+        r = self.pulley_radius
+        if r is None:
+            r = c.pulley_radius if c.pulley_radius > 0 else 0.15
+        m = self.platform_mass if self.platform_mass is not None else (c.platform_mass or 366.0)
+        return replace(self, pulley_radius=float(r), platform_mass=float(m))
+
+    @property
+    def total_mass(self) -> float:
+        return float(self.platform_mass) + float(self.payload_mass)
+
+    @property
+    def total_com(self) -> np.ndarray:
+        """CoM of platform + payload in the platform frame, m."""
+        mp, ml = float(self.platform_mass), float(self.payload_mass)
+        return (mp * np.asarray(self.platform_com) + ml * np.asarray(self.payload_com)) / (mp + ml)
+
+
+_RUN = 20.0  # m of cable between the winch carriage (at s = 0) and A_i along the swivel axis (longer
+#              than any reel-out, so the carriage never reaches the sheave)
+
+
+FRICTION_SOLIMP = "0.9999 0.9999 0.001"   # near-hard Coulomb friction on the winches
+
+
+def _frame_quat(z: np.ndarray, x: np.ndarray) -> np.ndarray:
+    y = np.cross(z, x)
+    R = np.stack([x, y, z], 1)
+    from .geometry import matrix_to_quat
+    return matrix_to_quat(R)
+
+
+def _fmt(v) -> str:
+    return " ".join(f"{float(x):.9g}" for x in np.ravel(v))
+
+
+def build_model_xml(desc: Description, truth: CdprTruth) -> str:
+    """MJCF text of the CDPR (cable limits still open; :class:`CdprSim` closes them)."""
+    if desc.cdpr is None:
+        raise CablelabError("plant description: no 'cdpr' section")
+    c = desc.cdpr
+    t = truth.resolved(desc)
+    k = c.gear_ratio / c.drum_radius                       # motor rad per m of cable
+    r = t.pulley_radius
+    sx, sy, sz = t.platform_size
+    mp = t.platform_mass
+    inertia = mp / 12.0 * np.array([sy * sy + sz * sz, sx * sx + sz * sz, sx * sx + sy * sy])
+    axes = c.swivel_axes
+    refs = swivel_reference(axes)
+    bodies, tendons, actuators, sensors = [], [], [], []
+    for i, cab in enumerate(c.cables, start=1):
+        A, z, x = cab.exit_point, axes[i - 1], refs[i - 1]
+        quat = _frame_quat(z, x)
+        bodies.append(
+            f'<body name="winch_{i}" pos="{_fmt(A - _RUN * z)}" quat="{_fmt(quat)}" gravcomp="1">'
+            f'<joint name="reel_{i}" type="slide" axis="0 0 -1" armature="{t.motor_inertia * k * k:.9g}" '
+            f'frictionloss="{t.winch_coulomb * k:.9g}" solimpfriction="{FRICTION_SOLIMP}" '
+            f'damping="{t.winch_viscous * k * k:.9g}"/>'
+            f'<geom type="sphere" size="0.02" mass="0.1"/><site name="reel_{i}"/></body>')
+        if t.pulleys:
+            bodies.append(
+                f'<body name="pulley_{i}" pos="{_fmt(A)}" quat="{_fmt(quat)}">'
+                f'<joint name="swivel_{i}" type="hinge" axis="0 0 1" armature="0.05" damping="2"/>'
+                f'<geom name="sheave_{i}" type="cylinder" size="{r:.9g} 0.01" pos="{r:.9g} 0 0" '
+                f'euler="90 0 0" mass="2"/>'
+                f'<site name="in_{i}" pos="{-0.5 * r:.9g} 0 {1.5 * r:.9g}"/>'
+                f'<site name="out_{i}" pos="{2.5 * r:.9g} 0 {1.5 * r:.9g}"/>'
+                f'<site name="rim_{i}" pos="{r:.9g} 0 {1.001 * r:.9g}"/></body>')
+            path = (f'<site site="reel_{i}"/><geom geom="sheave_{i}" sidesite="in_{i}"/>'
+                    f'<site site="rim_{i}"/><geom geom="sheave_{i}" sidesite="out_{i}"/>'
+                    f'<site site="anchor_{i}"/>')
+        else:
+            bodies.append(f'<site name="exit_{i}" pos="{_fmt(A)}"/>')
+            path = f'<site site="reel_{i}"/><site site="exit_{i}"/><site site="anchor_{i}"/>'
+        tendons.append(f'<spatial name="cable_{i}" limited="true" range="0 1000" '
+                       f'solreflimit="{t.cable_timeconst:.9g} 1" solimplimit="0.95 0.99 0.001" '
+                       f'width="0.005">{path}</spatial>')
+        actuators.append(f'<motor name="motor_{i}" joint="reel_{i}" gear="{k:.9g}" ctrllimited="false"/>')
+        sensors.append(f'<tendonlimitfrc name="tension_{i}" tendon="cable_{i}"/>')
+    anchors = "".join(f'<site name="anchor_{i}" pos="{_fmt(cab.anchor_point)}"/>'
+                      for i, cab in enumerate(c.cables, start=1))
+    payload = ""
+    if t.payload_mass > 0:
+        ml = t.payload_mass
+        payload = (f'<body name="payload" pos="{_fmt(t.payload_com)}">'
+                   f'<inertial pos="0 0 0" mass="{ml:.9g}" diaginertia="{_fmt(ml / 12 * np.array([0.5, 0.5, 0.8]))}"/>'
+                   f'<geom type="box" size="0.5 0.4 0.05" mass="0" rgba="0.5 0.5 0.6 1"/></body>')
+    return f"""<mujoco model="cdpr">
+  <compiler angle="degree" autolimits="true"/>
+  <option timestep="{t.timestep:.9g}" gravity="0 0 {-desc.gravity:.9g}" integrator="implicitfast">
+    <flag contact="disable"/>
+  </option>
+  <default><geom contype="0" conaffinity="0"/></default>
+  <worldbody>
+    {''.join(bodies)}
+    <body name="platform" pos="0 0 1">
+      <freejoint name="platform"/>
+      <inertial pos="{_fmt(t.platform_com)}" mass="{mp:.9g}" diaginertia="{_fmt(inertia)}"/>
+      <geom type="box" size="{sx / 2:.9g} {sy / 2:.9g} {sz / 2:.9g}" mass="0" rgba="0.7 0.5 0.2 0.6"/>
+      {anchors}{payload}
+    </body>
+  </worldbody>
+  <tendon>{''.join(tendons)}</tendon>
+  <actuator>{''.join(actuators)}</actuator>
+  <sensor>{''.join(sensors)}</sensor>
+</mujoco>"""
+
+
+@dataclass
+class CdprSim:
+    """A running CDPR simulation (MuJoCo model + data) with contract-shaped measurements.
+
+    Args:
+        desc: plant description (any CDPR geometry).
+        truth: the simulated robot's true parameters and effect switches.
+        position: initial platform position (3,), m; the cables are made just taut there.
+    """
+
+    desc: Description
+    truth: CdprTruth = field(default_factory=CdprTruth)
+    position: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, 1.0]))
+
+    def __post_init__(self):
+        import mujoco
+
+        self._mj = mujoco
+        self.truth = self.truth.resolved(self.desc)
+        c = self.desc.cdpr
+        self.n = len(c.cables)
+        self.k = c.gear_ratio / c.drum_radius
+        self.model = mujoco.MjModel.from_xml_string(build_model_xml(self.desc, self.truth))
+        self.data = mujoco.MjData(self.model)
+        m = self.model
+        self._reel_q = np.array([m.jnt_qposadr[m.joint(f"reel_{i}").id] for i in range(1, self.n + 1)])
+        self._reel_v = np.array([m.jnt_dofadr[m.joint(f"reel_{i}").id] for i in range(1, self.n + 1)])
+        self._free_q = m.jnt_qposadr[m.joint("platform").id]
+        self._free_v = m.jnt_dofadr[m.joint("platform").id]
+        if self.truth.pulleys:
+            self._swivel_q = np.array([m.jnt_qposadr[m.joint(f"swivel_{i}").id] for i in range(1, self.n + 1)])
+        self._rng = np.random.default_rng(self.truth.seed)
+        bias = self.truth.tension_bias
+        self._bias = np.zeros(self.n) if bias is None else np.broadcast_to(np.asarray(bias, float), (self.n,)).copy()
+        self.reset(self.position)
+
+    # ----------------------------------------------------------------------------- state
+    def reset(self, position, quat=(1.0, 0.0, 0.0, 0.0)) -> None:
+        """Put the platform at rest at ``position`` with taut, tension-free cables."""
+        mj, m, d = self._mj, self.model, self.data
+        mj.mj_resetData(m, d)
+        d.qpos[self._free_q:self._free_q + 3] = position
+        d.qpos[self._free_q + 3:self._free_q + 7] = quat
+        if self.truth.pulleys:
+            c = self.desc.cdpr
+            g = cable_geometry(c.exit_points, c.anchor_points, np.asarray(position, float), None,
+                               self.truth.pulley_radius, c.swivel_axes)
+            d.qpos[self._swivel_q] = g.swivel_angles[0]
+        m.tendon_range[:, 1] = 1000.0
+        mj.mj_forward(m, d)
+        m.tendon_range[:, 1] = d.ten_length.copy()
+        self.cable_total = d.ten_length.copy()               # run + paid-out length at s = 0
+        mj.mj_forward(m, d)
+
+    @property
+    def time(self) -> float:
+        return float(self.data.time)
+
+    def step(self, torque: np.ndarray, nstep: int = 1) -> None:
+        """Apply motor torques (N m, positive reels in) for ``nstep`` physics steps."""
+        self.data.ctrl[:] = torque
+        self._mj.mj_step(self.model, self.data, nstep)
+
+    def truth_pose(self):
+        """(position (3,), quaternion (4,) w-x-y-z) of the platform, world."""
+        q = self.data.qpos[self._free_q:self._free_q + 7]
+        return q[:3].copy(), q[3:].copy()
+
+    def slack(self) -> np.ndarray:
+        """(n,) True where a cable is slack (shorter than its taut length: the tendon limit)."""
+        return self.data.ten_length < self.model.tendon_range[:, 1] - 1e-6
+
+    def truth_state(self) -> dict:
+        """Ground truth: pose, twist, tensions, swivel angles, slack flags."""
+        d = self.data
+        p, q = self.truth_pose()
+        tension = -d.sensordata[:self.n] if d.sensordata[:self.n].sum() < 0 else d.sensordata[:self.n].copy()
+        out = {"position": p, "quat": q, "velocity": d.qvel[self._free_v:self._free_v + 3].copy(),
+               "tension": np.abs(tension), "slack": self.slack()}
+        if self.truth.pulleys:
+            out["swivel"] = d.qpos[self._swivel_q].copy()
+        return out
+
+    def measure(self) -> dict:
+        """Contract measurements with sensor noise: motor angle/rate/torque (winch_1..n),
+        dynamometer tension and paid-out cable length (cable_1..n), measured pose."""
+        d, t, rng = self.data, self.truth, self._rng
+        s = d.qpos[self._reel_q]
+        sd = d.qvel[self._reel_v]
+        paid = self.cable_total - _RUN - s
+        tension = np.abs(d.sensordata[:self.n])
+        p, q = self.truth_pose()
+        return {
+            "motor_angle": -self.k * paid,
+            "motor_velocity": self.k * sd,
+            "motor_torque": d.actuator_force.copy() + t.torque_noise * rng.standard_normal(self.n),
+            "tension": tension + self._bias + t.tension_noise * rng.standard_normal(self.n),
+            "cable_length": paid,
+            "position": p + t.pose_noise * rng.standard_normal(3),
+            "quat": q,
+        }
+
+
+# ================================================================================ offline runs
+
+@dataclass
+class CdprRun:
+    """Arrays of one closed-loop run, sampled at the control rate (N samples, n cables).
+
+    Contract quantities: ``t`` s; ``motor_angle``, ``motor_velocity``, ``motor_torque`` (N, n);
+    ``tension``, ``cable_length`` (N, n); measured ``position`` (N, 3) and ``quat`` (N, 4, w-x-y-z);
+    reference ``ref_position``, ``ref_velocity``, ``ref_acceleration`` (N, 3), ``ref_quat``;
+    ``command`` (N, n) motor torque commands; the live estimate ``est_mass`` (N,), ``est_com``
+    (N, 2) (NaN where none); the ground truth ``true_position`` (N, 3), ``true_quat``,
+    ``true_tension`` (N, n), ``slack`` (N, n) bool, ``true_mass`` and ``true_com`` (3,).
+    """
+
+    desc: Description
+    truth: CdprTruth
+    arrays: dict
+
+    def __getattr__(self, name):
+        try:
+            return self.__dict__["arrays"][name]
+        except KeyError:
+            raise AttributeError(name) from None
+
+
+def simulate(desc: Description, truth: CdprTruth | None = None, *, controller: str = "pdff",
+             duration: float = 60.0, rate: float = 100.0, reference=None,
+             controller_config=None, estimator_config=None, progress=None,
+             settle: float = 2.0) -> CdprRun:
+    """Closed-loop simulation of the pick-and-place test (001 sec. II-C) as fast as possible.
+
+    Each control period (1/rate s): measure, estimate the payload live (Model II, dynamometers,
+    desired pose unless ``estimator_config`` says otherwise), compute the PD / PDFF torques, step
+    the physics. The same :class:`~cablelab.plants.cdpr.live.LiveEstimator` and
+    :class:`~cablelab.plants.cdpr.live.LiveController` run inside the nodes.
+
+    Args:
+        desc: plant description; truth: the simulated robot (default :class:`CdprTruth`).
+        controller: "pdff" (live mass feedforward), "pd" (no feedforward) or "ff-nominal".
+        duration: s; rate: control and sample rate, Hz (CAROCA: 100).
+        reference: a :class:`~cablelab.plants.cdpr.trajectory.Trajectory` sampled at ``rate``
+            (default: the test trajectory for ``duration``).
+        progress: optional callable(fraction, elapsed s) for long runs.
+        settle: s of holding the start pose under control before the recorded run starts (the
+            cables are tension-free when the model is built).
+    """
+    import time as _time
+
+    from .control import PdffConfig
+    from .live import ControllerConfig, EstimatorConfig, LiveController, LiveEstimator
+    from .trajectory import sample_trajectory
+
+    truth = (truth or CdprTruth()).resolved(desc)
+    c = desc.cdpr
+    ref = reference if reference is not None else sample_trajectory(duration, rate)
+    N = len(ref.t)
+    sim = CdprSim(desc, truth, ref.position[0])
+    nstep = max(1, int(round(1.0 / (rate * truth.timestep))))
+    ccfg = controller_config or ControllerConfig(
+        feedforward=controller != "pd", nominal_mass=c.platform_mass or 366.0,
+        gains=PdffConfig(coulomb=truth.winch_coulomb, viscous=truth.winch_viscous))
+    ctl = LiveController(c, desc.gravity, ccfg)
+    est = LiveEstimator(c, desc.gravity, estimator_config or EstimatorConfig())
+    n = sim.n
+    keys_n = ("motor_angle", "motor_velocity", "motor_torque", "tension", "cable_length",
+              "command", "true_tension")
+    A = {k: np.empty((N, n)) for k in keys_n}
+    A.update({k: np.empty((N, 3)) for k in ("position", "true_position")})
+    A.update({k: np.empty((N, 4)) for k in ("quat", "true_quat")})
+    A["slack"] = np.zeros((N, n), bool)
+    A["est_mass"] = np.full(N, np.nan)
+    A["est_com"] = np.full((N, 2), np.nan)
+    # geometry of the whole reference at once (vectorised); the live classes take one sample
+    from .geometry import CableGeometry, quat_to_matrix, wrench_matrix
+    Rref = None if np.allclose(ref.orientation, [1, 0, 0, 0]) else quat_to_matrix(ref.orientation)
+
+    def _geoms(r):
+        g = cable_geometry(c.exit_points, c.anchor_points, ref.position, Rref, r, c.swivel_axes)
+        return g, wrench_matrix(g)
+
+    r_ctl = 0.0 if ccfg.model == "I" else (ccfg.gains.pulley_radius if ccfg.gains.pulley_radius is not None
+                                           else c.pulley_radius)
+    g_ctl, W_ctl = _geoms(r_ctl)
+    pinv_ctl = np.linalg.pinv(W_ctl)
+    g_est, W_est = _geoms(est._radius())
+    cond_est = np.linalg.cond(W_est)
+
+    def _one(g, k):
+        return CableGeometry(*(getattr(g, f)[k:k + 1] for f in g.__dataclass_fields__))
+
+    desired = est.config.pose == "desired"
+    # settle: hold the start pose with the controller until the cables carry the platform
+    for _ in range(int(round(settle * rate))):
+        ms = sim.measure()
+        e = est.update(0.0, tensions=ms["tension"], effort=ms["motor_torque"],
+                       motor_velocity=ms["motor_velocity"], position=ref.position[0],
+                       quat=ref.orientation[0], geometry=_one(g_est, 0), condition=cond_est[0])
+        if e is not None and controller == "pdff":
+            ctl.estimate(0.0, *e)
+        sim.step(ctl.update(0.0, ms["motor_angle"], ms["motor_velocity"], ref.position[0],
+                            ref.orientation[0], geometry=_one(g_ctl, 0), pinv=pinv_ctl[:1]), nstep)
+    ctl._t_est = ctl._t_filter = 0.0 if ctl._t_est is not None else None
+    t0 = _time.monotonic()
+    for k in range(N):
+        t = k / rate
+        ms = sim.measure()
+        tr = sim.truth_state()
+        for key in ("motor_angle", "motor_velocity", "motor_torque", "tension", "cable_length",
+                    "position", "quat"):
+            A[key][k] = ms[key]
+        A["true_position"][k], A["true_quat"][k] = tr["position"], tr["quat"]
+        A["true_tension"][k], A["slack"][k] = tr["tension"], tr["slack"]
+        e = est.update(t, tensions=ms["tension"], effort=ms["motor_torque"],
+                       motor_velocity=ms["motor_velocity"],
+                       position=ref.position[k] if desired else ms["position"],
+                       quat=ref.orientation[k] if desired else ms["quat"],
+                       acceleration=ref.acceleration[k],
+                       geometry=_one(g_est, k) if desired else None,
+                       condition=cond_est[k] if desired else None)
+        if e is not None:
+            A["est_mass"][k], A["est_com"][k] = e
+            if controller == "pdff":
+                ctl.estimate(t, *e)
+        tau = ctl.update(t, ms["motor_angle"], ms["motor_velocity"], ref.position[k],
+                         ref.orientation[k], ref.velocity[k], ref.acceleration[k],
+                         geometry=_one(g_ctl, k), pinv=pinv_ctl[k:k + 1])
+        A["command"][k] = tau
+        sim.step(tau, nstep)
+        if progress is not None and k % max(1, N // 10) == 0:
+            progress(k / N, _time.monotonic() - t0)
+    A["t"] = ref.t.copy()
+    A["ref_position"], A["ref_velocity"] = ref.position, ref.velocity
+    A["ref_acceleration"], A["ref_quat"] = ref.acceleration, ref.orientation
+    A["true_mass"], A["true_com"] = truth.total_mass, truth.total_com
+    return CdprRun(desc, truth, A)
+
+
+def write_run_bag(run: CdprRun, path, *, overwrite: bool = True, pose: bool = True,
+                  ground_truth: bool = True, commands: bool = True, every: int = 1) -> None:
+    """Write a run as a contract bag (CONTRACT section 2): /plant_description, /clock,
+    /cdpr/joint_states, /cdpr/cable_tensions, /cdpr/reference, optional /cdpr/platform_pose,
+    /cdpr/effort_commands, /cdpr/ground_truth/{pose,payload}; ``every`` keeps every k-th sample."""
+    from ...bags import BagWriter
+    from ...description import dump_description
+
+    n = run.motor_angle.shape[1]
+    k = max(1, int(every))                       # keep every k-th sample (smaller reference bags)
+    A = {key: (v[::k] if isinstance(v, np.ndarray) and v.ndim and len(v) == len(run.arrays["t"]) else v)
+         for key, v in run.arrays.items()}
+    t = A["t"]
+    with BagWriter(path, overwrite=overwrite) as w:
+        w.write_description(run.desc.yaml_text or dump_description(run.desc), float(t[0]))
+        w.write_clock(t)
+        w.write_joint_states("/cdpr/joint_states", t, [f"winch_{i}" for i in range(1, n + 1)],
+                             A["motor_angle"], A["motor_velocity"], A["motor_torque"])
+        w.write_joint_states("/cdpr/cable_tensions", t, [f"cable_{i}" for i in range(1, n + 1)],
+                             A["cable_length"], None, A["tension"])
+        w.write_multidof_trajectory("/cdpr/reference", t, A["ref_position"], wxyz_to_xyzw(A["ref_quat"]),
+                                    A["ref_velocity"], None, A["ref_acceleration"], None)
+        if pose:
+            w.write_poses("/cdpr/platform_pose", t, A["position"], wxyz_to_xyzw(A["quat"]))
+        if commands:
+            w.write_float_arrays("/cdpr/effort_commands", t, A["command"])
+        if ground_truth:
+            w.write_poses("/cdpr/ground_truth/pose", t, A["true_position"], wxyz_to_xyzw(A["true_quat"]))
+            com = np.broadcast_to(A["true_com"], (len(t), 3))
+            w.write_inertia("/cdpr/ground_truth/payload", t, np.full(len(t), A["true_mass"]), com)
+
+
+def main(argv=None) -> int:
+    """``python -m cablelab.plants.cdpr.sim -o BAG``: simulate the 001 test trajectory offline (as fast as
+    possible) and write a contract bag."""
+    import argparse
+    import sys
+    import time as _time
+
+    from ...description import load_description
+    from ...errors import CablelabError
+
+    p = argparse.ArgumentParser(prog="python -m cablelab.plants.cdpr.sim", description=main.__doc__)
+    p.add_argument("-o", "--out", required=True, help="bag directory to write (replaced)")
+    p.add_argument("--description", default=None, help="plant description (default: CAROCA)")
+    p.add_argument("--payload", type=float, default=0.0, help="payload mass, kg (001: 122, 249)")
+    p.add_argument("--controller", choices=("pdff", "pd"), default="pdff")
+    p.add_argument("--duration", type=float, default=60.0, help="s (60 = A->E->A)")
+    p.add_argument("--rate", type=float, default=100.0, help="control and sample rate, Hz")
+    p.add_argument("--no-pulleys", action="store_true", help="truth: point exits (Model I physics)")
+    p.add_argument("--coulomb", type=float, default=None, help="truth winch Coulomb friction, N m")
+    p.add_argument("--viscous", type=float, default=None, help="truth winch viscous friction, N m s/rad")
+    p.add_argument("--bias", type=float, nargs="*", default=None, help="dynamometer biases, N")
+    p.add_argument("--speed", type=float, default=1.0, help="trajectory time scale (2 = twice as fast)")
+    p.add_argument("--strip-pulley-radius", action="store_true",
+                   help="write the description without pulley_radius (pulleys unknown to the analysis)")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--every", type=int, default=1, help="write every k-th sample (smaller bags)")
+    a = p.parse_args(argv)
+    try:
+        desc = load_description(a.description or default_description_path())
+        kw = {"payload_mass": a.payload, "pulleys": not a.no_pulleys, "seed": a.seed}
+        if a.coulomb is not None:
+            kw["winch_coulomb"] = a.coulomb
+        if a.viscous is not None:
+            kw["winch_viscous"] = a.viscous
+        if a.bias:
+            kw["tension_bias"] = tuple(a.bias)
+        t0 = _time.monotonic()
+        run = simulate(desc, CdprTruth(**kw), controller=a.controller, duration=a.duration / a.speed,
+                       rate=a.rate, reference=scaled_reference(a.duration, a.rate, a.speed),
+                       progress=lambda f, el: print(f"sim: {100 * f:3.0f} %  ETA {el / max(f, 1e-9) - el:5.1f} s",
+                                                    file=sys.stderr))
+        if a.strip_pulley_radius:
+            run = CdprRun(without_pulley_radius(desc), run.truth, run.arrays)
+        write_run_bag(run, a.out, every=a.every)
+        el = _time.monotonic() - t0
+        print(f"wrote {a.out}: {run.t[-1]:.1f} s simulated in {el:.1f} s ({run.t[-1] / el:.0f}x real time)")
+    except CablelabError as exc:
+        print(f"cablelab.plants.cdpr.sim: error: {exc}", file=sys.stderr)
+        return 2
+    return 0
+
+
+def default_description_path() -> str:
+    import os
+
+    return os.path.join(os.path.dirname(__file__), "data", "caroca.yaml")
+
+
+def default_description() -> Description:
+    """The shipped CAROCA description (``cablelab/plants/cdpr/data/caroca.yaml``)."""
+    from ...description import load_description
+
+    return load_description(default_description_path())
+
+
+def scaled_reference(duration: float, rate: float, speed: float):
+    """The 001 test trajectory played ``speed`` times faster (velocities x speed, accelerations
+    x speed^2), ``duration / speed`` s sampled at ``rate`` Hz (the strong-accelerations bags)."""
+    from .trajectory import Trajectory, pick_and_place
+
+    t = np.arange(int(round(duration / speed * rate)) + 1) / rate
+    tr = pick_and_place(t * speed)
+    return Trajectory(t, tr.position, tr.velocity * speed, tr.acceleration * speed ** 2)
+
+
+def without_pulley_radius(desc: Description) -> Description:
+    """The description with the pulley radius removed (pulleys unknown to an analysis)."""
+    import dataclasses
+
+    from ...description import dump_description, load_description
+    d2 = desc.with_section("cdpr", dataclasses.replace(desc.cdpr, pulley_radius=0.0))
+    text = dump_description(d2).replace("  pulley_radius: 0.0\n", "")
+    return load_description(text)
+
+
+if __name__ == "__main__":
+    import sys
+
+    sys.exit(main())

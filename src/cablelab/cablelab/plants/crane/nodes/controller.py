@@ -1,0 +1,141 @@
+"""Crane controller node: joint PD + gravity compensation + reference-acceleration feedforward
+(002 sec. 5.3.1, :func:`cablelab.plants.crane.control.control_law`).
+
+On every ``/crane/joint_states`` message it computes the efforts and publishes
+``/crane/effort_commands`` [slew N m, luff N m, hoist N]. Gravity and inertia come from the
+``/plant_description`` (``slew_inertia``, ``luff_inertia`` parameters for what it does not
+hold) and the latest ``/crane/swing_estimate`` (optional; a hanging payload without it). The
+reference is ``/crane/reference`` (``reference_source: topic``) or the built-in multi-sine
+excitation (``reference_source: excitation``, published on ``/crane/reference`` too).
+Fallback: with a stale reference the node holds the crane where it is (gravity compensation +
+damping, :func:`~cablelab.plants.crane.control.hold_command`) and reports WARN.
+
+ROS parameters: ``kp``, ``kd`` ([slew, luff, hoist]), ``feedforward`` (bool),
+``reference_source``, ``excitation_seed``, ``reference_timeout`` (s wall).
+
+Each command names the stamp of the state it answers (``layout.dim[0].label = 'joints stamp=<t>'``,
+:func:`cablelab.ros.convert.command_msg`): a lock-step simulator applies only the answer to its
+latest state.
+"""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+from sensor_msgs.msg import JointState
+from std_msgs.msg import Float64MultiArray
+from trajectory_msgs.msg import JointTrajectory
+
+from ....errors import CablelabError
+from ..control import LIVE_GAINS, Gains, control_law, hold_command
+from ..model import JOINTS, CraneParams
+from ....ros import convert
+from ....ros.inputs import WARN
+from ....ros.plant_node import PlantNode
+from ....ros.qos import publisher_qos, stream_qos
+from ..sim import reference_trajectory
+
+
+class CraneController(PlantNode):
+    def __init__(self):
+        super().__init__("pd_feedforward")
+        p = self.declare_parameter
+        kp = [float(x) for x in p("kp", list(LIVE_GAINS.kp)).value]
+        kd = [float(x) for x in p("kd", list(LIVE_GAINS.kd)).value]
+        if len(kp) != 3 or len(kd) != 3:
+            raise CablelabError("pd_feedforward --plant crane: parameters kp and kd need 3 values "
+                                "[slew, luff, hoist]")
+        self.gains = Gains(tuple(kp), tuple(kd))
+        self.feedforward = bool(p("feedforward", True).value)
+        self.inertias = {"slew_inertia": float(p("slew_inertia", 0.05).value),
+                         "luff_inertia": float(p("luff_inertia", 0.02).value)}
+        self.params = None
+        self.source = self.choice("reference_source", "topic", ("topic", "excitation"))
+        self.seed = int(p("excitation_seed", 0).value)
+        self.ref = None
+        self.swing = None
+        self.fallbacks = 0
+        self.t0 = None
+        self.inputs.add("joint_states", timeout=0.5, length=3)
+        self.inputs.add("reference", timeout=float(p("reference_timeout", 0.5).value), length=3,
+                        required=self.source == "topic")
+        self.inputs.add("swing_estimate", timeout=0.5, length=2, required=False)
+        self.pub_cmd = self.create_publisher(Float64MultiArray, "/crane/effort_commands", publisher_qos())
+        self.pub_ref = self.create_publisher(JointTrajectory, "/crane/reference", publisher_qos()) \
+            if self.source == "excitation" else None
+        self.create_subscription(JointState, "/crane/joint_states", self.on_state, stream_qos())
+        self.create_subscription(JointState, "/crane/swing_estimate", self.on_swing, stream_qos())
+        if self.source == "topic":
+            self.create_subscription(JointTrajectory, "/crane/reference", self.on_reference, stream_qos())
+        self.listen_for_description()
+        self.start_diagnostics()
+
+    def extend_status(self, level, msg, values):
+        values["fallback (hold) commands"] = str(self.fallbacks)
+        if self.params is None:
+            level = max(level, WARN)
+            msg = "waiting for /plant_description" if msg == "ok" else msg + "; waiting for /plant_description"
+        return level, msg, values
+
+    def set_description(self, desc) -> None:
+        super().set_description(desc)
+        if desc.crane is None:
+            self.get_logger().error("/plant_description has no crane section")
+            return
+        self.params = CraneParams.from_description(desc, **self.inertias)
+
+    def on_swing(self, msg: JointState) -> None:
+        _, names, q, _, _ = convert.joint_state_arrays(msg)
+        if q is not None and {"theta1", "theta2"} <= set(names) and len(names) == q.size:
+            vals = [q[names.index("theta1")], q[names.index("theta2")]]
+            if self.inputs.accept("swing_estimate", vals, time.monotonic()):
+                self.swing = np.array(vals)
+        else:
+            self.inputs.accept("swing_estimate", None, time.monotonic())
+
+    def on_reference(self, msg: JointTrajectory) -> None:
+        _, names, q, qd, qdd = convert.joint_trajectory_point(msg)
+        if q is None or list(names) != list(JOINTS):
+            self.inputs.accept("reference", None, time.monotonic())
+            return
+        if self.inputs.accept("reference", q, time.monotonic()):
+            z = np.zeros(3)
+            self.ref = (q, qd if qd is not None and qd.size == 3 else z,
+                        qdd if qdd is not None and qdd.size == 3 else z)
+
+    def on_state(self, msg: JointState) -> None:
+        t, names, q, qd, _ = convert.joint_state_arrays(msg)
+        now = time.monotonic()
+        if q is None or list(names) != list(JOINTS):
+            self.inputs.accept("joint_states", None, now)
+            return
+        if not self.inputs.accept("joint_states", q, now) or self.params is None:
+            return
+        if qd is None or qd.size != 3 or not np.isfinite(qd).all():
+            qd = np.zeros(3)
+        swing = self.swing[None] if self.swing is not None and self.inputs.fresh("swing_estimate", now) else None
+        if self.source == "excitation":
+            if self.t0 is None:
+                self.t0 = t
+            r = reference_trajectory(np.array([t - self.t0]), q0=tuple(self._q0(q)), seed=self.seed)
+            ref = tuple(x[0] for x in r)
+            self.pub_ref.publish(convert.joint_trajectory_msg(t, JOINTS, *ref))
+        elif self.ref is not None and self.inputs.fresh("reference", now):
+            ref = self.ref
+        else:
+            self.fallbacks += 1
+            u = hold_command(q[None], qd[None], self.params, self.gains, swing)[0]
+            self.pub_cmd.publish(convert.command_msg(u, stamp=t, label="joints"))
+            return
+        u = control_law(q[None], qd[None], ref[0][None], ref[1][None], ref[2][None], self.params,
+                        self.gains, swing, self.feedforward)[0]
+        self.pub_cmd.publish(convert.command_msg(u, stamp=t, label="joints"))
+
+    def _q0(self, q):
+        if not hasattr(self, "_start"):
+            self._start = np.array(q, dtype=float)
+        return self._start
+
+
+def make_node(args) -> PlantNode:
+    return CraneController()

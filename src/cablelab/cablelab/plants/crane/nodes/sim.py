@@ -1,0 +1,161 @@
+"""Crane simulator node: the MuJoCo boom crane of 002 driven by ``/crane/effort_commands``.
+
+Publishes (CONTRACT sec. 2) ``/crane/joint_states`` (slew, luff, hoist: position, velocity, effort
+= applied command + sensor offset + noise), the motion-capture poses ``/crane/boom_tip_pose`` and
+``/crane/payload_pose`` (noise, NaN dropouts), ``/crane/ground_truth/swing`` (theta1, theta2,
+rope_length), ``/clock`` and ``/plant_description`` (transient-local). Physics:
+:class:`cablelab.plants.crane.sim.CraneSim`.
+
+ROS parameters: ``description`` (YAML file or text; default ``cablelab/plants/crane/data/crane.yaml``),
+``slew_inertia``, ``luff_inertia`` (kg m^2), truth switches ``base_tilt`` [x, y] rad,
+``viscous`` / ``coulomb`` / ``offset`` [slew, luff, hoist], ``mocap_noise`` (m),
+``mocap_dropout`` (probability), ``timestep`` (s), ``rate`` (Hz of publishing = command
+sampling), ``command_timeout`` (s wall, real-time mode), ``lockstep`` (default true: once
+commands flow, after publishing a state the simulation waits for the command that answers it
+before advancing, so a slow or loaded controller slows the simulation down instead of
+destabilising it with delayed commands; an answer is applied however late it comes),
+``lockstep_timeout`` (s wall, default 10: without an answer for that long the simulation drops
+back to real time, holding the crane, until commands flow again), ``wait_for_subscribers``
+(int, default 0: time starts only when ``/crane/joint_states`` has that many matched
+subscriptions, at most 60 s, the initial state resent every 0.5 s meanwhile; DDS discovery on a
+busy machine can take seconds, which a recorder would otherwise miss). Without a fresh command the
+drives hold the crane (gravity compensation + damping, like a brake) and the node reports WARN
+on /diagnostics.
+
+Lock-step matching: a command naming the stamp of the state it answers
+(:func:`cablelab.ros.convert.command_msg`, as the cablelab controller sends) answers the latest
+state only if the stamps agree; answers to earlier states (e.g. to states published while the
+simulation still ran in real time) are counted and ignored, so they never add a control delay.
+A command naming no stamp answers the last published state.
+"""
+from __future__ import annotations
+
+import os
+import time
+
+import numpy as np
+from geometry_msgs.msg import PoseStamped
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import JointState
+from std_msgs.msg import Float64MultiArray
+
+from ....description import load_description
+from ....errors import CablelabError
+from ..control import LIVE_GAINS, hold_command
+from ..model import JOINTS, CraneParams
+from ....ros import convert
+from ....ros.plant_node import PlantNode
+from ....ros.qos import publisher_qos, stream_qos
+from ..sim import CraneSim, CraneTruth
+
+DEFAULT_DESCRIPTION = os.path.join(os.path.dirname(os.path.dirname(__file__)), "data", "crane.yaml")
+SWING = ["theta1", "theta2", "rope_length"]
+
+
+def _vec(value, n: int, name: str) -> tuple:
+    v = [float(x) for x in value]
+    if len(v) != n or not np.all(np.isfinite(v)):
+        raise CablelabError(f"cable_sim_node: parameter {name}: expected {n} finite numbers, got {value!r}")
+    return tuple(v)
+
+
+class CraneSimNode(PlantNode):
+    def __init__(self):
+        super().__init__("cable_sim_node")
+        p = self.declare_parameter
+        self.description = load_description(p("description", "").value or DEFAULT_DESCRIPTION)
+        if self.description.crane is None:
+            raise CablelabError("cable_sim_node --plant crane: the description has no crane section")
+        params = CraneParams.from_description(self.description,
+                                              slew_inertia=float(p("slew_inertia", 0.05).value),
+                                              luff_inertia=float(p("luff_inertia", 0.02).value))
+        truth = CraneTruth(params=params,
+                           base_tilt=_vec(p("base_tilt", [0.0, 0.0]).value, 2, "base_tilt"),
+                           viscous=_vec(p("viscous", [0.0, 0.0, 0.0]).value, 3, "viscous"),
+                           coulomb=_vec(p("coulomb", [0.0, 0.0, 0.0]).value, 3, "coulomb"),
+                           torque_offset=_vec(p("offset", [0.0, 0.0, 0.0]).value, 3, "offset"),
+                           mocap_noise=float(p("mocap_noise", 0.0).value),
+                           mocap_dropout=float(p("mocap_dropout", 0.0).value),
+                           timestep=float(p("timestep", 0.001).value))
+        q0 = _vec(p("initial", [0.0, 0.5, 0.6]).value, 3, "initial")
+        self.rate = float(p("rate", 100.0).value)
+        self.lockstep = bool(p("lockstep", True).value)
+        self.lockstep_timeout = float(p("lockstep_timeout", 10.0).value)
+        self.answered = False       # the command answering the last published state arrived
+        self.stale_answers = 0      # lock-step: answers to earlier states, ignored
+        self.start_gate()
+        self.published_at = time.monotonic()
+        self.sim = CraneSim(truth, q0)
+        self.u = None
+        self.fallbacks = 0
+        self.inputs.add("effort_commands", timeout=float(p("command_timeout", 0.5).value), length=3)
+
+        self.pub_js = self.create_publisher(JointState, "/crane/joint_states", publisher_qos())
+        self.pub_tip = self.create_publisher(PoseStamped, "/crane/boom_tip_pose", publisher_qos())
+        self.pub_pay = self.create_publisher(PoseStamped, "/crane/payload_pose", publisher_qos())
+        self.pub_truth = self.create_publisher(JointState, "/crane/ground_truth/swing", publisher_qos())
+        self.pub_clock = self.create_publisher(Clock, "/clock", stream_qos(10))
+        self.publish_description(self.description)
+        self.create_subscription(Float64MultiArray, "/crane/effort_commands", self.on_command, stream_qos())
+        self.start_diagnostics()
+        self.timer = self.create_timer(1.0 / self.rate, self.tick)
+        self.publish_state()
+
+    def extend_status(self, level, msg, values):
+        values["fallback (hold) steps"] = str(self.fallbacks)
+        values["stale answers ignored (lock-step)"] = str(self.stale_answers)
+        values["simulation resets"] = str(self.sim.resets)
+        if self.sim.resets:
+            level = 2
+            extra = f"simulation diverged {self.sim.resets} times (restored at rest): commands too large?"
+            msg = extra if msg == "ok" else f"{msg}; {extra}"
+        return level, msg, values
+
+    def on_command(self, msg: Float64MultiArray) -> None:
+        values = convert.float_array(msg)
+        if not self.inputs.accept("effort_commands", values, time.monotonic()):
+            return
+        stamp = convert.command_stamp(msg)
+        if self.lockstep and stamp is not None and not convert.same_stamp(stamp, self.sim.time):
+            self.stale_answers += 1      # answers an earlier state: never applied late
+            if self.u is None:
+                self.u = values.copy()   # but commands flow: lock-step starts with the next state
+            return
+        self.u = values.copy()
+        self.answered = True
+
+    def tick(self) -> None:
+        now = time.monotonic()
+        if self.waiting_for_subscribers(self.pub_js, self.published_at, self.publish_state):
+            return
+        if self.lockstep and self.u is not None and not self.answered:
+            if now - self.published_at < self.lockstep_timeout:
+                return  # wait for the controller's answer to the last state
+            self.u = None  # no answer for lockstep_timeout s: real time (hold) until commands flow
+        if self.lockstep and self.answered:
+            u = self.u  # the answer to the last state, however late it came
+        elif (self.u is None or not self.inputs.fresh("effort_commands", now)
+                or self.lockstep):
+            _, q, qd = self.sim.state()
+            u = hold_command(q[None, :3], qd[None, :3], self.sim.truth.params, LIVE_GAINS,
+                             swing=q[None, 3:])[0]
+            self.fallbacks += 1
+        else:
+            u = self.u
+        self.sim.advance(u, 1.0 / self.rate)
+        self.publish_state()
+
+    def publish_state(self) -> None:
+        self.answered = False
+        self.published_at = time.monotonic()
+        t, q, qd = self.sim.state()
+        m = self.sim.measurement()
+        self.pub_clock.publish(convert.clock_msg(t))
+        self.pub_js.publish(convert.joint_state_msg(t, JOINTS, m["joints"], m["joint_rates"], m["effort"]))
+        self.pub_tip.publish(convert.pose_msg(t, m["tip"], m["tip_quat"]))
+        self.pub_pay.publish(convert.pose_msg(t, m["payload"], m["payload_quat"]))
+        self.pub_truth.publish(convert.joint_state_msg(t, SWING, [q[3], q[4], q[2]], [qd[3], qd[4], qd[2]]))
+
+
+def make_node(args) -> PlantNode:
+    return CraneSimNode()

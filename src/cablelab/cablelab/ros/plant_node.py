@@ -1,0 +1,143 @@
+"""``PlantNode``: what every plant's simulator, estimator and controller node shares.
+
+A plant's node (``plants/<plant>/nodes/<role>.py``) subclasses :class:`PlantNode` and keeps only
+its law: the base holds the input monitor (NaN, wrong-length and stale messages are rejected and
+counted), the ``/plant_description`` subscription (a bad description is logged and reported, never
+raised into the spin loop) or publication, the ``/diagnostics`` status built from the inputs plus
+the node's own values, and the choice of executor (``fast_executor``, ``rt_priority``).
+"""
+from __future__ import annotations
+
+import time
+
+from rclpy.node import Node
+from std_msgs.msg import String
+
+from ..description import load_description
+from ..errors import CablelabError
+from . import convert
+from .diagnostics import Diagnostics
+from .inputs import InputMonitor
+from .qos import DESCRIPTION_QOS
+
+
+class PlantNode(Node):
+    """Base of every plant node.
+
+    Subclasses call, in ``__init__``: :meth:`param` for their ROS parameters,
+    :meth:`listen_for_description` (estimators, controllers) or :meth:`publish_description`
+    (simulators), and :meth:`start_diagnostics` last; they override :meth:`set_description`
+    (what the law needs from the description) and :meth:`extend_status` (their own values).
+    """
+
+    def __init__(self, name: str, **node_kwargs):
+        super().__init__(name, **node_kwargs)
+        self.inputs = InputMonitor()
+        self.description = None
+        self.description_problem = ""
+        self.fast = False
+        self.keep_first_description = False  # True: later /plant_description messages are ignored
+        self._desc_pub = None
+
+    # ------------------------------------------------------------------ parameters
+    def param(self, name: str, default):
+        """Declare a ROS parameter (once) and return its value."""
+        if self.has_parameter(name):
+            return self.get_parameter(name).value
+        return self.declare_parameter(name, default).value
+
+    def choice(self, name: str, default: str, allowed: tuple[str, ...]) -> str:
+        """A text ROS parameter restricted to ``allowed`` (one-line error naming it otherwise)."""
+        value = str(self.param(name, default))
+        if value not in allowed:
+            raise CablelabError(f"{self.get_name()}: parameter {name}: expected "
+                                f"{' or '.join(repr(a) for a in allowed)}, got {value!r}")
+        return value
+
+    def use_fast_executor(self, default: bool = True) -> None:
+        """Parameters ``fast_executor`` (spin with :class:`~cablelab.ros.fastspin.FastExecutor`)
+        and ``rt_priority`` (SCHED_FIFO priority, 0 = off)."""
+        from .fastspin import set_realtime_priority
+
+        self.fast = bool(self.param("fast_executor", default))
+        rt = int(self.param("rt_priority", 0))
+        if rt > 0:
+            self.get_logger().info(f"rt_priority: {set_realtime_priority(rt)}")
+
+    def executor_factory(self):
+        """The executor :func:`cablelab.ros.runner.run_node` spins this node with."""
+        from .fastspin import executor_for
+
+        return executor_for(self, self.fast)
+
+    # ------------------------------------------------------------------ description
+    def listen_for_description(self, text: str = "") -> None:
+        """Subscribe to ``/plant_description`` (transient local); ``text`` (a ``description``
+        parameter) is used at once when given."""
+        self.create_subscription(String, "/plant_description", self.on_description, DESCRIPTION_QOS)
+        if text:
+            self.set_description(load_description(text))
+
+    def on_description(self, msg: String) -> None:
+        """/plant_description callback: parse, then :meth:`set_description` (errors logged)."""
+        if self.keep_first_description and self.description is not None:
+            return
+        try:
+            desc = load_description(msg.data)
+        except CablelabError as exc:
+            self.description_problem = f"bad /plant_description: {exc}"
+            self.get_logger().error(f"/plant_description: {exc}")
+            return
+        self.set_description(desc)
+
+    def set_description(self, desc) -> None:
+        """Take a validated description (override to configure the law; call super)."""
+        self.description = desc
+
+    def publish_description(self, desc) -> None:
+        """Publish ``desc`` on ``/plant_description`` (transient local: late joiners get it)."""
+        self.description = desc
+        self._desc_pub = self.create_publisher(String, "/plant_description", DESCRIPTION_QOS)
+        self._desc_pub.publish(convert.string_msg(desc.to_yaml()))
+
+    # ------------------------------------------------------------------ simulators: start gate
+    def start_gate(self) -> None:
+        """Parameter ``wait_for_subscribers`` (simulators): before time starts, wait (at most
+        60 s) until the state topic has that many subscribers, see :meth:`waiting_for_subscribers`."""
+        self.wait_subs = int(self.param("wait_for_subscribers", 0))
+        self.created = time.monotonic()
+
+    def waiting_for_subscribers(self, publisher, last_publish: float, republish,
+                                every: float = 0.5) -> bool:
+        """True while time must not start yet: fewer than ``wait_for_subscribers`` subscribers of
+        ``publisher`` (for at most 60 s); meanwhile ``republish()`` the initial state every
+        ``every`` s (wall) after ``last_publish``, for late joiners."""
+        if not self.wait_subs:
+            return False
+        now = time.monotonic()
+        if publisher.get_subscription_count() < self.wait_subs and now - self.created < 60.0:
+            if now - last_publish > every:
+                republish()
+            return True
+        self.wait_subs = 0
+        return False
+
+    # ------------------------------------------------------------------ diagnostics
+    def start_diagnostics(self) -> None:
+        """Publish :meth:`status` on /diagnostics (call last in ``__init__``)."""
+        self.diag = Diagnostics(self, update=self.status)
+
+    def status(self):
+        """``(level, message, values)``: the inputs' status, extended by the node."""
+        level, msg, values = self.inputs.status(time.monotonic())
+        if self.description_problem:
+            level = max(level, 1)
+            msg = self.description_problem if msg == "ok" else f"{msg}; {self.description_problem}"
+        return self.extend_status(level, msg, values)
+
+    def extend_status(self, level: int, msg: str, values: dict):
+        """Add the node's own values / raise the level (override)."""
+        return level, msg, values
+
+
+__all__ = ["PlantNode"]

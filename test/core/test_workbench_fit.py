@@ -1,0 +1,151 @@
+"""Workbench core: effect registry, linear LS (rank, base parameters, bounds, uncertainty),
+separable LS for a delay, conditioning. Oracles: closed forms, Monte Carlo scatter, exact sums."""
+import numpy as np
+import pytest
+
+from cablelab.conditioning import derivatives, is_uniform, lowpass, uniform_grid, unwrap_angle
+from cablelab.description import load_description
+from cablelab.effects import effects_for, get_effect
+from cablelab.errors import CablelabError
+from cablelab.fit import identify, solve_linear
+from cablelab.model import Dataset, Model, Param
+from cablelab.plants import get_plant
+
+PRISMATIC = load_description("plant: axis\naxis:\n  joint_type: prismatic\n")
+
+
+def test_registry_lists_catalog_effects_and_rejects_bad_ids():
+    axis = effects_for("axis")
+    for eid in ("joint_viscous_friction", "joint_coulomb_friction", "torque_sensor_offset", "time_delay"):
+        assert eid in axis
+    with pytest.raises(CablelabError, match=r"unknown effect 'bogus'.*joint_coulomb_friction"):
+        get_effect("bogus", "axis")
+    with pytest.raises(CablelabError, match=r"does not apply to plant cdpr.*valid effects for cdpr"):
+        get_effect("axis_inertia", "cdpr")
+    with pytest.raises(CablelabError, match="has no workbench model"):
+        get_plant("nonexistent_plant")
+
+
+def test_linear_fit_stderr_matches_monte_carlo_scatter():
+    rng = np.random.default_rng(0)
+    n = 400
+    phi = np.stack([rng.normal(size=n), np.sin(np.linspace(0, 20, n)), np.ones(n)], axis=1)
+    theta = np.array([2.0, -1.5, 0.3])
+    params = [Param(k, "-") for k in ("a", "b", "c")]
+    est, se = [], []
+    for _ in range(300):
+        y = phi @ theta + 0.5 * rng.normal(size=n)
+        f = solve_linear(phi, y, params)
+        est.append(f.theta)
+        se.append(f.stderr)
+    est, se = np.array(est), np.array(se)
+    assert np.allclose(est.mean(axis=0), theta, atol=4 * se.mean(axis=0) / np.sqrt(300))
+    # LS covariance sigma^2 (Phi^T Phi)^-1 predicts the scatter of the estimates
+    assert np.allclose(est.std(axis=0), se.mean(axis=0), rtol=0.15)
+    assert f.rank == 3 and f.cond < 10
+
+
+def test_rank_deficient_fit_names_the_direction_or_regroups_base_parameters():
+    rng = np.random.default_rng(1)
+    x = rng.normal(size=300)
+    phi = np.stack([x, 2.0 * x, rng.normal(size=300)], axis=1)  # b column = 2 a column
+    y = phi @ np.array([1.0, 0.5, 3.0])
+    params = [Param("a", "-"), Param("b", "-"), Param("c", "-")]
+    with pytest.raises(CablelabError, match=r"rank-deficient fit \(rank 2 of 3.*a.*b.*--fix") as ei:
+        solve_linear(phi, y, params)
+    assert "\n" not in str(ei.value)
+    f = solve_linear(phi, y, params, on_deficient="base")
+    assert f.rank == 2 and len(f.unidentifiable) == 1
+    # the identifiable combination a + 2 b (exact sum 1 + 2 * 0.5 = 2) or b + 0.5 a (= 1)
+    vals = f.params
+    combo = [k for k in vals if "a" in k and "b" in k][0]
+    expect = 2.0 if combo.startswith("a") else 1.0
+    assert vals[combo] == pytest.approx(expect, rel=1e-9)
+    assert vals["c"] == pytest.approx(3.0, rel=1e-9)
+
+
+def test_bounded_least_squares_keeps_physical_sign():
+    rng = np.random.default_rng(2)
+    x1, x2 = rng.normal(size=500), rng.normal(size=500)
+    y = 1.0 * x1 - 0.2 * x2 + 0.01 * rng.normal(size=500)
+    f = solve_linear(np.stack([x1, x2], 1), y, [Param("a", "-"), Param("F", "-", lower=0.0)])
+    assert f.params["F"] == pytest.approx(0.0, abs=1e-12)
+    assert f.active_bounds == ["F"]
+    free = solve_linear(np.stack([x1, x2], 1), y, [Param("a", "-"), Param("F", "-")])
+    assert free.params["F"] == pytest.approx(-0.2, abs=0.01)
+
+
+def _axis_data(t, q, f, **kw):
+    from cablelab.plants.axis.plant import dataset_from_arrays
+
+    return dataset_from_arrays(t, q, f, PRISMATIC, kw.get("options"))
+
+
+def test_separable_ls_recovers_time_delay_and_linear_params():
+    fs = 500.0
+    t = np.arange(0, 20, 1 / fs)
+    q = 0.3 * np.sin(1.3 * t) + 0.1 * np.sin(4.1 * t + 1)
+    qd = 0.3 * 1.3 * np.cos(1.3 * t) + 0.1 * 4.1 * np.cos(4.1 * t + 1)
+    qdd = -0.3 * 1.69 * np.sin(1.3 * t) - 0.1 * 4.1**2 * np.sin(4.1 * t + 1)
+    force = 12.0 * qdd + 30.0 * qd + 4.0 * np.sign(qd)
+    tau = 0.012  # measurement lags the model by 12 ms
+    meas = np.interp(t - tau, t, force)
+    ds = _axis_data(t, q, meas)
+    r = identify(Model("axis", ("axis_inertia", "joint_viscous_friction", "joint_coulomb_friction",
+                                "time_delay")), ds)
+    assert r.params["tau"] == pytest.approx(tau, abs=0.0005)
+    assert r.params["M"] == pytest.approx(12.0, rel=0.02)
+    assert r.params["Fv"] == pytest.approx(30.0, rel=0.02)
+    assert r.params["Fc"] == pytest.approx(4.0, rel=0.05)
+    assert r.stderr["tau"] > 0
+
+
+def test_known_parameters_move_to_the_left_hand_side():
+    fs = 200.0
+    t = np.arange(0, 10, 1 / fs)
+    q = np.sin(t)
+    force = 5.0 * -np.sin(t) + 2.0 * np.cos(t)
+    ds = _axis_data(t, q, force)
+    r = identify(Model("axis", ("axis_inertia", "joint_viscous_friction"), fixed={"M": 5.0}), ds)
+    assert r.params["Fv"] == pytest.approx(2.0, rel=1e-3)
+    assert r.stderr["M"] == 0.0 and "M" in r.fixed
+    with pytest.raises(CablelabError, match="fixed parameter 'X'"):
+        identify(Model("axis", ("axis_inertia",), fixed={"X": 1.0}), ds)
+
+
+def test_conditioning_derivatives_unwrap_and_irregular_times():
+    fs = 1000.0
+    t = np.arange(0, 5, 1 / fs)
+    x = np.sin(2 * np.pi * 1.0 * t)
+    xf, xd, xdd = derivatives(x, fs, 50.0)
+    inner = slice(100, -100)
+    w = 2 * np.pi
+    assert np.max(np.abs(xd[inner] - w * np.cos(w * t[inner]))) < 1e-3 * w
+    assert np.max(np.abs(xdd[inner] + w**2 * np.sin(w * t[inner]))) < 1e-3 * w**2
+    # zero phase: a filtered sine keeps its phase
+    assert np.max(np.abs(lowpass(x, fs, 50.0)[inner] - x[inner])) < 1e-4
+    wrapped = np.angle(np.exp(1j * 3 * t))
+    assert np.allclose(unwrap_angle(wrapped), 3 * t, atol=1e-9)
+    rng = np.random.default_rng(3)
+    ti = np.sort(rng.uniform(0, 5, 3000))
+    assert not is_uniform(ti)
+    tu, (xu,) = uniform_grid(ti, np.sin(ti))
+    assert is_uniform(tu) and np.max(np.abs(xu - np.sin(tu))) < 1e-3
+    with pytest.raises(CablelabError, match="only 20 samples"):
+        _axis_data(t[:20], x[:20], x[:20])
+
+
+def test_model_regressor_is_sum_of_effect_blocks_on_a_multi_actuator_map():
+    """Generic per-actuator effects through an actuator -> channel map (CDPR-like, C=2, n_act=3)."""
+    rng = np.random.default_rng(4)
+    n = 50
+    amap = rng.normal(size=(n, 2, 3))
+    v = rng.normal(size=(n, 3))
+    ds = Dataset(plant="axis", t=np.arange(n) * 0.01, y=np.zeros((n, 2)), channels=("a", "b"),
+                 actuators=("m1", "m2", "m3"), act_vel=v, act_map=amap)
+    eff = get_effect("joint_coulomb_friction")
+    names = [p.name for p in eff.columns(ds)]
+    assert names == ["Fc[m1]", "Fc[m2]", "Fc[m3]"]
+    fc = np.array([1.0, 2.0, 3.0])
+    expect = np.einsum("nca,na->nc", amap, np.sign(v) * fc)
+    assert np.allclose(eff.block(ds) @ fc, expect)

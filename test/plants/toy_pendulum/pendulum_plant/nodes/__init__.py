@@ -1,0 +1,1 @@
+"""The toy pendulum's nodes (only a simulator)."""
