@@ -7,7 +7,9 @@ with ``--json`` nothing but the one JSON object goes to stdout.
 from __future__ import annotations
 
 import argparse
+import errno
 import importlib
+import os
 import sys
 
 from .errors import CablelabError
@@ -23,6 +25,7 @@ VERBS = {
     "record": "record",
     "replay": "replay",
     "info": "info",
+    "repair": "repair",
 }
 
 
@@ -61,6 +64,26 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print(f"cablelab {args.verb}: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:  # output piped into e.g. head: stop quietly
+        with _suppress_os():
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
+    except OSError as exc:  # the machine, not the program: disk full, read-only, permission
+        if exc.errno not in _ENVIRONMENT_ERRNOS:
+            raise
+        from .atomic import os_error_message
+
+        print(f"cablelab {args.verb}: error: {os_error_message(exc.filename or '?', exc)}", file=sys.stderr)
+        return 2
+
+
+_ENVIRONMENT_ERRNOS = {errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EACCES, errno.EPERM}
+
+
+def _suppress_os():
+    import contextlib
+
+    return contextlib.suppress(OSError)
 
 
 if __name__ == "__main__":

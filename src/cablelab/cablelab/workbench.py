@@ -22,17 +22,39 @@ from .model import Dataset, Model
 
 def load(bag_path, description_path=None, options: dict | None = None):
     """Open a bag, read its description (or the given file), check the plant's topics and build
-    the plant's dataset.
+    the plant's dataset (:func:`load_checked` without its check report).
 
     Returns:
         ``(plant, description, dataset)``.
     Raises:
         CablelabError: unreadable bag, no description, missing topics (one line each).
     """
+    plant, desc, ds, _ = load_checked(bag_path, description_path, options)
+    return plant, desc, ds
+
+
+def load_checked(bag_path, description_path=None, options: dict | None = None, *,
+                 recover: bool = False):
+    """:func:`load` with the input checks of :mod:`cablelab.bagcheck`: time base of every topic
+    the plant reads (gaps, clock jumps, stamps out of order, NaN samples), description vs bag
+    (joint and cable names), negative cable tensions. Samples inside a gap (widened by the
+    conditioning border) are marked invalid in ``dataset.valid``: fits use the contiguous
+    segments and never values interpolated across a gap.
+
+    Args:
+        recover: read an unfinished bag (recorder killed) up to its last complete chunk.
+    Returns:
+        ``(plant, description, dataset, check)``, ``check`` a :class:`~cablelab.bagcheck.BagCheck`
+        (``check.warnings``: lines for the text output and the JSON ``"warnings"`` list).
+    Raises:
+        CablelabError: unreadable bag, no description, missing topics, stamps going back in time,
+            a description that does not match the bag (one line each).
+    """
+    from .bagcheck import check_bag
     from .bags import open_bag
     from .registry import get_plant
 
-    bag = open_bag(bag_path)
+    bag = open_bag(bag_path, recover=recover)
     desc = load_bag_description(bag_path, description_path, bag)
     plant = get_plant(desc.plant)
     for topic, msgtype in plant.topics:
@@ -41,8 +63,17 @@ def load(bag_path, description_path=None, options: dict | None = None):
             raise CablelabError(f"{bag_path}: topic {topic} needed by plant {plant.name} is not in the "
                                 f"bag (topics: {have})")
         bag.require(topic, msgtype)
+    check = check_bag(bag, plant, desc, options)
     ds = plant.dataset(bag, desc, dict(options or {}))
-    return plant, desc, ds
+    if check.gaps:
+        cond = (options or {}).get("conditioning")
+        border = getattr(cond, "border", 50)
+        period = min(r.period for r in check.reports.values() if np.isfinite(r.period))
+        keep = check.mask(ds.t, border * period)
+        ds.valid = np.asarray(ds.valid, dtype=bool) & keep
+        if ds.valid.sum() < 10:
+            raise CablelabError(f"{bag_path}: fewer than 10 samples left outside the gaps of the recording")
+    return plant, desc, ds, check
 
 
 def load_bag_description(bag_path, description_path=None, bag=None):

@@ -10,6 +10,19 @@ def add_bag(p) -> None:
     p.add_argument("bag", help="rosbag2 directory or its .mcap file")
     p.add_argument("--description", metavar="FILE",
                    help="plant description YAML (default: /plant_description in the bag)")
+    add_recover(p)
+
+
+def add_recover(p) -> None:
+    """``--recover``: every verb that reads a bag accepts an unfinished one (recorder killed)."""
+    p.add_argument("--recover", action="store_true",
+                   help="read an unfinished bag (recorder killed) up to its last complete chunk "
+                        "(cablelab repair BAG makes it a complete bag)")
+
+
+def add_overwrite(p) -> None:
+    """``--overwrite``: every verb that writes refuses an existing output without it."""
+    p.add_argument("--overwrite", action="store_true", help="replace an existing output")
 
 
 def add_tensions(p) -> None:
@@ -46,7 +59,20 @@ def conditioning_from_args(args):
     """:class:`~cablelab.conditioning.Conditioning` from the shared options (defaults where unset)."""
     from ..conditioning import Conditioning
 
+    from ..errors import CablelabError
+
     kw = {}
+    cutoff = getattr(args, "cutoff", None)
+    if cutoff is not None and not (math.isfinite(cutoff) and cutoff > 0):
+        raise CablelabError(f"--cutoff {cutoff!r}: expected a frequency > 0 in Hz")
+    decimate = getattr(args, "decimate", None)
+    if decimate is not None and decimate < 1:
+        raise CablelabError(f"--decimate {decimate}: expected an integer >= 1")
+    folds = getattr(args, "folds", None)
+    if folds is not None and (folds < 0 or folds == 1):
+        raise CablelabError(f"--folds {folds}: expected 0 (none) or at least 2 folds")
+    if getattr(args, "segments", None) is not None and args.segments < 1:
+        raise CablelabError(f"--segments {args.segments}: expected an integer >= 1")
     if getattr(args, "cutoff", None) is not None:
         kw["cutoff_hz"] = args.cutoff
     if getattr(args, "decimate", None):
@@ -57,17 +83,44 @@ def conditioning_from_args(args):
 
 
 def load_from_args(args):
-    """(plant, description, dataset, model) from the shared options."""
+    """(plant, description, dataset, model) from the shared options; the input checks' warning
+    lines are kept in ``args.warnings`` (see :func:`with_warnings`)."""
     from ..model import parse_effect_list, parse_fixed
-    from ..workbench import build_model, load
+    from ..workbench import build_model, load_checked
 
     options = {"conditioning": conditioning_from_args(args), "tensions": args.tensions}
-    plant, desc, ds = load(args.bag, args.description, options)
+    plant, desc, ds, check = load_checked(args.bag, args.description, options,
+                                          recover=getattr(args, "recover", False))
+    args.warnings = list(check.warnings)
     baseline = None
     if args.baseline is not None:
         baseline = () if args.baseline.strip() in ("", "none") else parse_effect_list(args.baseline)
     model = build_model(plant, desc, parse_effect_list(args.effects), baseline, parse_fixed(args.fix))
+    if not model.effects:
+        from ..errors import CablelabError
+
+        raise CablelabError(f"--baseline {args.baseline}: the model has no effects left to fit; add some "
+                            f"with --effects A,B (e.g. --effects {','.join(plant.baseline(desc))})")
     return plant, desc, ds, model
+
+
+def with_warnings(args, out: dict) -> dict:
+    """``out`` with the input checks' ``"warnings"`` list (JSON); in text mode each warning is
+    printed first as ``warning: ...``."""
+    warnings = list(getattr(args, "warnings", []) or [])
+    out["warnings"] = warnings
+    if not getattr(args, "json", False):
+        for w in warnings:
+            print(f"warning: {w}")
+    return out
+
+
+def check_alpha(value: float, name: str = "--alpha") -> None:
+    """A significance level must lie in (0, 1)."""
+    from ..errors import CablelabError
+
+    if not (0.0 < value < 1.0):
+        raise CablelabError(f"{name} {value!r}: expected a significance level between 0 and 1 (e.g. 0.01)")
 
 
 def param_line(name: str, v: dict, tag: str = "") -> str:

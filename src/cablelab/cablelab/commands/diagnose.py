@@ -1,7 +1,7 @@
 """``cablelab diagnose BAG [--effects a,b] [--greedy] --json``: which effect is missing."""
 from __future__ import annotations
 
-from ._workbench_args import add_common, add_folds, dump_json, load_from_args
+from ._workbench_args import add_common, add_folds, check_alpha, dump_json, load_from_args, with_warnings
 
 HELP = "rank the missing physical effects by held-out error (blocked k-fold), --greedy adds them"
 
@@ -22,10 +22,16 @@ def run(args) -> int:
     from ..model import parse_effect_list
     from ..workbench import diagnose
 
+    check_alpha(args.alpha)
+    if not args.min_gain >= 0:
+        from ..errors import CablelabError
+
+        raise CablelabError(f"--min-gain {args.min_gain!r}: expected a relative gain >= 0 (e.g. 0.05)")
     plant, desc, ds, model = load_from_args(args)
     cands = parse_effect_list(args.candidates) if args.candidates else plant.candidates(desc)
     out = diagnose(ds, model, cands, folds=args.folds, alpha=args.alpha, min_gain=args.min_gain,
                    greedy_mode=args.greedy, quiet=args.json)
+    with_warnings(args, out)
     if args.json:
         print(dump_json(out))
         return 0

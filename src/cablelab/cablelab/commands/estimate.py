@@ -10,7 +10,7 @@ from __future__ import annotations
 import inspect
 
 from ..errors import CablelabError
-from ._workbench_args import add_bag, add_json, add_tensions, dump_json
+from ._workbench_args import add_bag, add_json, add_overwrite, add_tensions, dump_json, with_warnings
 
 HELP = "estimate the payload (CDPR mass and CoM) or the swing (crane) per sample from a bag"
 
@@ -24,28 +24,43 @@ def add_arguments(p) -> None:
     p.add_argument("--pose", choices=("desired", "measured"), default="desired",
                    help="CDPR: pose for the wrench matrix (001 uses the desired pose)")
     p.add_argument("--out", metavar="BAG2", help="also write the per-sample estimates as a bag")
+    add_overwrite(p)
     add_json(p)
 
 
 def run(args) -> int:
+    import contextlib
+
+    from ..atomic import atomic_output, check_target
+    from ..bagcheck import check_bag
+    from ..bags import open_bag
     from ..model import parse_effect_list
+    from ..registry import available_plants, get_plant
     from ..workbench import load_bag_description
 
-    desc = load_bag_description(args.bag, args.description)
-    from ..registry import available_plants, get_plant
-
-    fn = get_plant(desc.plant).estimate
+    if args.out:   # before any work: never over the input, never over an output unasked
+        check_target(args.out, overwrite=args.overwrite, inputs=[args.bag, args.description])
+    bag = open_bag(args.bag, recover=args.recover)
+    desc = load_bag_description(args.bag, args.description, bag)
+    plant = get_plant(desc.plant)
+    args.warnings = check_bag(bag, plant, desc, {"tensions": args.tensions}).warnings
+    fn = plant.estimate
     if fn is None:
         able = [p for p in available_plants() if get_plant(p).estimate is not None]
         raise CablelabError(f"plant {desc.plant}: no estimator (cablelab estimate supports "
                             f"{', '.join(able)})")
     kwargs = {"tensions": args.tensions, "effects": parse_effect_list(args.effects),
-              "pose": args.pose, "out": args.out}
+              "pose": args.pose, "out": None}
     accepted = inspect.signature(fn).parameters
     if not any(p.kind == p.VAR_KEYWORD for p in accepted.values()):
         kwargs = {k: v for k, v in kwargs.items() if k in accepted}
-    res = fn(args.bag, desc, **kwargs)
-    out = res.summary() if hasattr(res, "summary") else dict(res)
+    writing = atomic_output(args.out, overwrite=args.overwrite, inputs=[args.bag, args.description]) \
+        if args.out else contextlib.nullcontext(None)
+    with writing as tmp:   # the estimates bag appears whole under --out, or not at all
+        if tmp is not None:
+            kwargs["out"] = str(tmp)
+        res = fn(bag, desc, **kwargs)
+    out = with_warnings(args, res.summary() if hasattr(res, "summary") else dict(res))
     if args.json:
         print(dump_json(out))
         return 0
@@ -58,7 +73,8 @@ def run(args) -> int:
             print(f"  truth {out['truth']['mass']:.2f} kg: error {out['truth']['mass_error_percent']:+.2f} %")
     else:
         for k, v in out.items():
-            print(f"  {k}: {v}")
+            if k != "warnings":
+                print(f"  {k}: {v}")
     if args.out:
         print(f"  estimates written to {args.out}")
     return 0

@@ -1,7 +1,7 @@
 """``cablelab identify BAG --effects a,b --json``: parameters with uncertainty and fit."""
 from __future__ import annotations
 
-from ._workbench_args import add_common, add_folds, dump_json, load_from_args, param_line
+from ._workbench_args import add_common, with_warnings, add_folds, dump_json, load_from_args, param_line
 
 HELP = "identify the parameters of the nominal model + --effects, with standard errors"
 
@@ -19,6 +19,7 @@ def run(args) -> int:
 
     _, _, ds, model = load_from_args(args)
     out = identify(ds, model, folds=args.folds, simulation=args.simulation, quiet=args.json)
+    with_warnings(args, out)
     if args.json:
         print(dump_json(out))
         return 0

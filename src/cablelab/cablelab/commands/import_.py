@@ -30,7 +30,7 @@ def add_arguments(p) -> None:
     p.add_argument("--description", metavar="YAML",
                    help="plant description file or YAML text (required for the workbench)")
     p.add_argument("-o", "--out", required=True, metavar="BAG", help="bag directory to write")
-    p.add_argument("--overwrite", action="store_true", help="replace an existing bag")
+    p.add_argument("--overwrite", action="store_true", help="replace an existing output")
     p.add_argument("--json", action="store_true", help="print one JSON object")
 
 
@@ -60,11 +60,33 @@ def read_table(path: str) -> dict[str, np.ndarray]:
         delim = ";" if header.count(";") > header.count(",") else ","
         names = [h.strip().strip('"') for h in header.strip().split(delim)]
         data = np.genfromtxt(path, delimiter=delim, skip_header=1, dtype=float, ndmin=2)
+        text = np.genfromtxt(path, delimiter=delim, skip_header=1, dtype=str, ndmin=2,
+                             autostrip=True, comments=None)
     except (OSError, ValueError, UnicodeDecodeError) as exc:
-        raise CablelabError(f"{path}: cannot read CSV ({exc})") from None
+        raise CablelabError(f"{path}: cannot read CSV ({str(exc).splitlines()[0] if str(exc) else exc})") from None
     if data.shape[1] != len(names):
         raise CablelabError(f"{path}: header has {len(names)} names but rows have {data.shape[1]} values")
+    _check_text_cells(path, names, data, text)
     return {n: data[:, i] for i, n in enumerate(names)}
+
+
+_MISSING = {"", "nan", "NaN", "NAN", "na", "NA", "n/a", "N/A"}
+
+
+def _check_text_cells(path, names, data, text) -> None:
+    """A cell that is neither a number nor empty/NaN is an error naming row, column and value
+    (genfromtxt would silently turn it into NaN)."""
+    if text.shape != data.shape:
+        return
+    nan = ~np.isfinite(data)
+    if not nan.any():
+        return
+    strip = np.char.strip(np.char.strip(text), '"')
+    bad = nan & ~np.isin(strip, list(_MISSING)) & ~np.isin(np.char.lower(strip), ["inf", "-inf", "+inf"])
+    if bad.any():
+        r, c = np.argwhere(bad)[0]
+        raise CablelabError(f"{path}: row {int(r) + 2}, column {names[c]!r}: {str(text[r, c])!r} is not a number "
+                            f"({int(bad.sum())} such cell(s))")
 
 
 def parse_spec(spec: str) -> dict[str, list[tuple[str, str]]]:
@@ -148,12 +170,17 @@ def import_series(path: str, plant: str, spec: str) -> dict:
         arrays[base][:, joints.index(joint)] = v
     if arrays["position"] is None and arrays["effort"] is None:
         raise CablelabError("--map: map at least position and effort")
+    if not np.all(np.isfinite(t)):
+        raise CablelabError(f"{path}: time column has {int((~np.isfinite(t)).sum())} missing or non-finite values")
     if not np.all(np.diff(t) > 0):
-        raise CablelabError(f"{path}: time column is not strictly increasing")
+        k = int(np.flatnonzero(np.diff(t) <= 0)[0])
+        raise CablelabError(f"{path}: time column is not strictly increasing (row {k + 3}: {t[k + 1]!r} after "
+                            f"{t[k]!r})")
     return {"topic": topic, "t": t, "names": list(joints), **arrays}
 
 
 def run(args) -> int:
+    from ..atomic import atomic_output, check_target
     from ..bags import BagWriter
     from ..description import load_description
     from ._workbench_args import dump_json
@@ -164,12 +191,25 @@ def run(args) -> int:
     desc = load_description(args.description)
     if desc.plant != args.plant:
         raise CablelabError(f"--description is for plant {desc.plant}, not --plant {args.plant}")
+    inputs = [args.file] + ([args.description] if os.path.exists(args.description) else [])
+    check_target(args.out, overwrite=args.overwrite, inputs=inputs, option="-o")
     s = import_series(args.file, args.plant, args.map)
-    with BagWriter(args.out, overwrite=args.overwrite) as w:
-        w.write_description(desc.to_yaml(), t=float(s["t"][0]))
-        w.write_joint_states(s["topic"], s["t"], s["names"], s["position"], s["velocity"], s["effort"])
+    with atomic_output(args.out, overwrite=args.overwrite, inputs=inputs, option="-o") as tmp:
+        with BagWriter(tmp) as w:
+            w.write_description(desc.to_yaml(), t=float(s["t"][0]))
+            w.write_joint_states(s["topic"], s["t"], s["names"], s["position"], s["velocity"], s["effort"])
+    nan = {}
+    for f in FIELDS:
+        if s[f] is not None:
+            mapped = s[f][:, np.isfinite(s[f]).any(axis=0)]    # joints this --map fills
+            nan[f] = int((~np.isfinite(mapped)).any(axis=1).sum())
+    warnings = [f"{args.file}: {n} of {s['t'].size} samples have no finite {f} value (missing cells)"
+                for f, n in nan.items() if n]
     info = {"bag": args.out, "plant": args.plant, "topic": s["topic"], "samples": int(s["t"].size),
-            "duration": float(s["t"][-1] - s["t"][0])}
+            "duration": float(s["t"][-1] - s["t"][0]), "warnings": warnings}
+    if not args.json:
+        for w in warnings:
+            print(f"warning: {w}")
     if args.json:
         print(dump_json(info))
     else:

@@ -3,14 +3,15 @@ from __future__ import annotations
 
 import json
 
+from ._workbench_args import add_recover
+
 HELP = "show a bag's topics, message counts, duration and plant description"
 
 
 def add_arguments(p) -> None:
     p.add_argument("bag", help="rosbag2 directory or its .mcap file")
     p.add_argument("--json", action="store_true", help="print one JSON object")
-    p.add_argument("--recover", action="store_true",
-                   help="read an unfinished bag (recorder killed) up to its last complete chunk")
+    add_recover(p)
 
 
 def run(args) -> int:

@@ -44,7 +44,17 @@ def run(args) -> int:
     from ..bags import BagWriter
     from ..ros.runner import run_node
 
+    import math
+
+    from ..atomic import check_target
+    from ..errors import CablelabError
+
+    if not (math.isfinite(args.duration) and args.duration >= 0):
+        raise CablelabError(f"--duration {args.duration!r}: expected seconds >= 0 (0: until Ctrl-C)")
+    if not (math.isfinite(args.flush_period) and args.flush_period > 0):
+        raise CablelabError(f"--flush-period {args.flush_period!r}: expected seconds > 0")
     topics = topic_set(args)
+    check_target(args.output, overwrite=args.overwrite, option="-o")   # read-only / missing parent
     writer = BagWriter(args.output, overwrite=args.overwrite)  # refuses an existing path first
 
     def factory(_args):

@@ -1,7 +1,13 @@
-"""``cablelab report BAG -o DIR``: index.html with PNG plots of compare, diagnose and identify."""
+"""``cablelab report BAG -o DIR``: index.html with PNG plots of compare, diagnose and identify.
+
+The directory is written under a temporary name and moved into place when complete (see
+:mod:`cablelab.atomic`): an existing DIR needs ``--overwrite``, DIR may not be the bag.
+"""
 from __future__ import annotations
 
-from ._workbench_args import add_common, add_folds, dump_json, load_from_args
+import os
+
+from ._workbench_args import add_common, add_folds, add_overwrite, dump_json, load_from_args, with_warnings
 
 HELP = "write DIR/index.html with plots: waterfall, ranking, parameters, overlay, residuals"
 
@@ -10,17 +16,32 @@ def add_arguments(p) -> None:
     add_common(p)
     add_folds(p)
     p.add_argument("-o", "--out", required=True, metavar="DIR", help="output directory")
+    add_overwrite(p)
+
+
+def _moved(path, tmp, final):
+    """``path`` under the temporary directory -> the same path under the final one."""
+    if isinstance(path, str) and path.startswith(str(tmp)):
+        return os.path.join(str(final), os.path.relpath(path, str(tmp)))
+    return path
 
 
 def run(args) -> int:
+    from ..atomic import atomic_output, check_target
     from ..report import build_report
 
+    inputs = [args.bag, args.description]
+    check_target(args.out, overwrite=args.overwrite, inputs=inputs, option="-o")  # before the work
     plant, desc, ds, model = load_from_args(args)
-    res = build_report(ds, model, plant.candidates(desc), args.out, folds=args.folds,
-                       title=f"cablelab report: {desc.name or plant.name}", quiet=args.json)
+    with atomic_output(args.out, overwrite=args.overwrite, inputs=inputs, option="-o") as tmp:
+        res = build_report(ds, model, plant.candidates(desc), str(tmp), folds=args.folds,
+                           title=f"cablelab report: {desc.name or plant.name}", quiet=args.json)
+    res["index"] = _moved(res["index"], tmp, args.out)
+    res["figures"] = [_moved(f, tmp, args.out) for f in res["figures"]]
+    out = with_warnings(args, {"index": res["index"], "figures": res["figures"], "seconds": res["seconds"],
+                               "final": res["steps"][-1]["effects"], "error": res["steps"][-1]["error"]})
     if args.json:
-        print(dump_json({"index": res["index"], "figures": res["figures"], "seconds": res["seconds"],
-                         "final": res["steps"][-1]["effects"], "error": res["steps"][-1]["error"]}))
+        print(dump_json(out))
     else:
         print(f"wrote {res['index']} ({len(res['figures'])} figures, {res['seconds']:.1f} s)")
     return 0

@@ -320,7 +320,7 @@ def estimate_bag(bag_path, description=None, *, tensions: str = "dynamometer", e
     (InertiaStamped: m, com = (x_G, y_G, NaN), frame ``platform``) stamped like the tensions."""
     from ...bags import open_bag
 
-    bag = open_bag(bag_path)
+    bag = bag_path if hasattr(bag_path, "joint_state") else open_bag(bag_path)   # path or open Bag
     desc = description if description is not None else bag.description
     if desc is None:
         raise CablelabError(f"{bag_path}: no /plant_description in the bag; give --description FILE")

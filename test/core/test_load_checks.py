@@ -1,0 +1,146 @@
+"""Every verb loads data through workbench.load_checked: a gap is split into segments (never
+interpolated across), a clock that jumps back, reversed stamps, stamps in ms and a description
+that does not match the bag are one-line errors, NaN samples and negative tensions are warnings
+in the text and the JSON. Oracle: the fit of the complete EMPS recording (001-style real data)."""
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+import yaml
+
+from conftest import CDPR, EMPS, axis_bag, copy_bag, tree_snapshot
+
+
+def _json(res):
+    assert res.code == 0, res.err
+    return json.loads(res.out)
+
+
+@pytest.fixture(scope="module")
+def full_fit():
+    from cablelab.cli import main  # noqa: F401 (imports the verbs)
+    from cablelab.workbench import build_model, compare, load
+
+    plant, desc, ds = load(EMPS)
+    out = compare(ds, build_model(plant, desc))
+    return out["params"]["M"]["value"], out["samples"]
+
+
+def test_gap_is_masked_not_interpolated(cli, tmp_path, full_fit):
+    """3 s of the 24.8 s EMPS recording missing: the verb reports the gap, fits the two
+    segments only and finds the inertia of the complete recording (the old interpolation across
+    the gap gave a different inertia: checked below as the control)."""
+    M_full, n_full = full_fit
+    mid = 12.42
+    bag = axis_bag(tmp_path / "gap", keep=lambda t: ~((t > mid) & (t < mid + 3.0)))
+    out = _json(cli("compare", bag, "--json"))
+    assert len(out["warnings"]) == 1 and "1 recording gap" in out["warnings"][0]
+    assert "3 s" in out["warnings"][0] and "2 contiguous segments" in out["warnings"][0]
+    M = out["params"]["M"]["value"]
+    assert abs(M - M_full) < 0.01 * M_full, (M, M_full)
+    # the sample count is what was fitted: 3 s (3000 samples) + 2 x 50 border samples fewer
+    assert n_full - 3000 - 2 * 50 - 2 <= out["samples"] <= n_full - 3000 - 2 * 50 + 2
+    # control: the same data interpolated across the gap (no mask) is measurably wrong
+    from cablelab.bags import open_bag
+    from cablelab.plants import get_plant
+    from cablelab.workbench import build_model, compare
+
+    b = open_bag(bag)
+    plant = get_plant("axis")
+    ds = plant.dataset(b, b.description, {})
+    M_interp = compare(ds, build_model(plant, b.description))["params"]["M"]["value"]
+    assert abs(M_interp - M_full) > 5 * abs(M - M_full)
+    # text output: the warning line is printed too
+    txt = cli("compare", bag)
+    assert txt.code == 0 and txt.out.startswith("warning: /axis/joint_states: 1 recording gap")
+
+
+def test_clock_jump_forward_is_reported_as_clock_jump(cli, tmp_path):
+    def stamps(t):
+        t[t > 12.42] += 2.0            # header clock jumps 2 s ahead, log time keeps running
+        return t
+    bag = axis_bag(tmp_path / "jump", stamps=stamps, log=lambda t: t)
+    out = _json(cli("identify", bag, "--json", "--folds", "0"))
+    assert any("1 clock jump" in w for w in out["warnings"]), out["warnings"]
+
+
+@pytest.mark.parametrize("case, expect", [
+    ("jump_back", "go back in time 1 time(s)"),
+    ("reversed", "go back in time 99 time(s)"),
+    ("milliseconds", "look like milliseconds"),
+])
+@pytest.mark.parametrize("verb", ["compare", "diagnose", "identify"])
+def test_impossible_stamps_are_one_line_errors(cli, tmp_path, case, expect, verb):
+    def stamps(t):
+        if case == "jump_back":
+            t[t > 12.42] -= 0.5
+        elif case == "reversed":
+            i = np.searchsorted(t, 12.42)
+            t[i:i + 100] = t[i:i + 100][::-1].copy()
+        else:
+            t = t * 1000.0
+        return t
+    bag = axis_bag(tmp_path / case, stamps=stamps, log=lambda t: t)
+    before = tree_snapshot(bag)
+    res = cli(verb, bag, "--json")
+    assert res.code == 2 and res.out == ""
+    assert len(res.err_lines) == 1 and expect in res.err and "/axis/joint_states" in res.err
+    assert str(bag) in res.err
+    assert tree_snapshot(bag) == before
+
+
+def test_nan_samples_are_counted(cli, tmp_path):
+    def eff(e):
+        e[1000:1037] = np.nan
+        return e
+    bag = axis_bag(tmp_path / "nan", effort=eff)
+    out = _json(cli("compare", bag, "--json"))
+    assert any("37 of 24841 samples have NaN/inf" in w for w in out["warnings"]), out["warnings"]
+
+
+def _cdpr_desc(tmp_path, n):
+    from cablelab.bags import open_bag
+
+    d = yaml.safe_load(open_bag(CDPR).description_yaml)
+    d["cdpr"]["cables"] = d["cdpr"]["cables"][:n]
+    p = tmp_path / f"cdpr_{n}.yaml"
+    p.write_text(yaml.safe_dump(d))
+    return p
+
+
+@pytest.mark.parametrize("verb", ["compare", "estimate"])
+def test_cdpr_description_with_5_cables_on_8_cable_bag(cli, tmp_path, verb):
+    res = cli(verb, CDPR, "--description", _cdpr_desc(tmp_path, 5), "--json")
+    assert res.code == 2 and res.out == "" and len(res.err_lines) == 1, res.err
+    assert "has 8 winches" in res.err or "has 8 cables" in res.err
+    assert "description has 5 cables" in res.err
+
+
+def test_negative_tensions_are_a_loud_warning(cli, tmp_path):
+    def edit(bag, w):
+        ts = bag.joint_state("/cdpr/cable_tensions")
+        eff = ts.effort.copy()
+        eff[100:140, 2] = -25.0
+        w.write_joint_states("/cdpr/cable_tensions", ts.t, ts.names, None, None, eff)
+    bag = copy_bag(CDPR, tmp_path / "neg", skip={"/cdpr/cable_tensions"}, edit=edit)
+    for verb in ("compare", "estimate"):
+        out = _json(cli(verb, bag, "--json"))
+        assert any("cable_3 has 40 of" in w and "negative tension" in w for w in out["warnings"]), out
+    clean = _json(cli("estimate", CDPR, "--json"))
+    assert clean["warnings"] == []
+
+
+def test_crane_joint_names_must_match(cli, tmp_path):
+    from cablelab.bags import open_bag
+
+    src = open_bag(CDPR.parent / "crane_control")
+
+    def edit(bag, w):
+        js = bag.joint_state("/crane/joint_states")
+        w.write_joint_states("/crane/joint_states", js.t, ["slew", "luff", "rope"], js.position,
+                             js.velocity, js.effort)
+    bag = copy_bag(src.path, tmp_path / "crane", skip={"/crane/joint_states"}, edit=edit)
+    res = cli("compare", bag, "--json")
+    assert res.code == 2 and len(res.err_lines) == 1 and "missing hoist" in res.err, res.err
