@@ -23,6 +23,7 @@ VERBS = {
     "record": "record",
     "replay": "replay",
     "info": "info",
+    "batch": "batch",
 }
 
 
