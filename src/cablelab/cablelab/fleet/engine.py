@@ -43,7 +43,8 @@ def start_client(scheduler: str | None = None, workers: int | None = None, *, qu
 def run_batch(root, out, *, effects=(), greedy: bool = False, folds: int = 5, scheduler: str | None = None,
               workers: int | None = None, group_by: str | None = None, reports: bool = False,
               progress: bool = True, client=None) -> dict:
-    """Diagnose every bag under ``root`` into ``out``; returns ``{"refs", "hashes", "ran",
+    """Diagnose every bag under ``root`` into ``out`` (the dashboard link always goes to stderr,
+    the progress bar when ``progress``); returns ``{"refs", "hashes", "ran",
     "skipped", "table", "seconds", "dashboard"}`` (the table: :mod:`cablelab.fleet.table`)."""
     out = Path(out)
     try:
@@ -58,8 +59,7 @@ def run_batch(root, out, *, effects=(), greedy: bool = False, folds: int = 5, sc
         client, cluster = start_client(scheduler, workers)
     try:
         dash = getattr(client, "dashboard_link", None)
-        if progress:
-            print(f"cablelab batch: {len(refs)} bags, Dask dashboard {dash}", file=sys.stderr)
+        print(f"cablelab batch: {len(refs)} bags, Dask dashboard {dash}", file=sys.stderr)
         hashes = client.gather(client.map(content_hash, [r.url for r in refs], pure=False)) if refs else []
         done = _table.done_hashes(out)
         todo, seen = [], set()
