@@ -35,8 +35,18 @@ def start_client(scheduler: str | None = None, workers: int | None = None, *, qu
         except (OSError, TimeoutError) as exc:
             raise CablelabError(f"--scheduler {scheduler}: cannot connect ({exc})") from None
         return client, None
-    cluster = LocalCluster(n_workers=workers or default_workers(), threads_per_worker=1, processes=True,
-                           dashboard_address=":0", silence_logs=logging.ERROR)
+    import dask
+
+    # Dask's default MALLOC_TRIM_THRESHOLD_=64 KiB makes glibc trim after every large numpy free,
+    # which slows the allocation-heavy fit; one task holds one bag, so memory stays bounded
+    # without it. Single-threaded BLAS as Dask sets it (one worker process per core). The
+    # worker's statistical profiler (a thread sampling the task's stack every 10 ms) is off: it
+    # competes for the GIL with the task.
+    env = {"OMP_NUM_THREADS": 1, "MKL_NUM_THREADS": 1, "OPENBLAS_NUM_THREADS": 1}
+    with dask.config.set({"distributed.nanny.pre-spawn-environ": env,
+                          "distributed.worker.profile.enabled": False}):
+        cluster = LocalCluster(n_workers=workers or default_workers(), threads_per_worker=1,
+                               processes=True, dashboard_address=":0", silence_logs=logging.ERROR)
     return Client(cluster), cluster
 
 
@@ -60,7 +70,7 @@ def run_batch(root, out, *, effects=(), greedy: bool = False, folds: int = 5, sc
     try:
         dash = getattr(client, "dashboard_link", None)
         print(f"cablelab batch: {len(refs)} bags, Dask dashboard {dash}", file=sys.stderr)
-        hashes = client.gather(client.map(content_hash, [r.url for r in refs], pure=False)) if refs else []
+        hashes = _hashes(client, [r.url for r in refs])
         done = _table.done_hashes(out)
         todo, seen = [], set()
         for ref, h in zip(refs, hashes):
@@ -79,6 +89,19 @@ def run_batch(root, out, *, effects=(), greedy: bool = False, folds: int = 5, sc
     return {"refs": refs, "hashes": hashes, "ran": ran, "failed_now": failed,
             "skipped": len(refs) - ran, "table": tab, "seconds": time.monotonic() - t0,
             "dashboard": dash}
+
+
+HASH_CHUNK = 32
+
+
+def _hash_chunk(urls: list[str]) -> list[str]:
+    return [content_hash(u) for u in urls]
+
+
+def _hashes(client, urls: list[str]) -> list[str]:
+    """Content hashes, computed on the workers where the bags lie, ``HASH_CHUNK`` bags a task."""
+    chunks = [urls[i:i + HASH_CHUNK] for i in range(0, len(urls), HASH_CHUNK)]
+    return [h for part in client.gather(client.map(_hash_chunk, chunks, pure=False)) for h in part]
 
 
 def _run(client, todo, out, effects, greedy, folds, progress) -> tuple[int, int]:
