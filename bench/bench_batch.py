@@ -7,7 +7,8 @@ are fixed costs reported separately). Derived: parallel efficiency = throughput(
 (1 worker vs loop, target < 5 %), plus an on-paper estimate of a 10 000-bag campaign on a 50-node
 cluster from the measured per-bag cost.
 
-Run: nice -n 10 ./run python bench/bench_batch.py [--machines 20 --days 10] [--greedy] [--json]
+Run: nice -n 10 ./run python bench/bench_batch.py [--machines 20 --days 10] [--duration 6] [--greedy]
+[--json]
 """
 from __future__ import annotations
 
@@ -26,6 +27,7 @@ def main() -> int:
     bench = Bench("batch", __doc__)
     bench.parser.add_argument("--machines", type=int, default=20)
     bench.parser.add_argument("--days", type=int, default=10)
+    bench.parser.add_argument("--duration", type=float, default=6.0, help="bag length, s (200 Hz)")
     bench.parser.add_argument("--greedy", action="store_true", help="greedy diagnosis per bag")
     bench.parser.add_argument("--nodes", type=int, default=50, help="campaign estimate: cluster nodes")
     bench.parser.add_argument("--cores", type=int, default=16, help="campaign estimate: cores per node")
@@ -40,7 +42,7 @@ def main() -> int:
     try:
         root = tmp / "fleet"
         bench.log(f"writing {args.machines * args.days} bags ...")
-        write_fleet(root, args.machines, args.days, progress=True)
+        write_fleet(root, args.machines, args.days, duration=args.duration, progress=True)
         refs = find_bags(root)
         n = len(refs)
 
