@@ -156,3 +156,27 @@ def test_missing_root_is_a_one_line_error(tmp_path):
                         str(tmp_path / "o")], capture_output=True, text=True, timeout=60)
     assert p.returncode == 2 and "no such directory" in p.stderr and "Traceback" not in p.stderr
     assert len(p.stderr.strip().splitlines()) == 1
+
+
+def test_bags_in_an_object_store_url_are_read_where_they_lie(fleet):
+    """fsspec URL (the in-memory store stands in for s3:// etc.): found, hashed like the local
+    copy, and diagnosed to the same rows as the local bag."""
+    import fsspec
+
+    root, _, _, _, _ = fleet
+    mem = fsspec.filesystem("memory")
+    local = root / "winch-01" / "day-03"
+    for f in local.iterdir():
+        mem.pipe(f"/fleetcopy/winch-01/day-03/{f.name}", f.read_bytes())
+    refs = find_bags("memory://fleetcopy")
+    assert [r.rel for r in refs] == ["winch-01/day-03"] and refs[0].url.startswith("memory://")
+    h = content_hash(refs[0].url)
+    assert h == content_hash(str(local))
+    from cablelab.fleet.scan import BagRef
+
+    remote_rows = run_bag(refs[0], h)
+    local_rows = run_bag(BagRef(str(local), "winch-01/day-03"), h)
+    assert [r["status"] for r in remote_rows] == ["ok"] * len(local_rows)
+    for a, b in zip(remote_rows, local_rows):
+        assert (a["effect"], a["params"], a["machine"], a["start_time"]) == \
+            (b["effect"], b["params"], b["machine"], b["start_time"])
