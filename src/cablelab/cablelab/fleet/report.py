@@ -45,7 +45,8 @@ def heatmap(path, rows: list[dict]):
     for i in range(len(machines)):
         for j in range(len(effects)):
             txt = "model" if model[i, j] else ("-" if np.isnan(frac[i, j]) else f"{frac[i, j]:.0%}")
-            ax.text(j, i, txt, ha="center", va="center", fontsize=7)
+            dark = not model[i, j] and np.nan_to_num(frac[i, j]) > 0.6
+            ax.text(j, i, txt, ha="center", va="center", fontsize=7, color="white" if dark else "black")
     ax.set_xticks(range(len(effects)), effects, rotation=30, ha="right", fontsize=8)
     ax.set_yticks(range(len(machines)), machines, fontsize=8)
     ax.set_title("share of bags in which the effect is significant")
