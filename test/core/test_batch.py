@@ -180,3 +180,42 @@ def test_bags_in_an_object_store_url_are_read_where_they_lie(fleet):
     for a, b in zip(remote_rows, local_rows):
         assert (a["effect"], a["params"], a["machine"], a["start_time"]) == \
             (b["effect"], b["params"], b["machine"], b["start_time"])
+
+
+def test_existing_cluster_via_scheduler_gives_the_same_rows(fleet, tmp_path):
+    """`dask scheduler` + `dask worker` started by hand (as on other hosts), then --scheduler."""
+    import time
+
+    root, out, _, _, _ = fleet
+    sched_file = tmp_path / "scheduler.json"
+    bindir = os.path.dirname(sys.executable)
+    procs = [subprocess.Popen([os.path.join(bindir, "dask"), "scheduler", "--scheduler-file", str(sched_file),
+                               "--port", "0", "--dashboard-address", ":0", "--host", "127.0.0.1"],
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)]
+    try:
+        t0 = time.monotonic()
+        while not sched_file.exists() and time.monotonic() - t0 < 60:
+            time.sleep(0.1)
+        address = json.loads(sched_file.read_text())["address"]
+        procs.append(subprocess.Popen([os.path.join(bindir, "dask"), "worker", address, "--nworkers", "1",
+                                       "--nthreads", "1", "--dashboard-address", ":0"],
+                                      stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+        out2 = tmp_path / "out"
+        p = subprocess.run([sys.executable, "-m", "cablelab.cli", "batch", str(root / "winch-04"), "-o",
+                            str(out2), "--greedy", "--scheduler", address, "--json"],
+                           capture_output=True, text=True, timeout=240)
+    finally:
+        for pr in reversed(procs):
+            pr.terminate()
+            try:
+                pr.wait(20)
+            except subprocess.TimeoutExpired:
+                pr.kill()
+    assert p.returncode == 0, p.stderr[-3000:]
+    s = json.loads(p.stdout)
+    assert s["bags"] == DAYS and s["failed"] == 0
+    assert [(d["machine"], d["param"]) for d in s["drift"]] == [("winch-04", "OF")]
+    mine = {(r["effect"], r["start_time"]): r["params"] for r in pq.read_table(out2 / "results.parquet").to_pylist()}
+    local = {(r["effect"], r["start_time"]): r["params"] for r in pq.read_table(out / "results.parquet").to_pylist()
+             if r["machine"] == "winch-04"}
+    assert mine == local
