@@ -26,6 +26,7 @@ VERBS = {
     "replay": "replay",
     "info": "info",
     "repair": "repair",
+    "batch": "batch",
 }
 
 

@@ -1,0 +1,99 @@
+"""`cablelab batch` throughput on Dask distributed vs a plain loop, on one synthetic 200-bag fleet.
+
+Rows: the plain Python loop (content hash + per-bag task, in this process) and the engine on a
+LocalCluster with 1, 2 and all local workers (warm workers: cluster start and the first import
+are fixed costs reported separately). Derived: parallel efficiency = throughput(k) /
+(k x throughput(1)) (target >= 80 % at 2 workers) and the engine's per-bag overhead vs the loop
+(1 worker vs loop, target < 5 %), plus an on-paper estimate of a 10 000-bag campaign on a 50-node
+cluster from the measured per-bag cost.
+
+Run: nice -n 10 ./run python bench/bench_batch.py [--machines 20 --days 10] [--duration 6] [--greedy]
+[--json]
+"""
+from __future__ import annotations
+
+import os
+import shutil
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from harness import Bench  # noqa: E402
+
+
+def main() -> int:
+    bench = Bench("batch", __doc__)
+    bench.parser.add_argument("--machines", type=int, default=20)
+    bench.parser.add_argument("--days", type=int, default=10)
+    bench.parser.add_argument("--duration", type=float, default=6.0, help="bag length, s (200 Hz)")
+    bench.parser.add_argument("--greedy", action="store_true", help="greedy diagnosis per bag")
+    bench.parser.add_argument("--nodes", type=int, default=50, help="campaign estimate: cluster nodes")
+    bench.parser.add_argument("--cores", type=int, default=16, help="campaign estimate: cores per node")
+    bench.parser.add_argument("--campaign", type=int, default=10000, help="campaign estimate: bags")
+    args = bench.parse()
+
+    from cablelab.fleet.engine import default_workers, run_batch, run_loop, start_client
+    from cablelab.fleet.scan import content_hash, find_bags
+    from cablelab.fleet.synthetic import write_fleet
+
+    tmp = Path(tempfile.mkdtemp(prefix="bench-batch-"))
+    try:
+        root = tmp / "fleet"
+        bench.log(f"writing {args.machines * args.days} bags ...")
+        write_fleet(root, args.machines, args.days, duration=args.duration, progress=True)
+        refs = find_bags(root)
+        n = len(refs)
+
+        def loop():
+            hashes = [content_hash(r.url) for r in refs]
+            return run_loop(refs, hashes, greedy=args.greedy)
+
+        loop()  # warm imports / caches of this process
+        t0 = time.perf_counter()
+        loop()
+        t_loop = time.perf_counter() - t0
+        bench.row(engine="plain loop", workers=1, bags=n, seconds=t_loop, bags_per_s=n / t_loop,
+                  per_bag_ms=1e3 * t_loop / n)
+        all_w = default_workers()
+        results = {}
+        for k in sorted({1, 2, all_w}):
+            t0 = time.perf_counter()
+            client, cluster = start_client(workers=k)
+            client.run(lambda: __import__("cablelab.fleet.task") and None)
+            warm = tmp / f"warm{k}"
+            run_batch(root / refs[0].rel, warm, greedy=args.greedy, client=client, progress=False)
+            t_start = time.perf_counter() - t0
+            out = tmp / f"out{k}"
+            t0 = time.perf_counter()
+            res = run_batch(root, out, greedy=args.greedy, client=client, progress=False)
+            sec = time.perf_counter() - t0
+            client.close()
+            cluster.close()
+            assert res["ran"] == n and res["table"].num_rows >= n
+            results[k] = sec
+            bench.row(engine="dask LocalCluster", workers=k, bags=n, seconds=sec, bags_per_s=n / sec,
+                      per_bag_ms=1e3 * sec / n, startup_s=t_start)
+        bench.section("derived")
+        bench.row(quantity="parallel efficiency, 2 workers", value=results[1] / (2 * results[2]),
+                  target=">= 0.80")
+        if all_w not in (1, 2):
+            bench.row(quantity=f"parallel efficiency, {all_w} workers", value=results[1] / (all_w * results[all_w]),
+                      target="-")
+        bench.row(quantity="engine overhead per bag vs loop (1 worker)", value=results[1] / t_loop - 1,
+                  target="< 0.05")
+        per_bag = t_loop / n
+        eff = min(1.0, results[1] / (2 * results[2]))
+        est = args.campaign * per_bag / (args.nodes * args.cores * eff)
+        bench.row(quantity=f"estimate: {args.campaign} bags on {args.nodes} nodes x {args.cores} cores "
+                           f"(s, at the measured per-bag cost and 2-worker efficiency)", value=est, target="-")
+        bench.done()
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    return 0
+
+
+if __name__ == "__main__":
+    os.environ.setdefault("MPLBACKEND", "Agg")
+    raise SystemExit(main())

@@ -1,0 +1,140 @@
+"""One bag -> result rows (the unit of work of ``cablelab batch``). Never raises: a bag that
+cannot be diagnosed gives one row whose ``status`` is the one-line reason.
+
+The work is the library's own: :func:`cablelab.workbench.load`, :func:`~cablelab.workbench.build_model`,
+:func:`~cablelab.workbench.diagnose` (held-out ranking, optional greedy waterfall) and
+:func:`~cablelab.workbench.identify` (the model's own parameters with standard errors).
+Optionally the bag's own ``cablelab report`` is written next to the results.
+"""
+from __future__ import annotations
+
+import datetime as _dt
+import json
+import os
+import tempfile
+import time
+
+from .scan import BagRef, filesystem, is_local
+
+FAILED_EFFECT = ""
+
+
+def _one_line(exc: BaseException) -> str:
+    text = str(exc).strip().splitlines()
+    return text[0] if text else type(exc).__name__
+
+
+def _params_json(values: dict, stderr: dict | None, names) -> str:
+    stderr = stderr or {}
+    return json.dumps({k: {"value": _f(values.get(k)), "stderr": _f(stderr.get(k))} for k in names
+                       if k in values})
+
+
+def _f(v):
+    try:
+        v = float(v)
+    except (TypeError, ValueError):
+        return None
+    return v if v == v and abs(v) != float("inf") else None
+
+
+def _effect_names(effect_id: str, ds) -> list[str]:
+    from ..effects import get_effect
+
+    return [p.name for p in get_effect(effect_id, ds.plant).columns(ds)]
+
+
+def _local(ref: BagRef):
+    """(local path, temp dir or None): a remote bag is copied to a temp dir first."""
+    fs, path = filesystem(ref.url)
+    if is_local(fs):
+        return path, None
+    tmp = tempfile.mkdtemp(prefix="cablelab-bag-")
+    dest = os.path.join(tmp, os.path.basename(path.rstrip("/")) or "bag")
+    fs.get(path, dest, recursive=True)
+    return dest, tmp
+
+
+def run_bag(ref: BagRef, bag_hash: str, effects=(), greedy: bool = False, folds: int = 5,
+            report_dir: str | None = None) -> list[dict]:
+    """Diagnose one bag. Returns its rows (see :mod:`cablelab.fleet.table`); never raises."""
+    t0 = time.monotonic()
+    base = {"bag": ref.rel, "url": ref.url, "bag_hash": bag_hash, "machine": ref.machine,
+            "start_time": ref.start_time, "plant": None}
+    try:
+        rows = _rows(ref, base, effects, greedy, folds, report_dir)
+    except Exception as exc:  # noqa: BLE001 - every failure becomes a row
+        from ..errors import CablelabError
+
+        msg = _one_line(exc) if isinstance(exc, CablelabError) else f"{type(exc).__name__}: {_one_line(exc)}"
+        rows = [dict(base, effect=FAILED_EFFECT, in_model=False, status=msg)]
+    sec = time.monotonic() - t0
+    for r in rows:
+        r["seconds"] = sec
+        if r["machine"] is None:
+            r["machine"] = ""
+    return rows
+
+
+def _rows(ref, base, effects, greedy, folds, report_dir):
+    import shutil
+
+    from ..model import parse_effect_list
+    from ..workbench import build_model, diagnose, identify, load
+
+    path, tmp = _local(ref)
+    try:
+        plant, desc, ds = load(path)
+        from ..bags import open_bag  # start time: first stamp of the bag
+
+        start = base["start_time"]
+        if start is None:
+            start = _dt.datetime.fromtimestamp(open_bag(path).start, _dt.timezone.utc)
+        base = dict(base, plant=plant.name, machine=base["machine"] or desc.name or "",
+                    start_time=start)
+        model = build_model(plant, desc, parse_effect_list(list(effects)))
+        cands = plant.candidates(desc)
+        out = diagnose(ds, model, cands, folds=folds, greedy_mode=greedy, quiet=True)
+        first = {r["effect"]: (i, r) for i, r in enumerate(out["ranking"])}
+        if greedy:
+            final_effects = list(out["final"]["effects"])
+            fvals, ferr = out["final"]["params"], out["final"]["stderr"]
+            last = {r["effect"]: r for r in out["greedy"][-1]["ranking"]}
+            final_error = out["final"]["error"]
+        else:
+            final_effects = list(model.effects)
+            idn = identify(ds, model, folds=0, quiet=True)
+            fvals = {k: v["value"] for k, v in idn["params"].items()}
+            ferr = {k: v["stderr"] for k, v in idn["params"].items()}
+            last = {r["effect"]: r for r in out["ranking"]}
+            final_error = out["baseline"]["error"]
+        rows = []
+        base_err = out["baseline"]["error"]
+        model_text = "+".join(final_effects)
+        for eff in final_effects:
+            rank, r = first.get(eff, (None, None))
+            rows.append(dict(base, effect=eff, in_model=True, rank=rank,
+                             significant=None if r is None else bool(r["significant"]),
+                             error_before=base_err if r is None else r["error_before"],
+                             error_after=final_error if r is None else r["error_after"],
+                             p_value=None if r is None else r.get("p_value"),
+                             params=_params_json(fvals, ferr, _effect_names(eff, ds)),
+                             model=model_text, status="ok"))
+        for eff, (rank, r) in first.items():
+            if eff in final_effects:
+                continue
+            lr = last.get(eff, r)
+            rows.append(dict(base, effect=eff, in_model=False, rank=rank, significant=bool(r["significant"]),
+                             error_before=r["error_before"], error_after=r["error_after"],
+                             p_value=r.get("p_value"),
+                             params=_params_json(lr.get("params", {}), lr.get("stderr"), list(lr.get("params", {}))),
+                             model=model_text, status="ok"))
+        if report_dir:
+            from ..report import build_report
+
+            build_report(ds, model, cands, report_dir, folds=folds,
+                         title=f"cablelab report: {base['machine']} {start.isoformat()}", quiet=True)
+        return rows
+    finally:
+        if tmp:
+            shutil.rmtree(tmp, ignore_errors=True)
