@@ -40,26 +40,6 @@ class BagCheck:
         return gap_mask(t, self.gaps, margin)
 
 
-def _expected_names(plant: str, desc) -> dict[str, tuple[str, ...]]:
-    """topic -> the joint names the description implies (exact set for the CDPR)."""
-    if plant == "cdpr" and getattr(desc, "cdpr", None) is not None:
-        n = len(desc.cdpr.cables)
-        return {"/cdpr/joint_states": tuple(f"winch_{i}" for i in range(1, n + 1)),
-                "/cdpr/cable_tensions": tuple(f"cable_{i}" for i in range(1, n + 1))}
-    if plant == "crane":
-        return {"/crane/joint_states": ("slew", "luff", "hoist")}
-    return {}
-
-
-def _topics(plant: str, bag, required) -> list[tuple[str, str]]:
-    out = list(required)
-    if plant == "cdpr":
-        for extra in ("/cdpr/cable_tensions", "/cdpr/reference", "/cdpr/platform_pose"):
-            if bag.has(extra) and all(extra != t for t, _ in out):
-                out.append((extra, bag.topics[extra]))
-    return out
-
-
 def _stamps_and_values(bag, topic: str, msgtype: str):
     """(header stamps, log times, values) of a topic, or None for a type without a header."""
     if msgtype == JOINT_STATE:
@@ -88,39 +68,48 @@ def check_bag(bag, plant, desc, options: dict | None = None, limits: Limits = Li
     if getattr(bag, "recovered", False):
         out.warnings.append(f"{bag.path}: unfinished bag (recorder killed?), read up to its last "
                             f"complete chunk")
-    names_wanted = _expected_names(plant.name, desc)
-    for topic, msgtype in _topics(plant.name, bag, plant.topics):
+    checked = list(plant.topics) + [(t, bag.topics[t]) for t in plant.checked_topics
+                                    if bag.has(t) and all(t != r for r, _ in plant.topics)]
+    series_by_topic = {}
+    for topic, msgtype in checked:
         if not bag.has(topic) or bag.counts.get(topic, 0) == 0:
             continue
         got = _stamps_and_values(bag, topic, msgtype)
         if got is None:
             continue
         t, t_log, vals, series = got
-        want = names_wanted.get(topic)
-        if want is not None:
-            _check_names(bag, topic, series, want, plant.name, desc)
+        series_by_topic[topic] = series
         rep: TimebaseReport = check_stamps(t, t_log, topic=topic, values=vals, limits=limits)
         raise_if_impossible(rep, str(bag.path))
         out.reports[topic] = rep
         out.warnings.extend(rep.warnings())
-        if topic == "/cdpr/cable_tensions" and (options.get("tensions") or "dynamometer") == "dynamometer":
-            out.warnings.extend(negative_tension_warnings(series.effort, series.names, topic))
+    if plant.check_bag is not None:     # the plant's own checks: names vs description, values
+        out.warnings.extend(plant.check_bag(bag, desc, options, series_by_topic))
     return out
 
 
-def _check_names(bag, topic, series, want, plant, desc) -> None:
-    have = list(series.names)
-    if plant == "cdpr":
+def check_names(bag, topic: str, names, want, *, exact: bool = False, plant: str = "",
+                noun: str = "joints", described: str = "") -> None:
+    """One-line error when the names of ``topic`` do not match what the description implies.
+
+    Args:
+        names: the names in the bag; want: the names the description implies.
+        exact: the sets must be equal (e.g. one name per cable), else ``want`` must be present.
+        noun: what the names are (``winches``, ``cables``); described: what the description
+            counts (default ``noun``).
+    """
+    have = list(names)
+    if exact:
         if set(have) != set(want):
-            noun = "cables" if "tensions" in topic else "winches"
             raise CablelabError(
                 f"{bag.path}: {topic} has {len(have)} {noun} ({_span(have)}) but the plant "
-                f"description has {len(want)} cables; give the description of this robot (--description)")
-    else:
-        missing = [n for n in want if n not in have]
-        if missing:
-            raise CablelabError(f"{bag.path}: {topic} has joints {', '.join(have) or 'none'}; the {plant} "
-                                f"description needs {', '.join(want)} (missing {', '.join(missing)})")
+                f"description has {len(want)} {described or noun}; give the description of this "
+                f"robot (--description)")
+        return
+    missing = [n for n in want if n not in have]
+    if missing:
+        raise CablelabError(f"{bag.path}: {topic} has {noun} {', '.join(have) or 'none'}; the {plant} "
+                            f"description needs {', '.join(want)} (missing {', '.join(missing)})")
 
 
 def _span(names) -> str:

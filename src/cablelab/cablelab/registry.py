@@ -54,8 +54,12 @@ class Plant:
         capabilities: what the plant's datasets offer to generic effects, e.g.
             ``"joint_actuators"`` (per-joint actuator velocities and efforts: joint friction and
             the like), ``"winch_actuators"`` (CDPR winch motors).
-        estimate: optional ``fn(bag, desc, options) -> Estimate`` for ``cablelab estimate``
-            (an object with ``summary() -> dict`` and ``write(path, overwrite)``).
+        estimate: optional ``fn(bag, desc, **options) -> Estimate`` for ``cablelab estimate``
+            (an object with ``summary() -> dict``, or a dict).
+        checked_topics: topics besides ``topics`` whose time base is checked when present.
+        check_bag: optional ``fn(bag, desc, options, series) -> list of warnings`` run before
+            every fit (:func:`cablelab.bagcheck.check_bag`; ``series``: topic -> decoded series):
+            names against the description (one-line errors), physically impossible values.
         package: the Python package of the plant (filled in by :func:`get_plant`).
     """
 
@@ -74,6 +78,8 @@ class Plant:
     joints: tuple[str, ...] | None = None
     capabilities: frozenset = frozenset()
     estimate: Callable | None = None
+    checked_topics: tuple[str, ...] = ()
+    check_bag: Callable | None = None
     package: str = ""
 
 

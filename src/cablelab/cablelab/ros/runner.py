@@ -104,17 +104,37 @@ ROLES = {"cable_sim_node": "sim", "payload_estimator": "estimator", "pd_feedforw
 
 
 def node_module(plant: str, role: str):
-    """The module of a plant's node for ``role`` (``sim``, ``estimator``, ``controller``):
-    ``<plant package>.nodes.<role>``, which exposes ``make_node(args)`` and optionally
-    ``add_arguments(parser)``. None when the plant has no node for that role."""
+    """What runs a plant's node for ``role`` (``sim``, ``estimator``, ``controller``): an object
+    with ``make_node(args)`` and optionally ``add_arguments(parser)``. A plant's ``nodes`` is
+    either a package with one module per role (``nodes/sim.py``, each with ``make_node(args)``)
+    or one module with ``make_node(role, args)`` (and optionally ``add_arguments(role, parser)``
+    and ``ROLES``, the roles it has). None when the plant has no node for that role."""
+    import types
+
     from ..registry import plant_module
 
+    def missing(exc: ModuleNotFoundError, *names: str) -> bool:
+        return bool(exc.name) and exc.name.endswith(names)
+
     try:
-        return plant_module(plant, f"nodes.{role}")
+        nodes = plant_module(plant, "nodes")
     except ModuleNotFoundError as exc:
-        if exc.name and exc.name.endswith((".nodes", f".nodes.{role}")):
+        if missing(exc, ".nodes"):
             return None
         raise
+    if hasattr(nodes, "__path__"):
+        try:
+            return plant_module(plant, f"nodes.{role}")
+        except ModuleNotFoundError as exc:
+            if missing(exc, f".nodes.{role}"):
+                return None
+            raise
+    if role not in getattr(nodes, "ROLES", (role,)) or not hasattr(nodes, "make_node"):
+        return None
+    adapter = types.SimpleNamespace(make_node=lambda args: nodes.make_node(role, args))
+    if hasattr(nodes, "add_arguments"):
+        adapter.add_arguments = lambda parser: nodes.add_arguments(role, parser)
+    return adapter
 
 
 def role_main(package: str, role: str, description: str):

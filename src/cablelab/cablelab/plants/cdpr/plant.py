@@ -337,6 +337,23 @@ def estimate_bag(bag_path, description=None, *, tensions: str = "dynamometer", e
     return est
 
 
+def check_bag(bag, desc, options, series) -> list[str]:
+    """Before a fit: one winch and one cable per described cable, and no cable that pushes."""
+    from ...bagcheck import check_names, negative_tension_warnings
+
+    warnings = []
+    n = len(desc.cdpr.cables) if desc.cdpr is not None else None
+    for topic, prefix, noun in ((JOINTS, "winch", "winches"), (TENSIONS, "cable", "cables")):
+        s = series.get(topic)
+        if s is None or n is None:
+            continue
+        check_names(bag, topic, s.names, [f"{prefix}_{i}" for i in range(1, n + 1)], exact=True,
+                    noun=noun, described="cables")
+        if topic == TENSIONS and (options.get("tensions") or "dynamometer") == "dynamometer":
+            warnings.extend(negative_tension_warnings(s.effort, s.names, topic))
+    return warnings
+
+
 CDPR = register_plant(Plant(
     name="cdpr",
     topics=((JOINTS, JOINT_STATE),),
@@ -361,4 +378,6 @@ CDPR = register_plant(Plant(
     joints=tuple(f"winch_{i}" for i in range(1, 9)),
     capabilities=frozenset({"winch_actuators"}),
     estimate=estimate_bag,
+    checked_topics=(TENSIONS, "/cdpr/reference", POSE),
+    check_bag=check_bag,
 ))

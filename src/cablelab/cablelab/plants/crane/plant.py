@@ -212,6 +212,15 @@ def candidates(description) -> tuple[str, ...]:
             "torque_sensor_offset")
 
 
+def _check_joint_names(bag, series) -> list[str]:
+    """Before a fit: the joint states name slew, luff and hoist."""
+    from ...bagcheck import check_names
+
+    if JOINT_STATES in series:
+        check_names(bag, JOINT_STATES, series[JOINT_STATES].names, JOINTS, plant="crane")
+    return []
+
+
 CRANE = register_plant(Plant(
     name="crane",
     topics=((JOINT_STATES, JOINT_STATE), (TIP_POSE, POSE), (PAYLOAD_POSE, POSE)),
@@ -235,4 +244,5 @@ CRANE = register_plant(Plant(
     joints=JOINTS,
     capabilities=frozenset({"joint_actuators"}),
     estimate=estimate_bag,
+    check_bag=lambda bag, desc, options, series: _check_joint_names(bag, series),
 ))
