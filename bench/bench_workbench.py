@@ -62,14 +62,14 @@ def main() -> int:
     cands = [c for c in plant.candidates(desc) if c not in inertia_only.effects]
     best, med, out = timed(lambda: diagnose(ds, inertia_only, cands, folds=5), args.repeat)
     rows.append((f"diagnose {len(cands)} candidates x 5 folds", ds.n, best, med, "< 5 s",
-                 f"first: {out['ranking'][0]['effect']}"))
+                 f"first: {out.ranking[0].effect}"))
     best, med, out = timed(lambda: diagnose(ds, nominal, plant.candidates(desc), folds=5), args.repeat)
     rows.append(("diagnose nominal (3 candidates)", ds.n, best, med, "",
-                 f"first: {out['ranking'][0]['effect']}"))
+                 f"first: {out.ranking[0].effect}"))
     best, med, out = timed(lambda: diagnose(ds, nominal, plant.candidates(desc), folds=5,
                                             greedy_mode=True), args.repeat)
     rows.append(("diagnose --greedy", ds.n, best, med, "",
-                 f"final NRMSE {100 * out['final']['error']:.2f} %"))
+                 f"final NRMSE {100 * out.final.error:.2f} %"))
     if not args.skip_report:
         from cablelab.report import build_report
 

@@ -111,3 +111,36 @@ def test_simulation_fit_recovers_axis_parameters_with_both_objectives():
         for k, v in truth.items():  # the (autocorrelation-corrected) errors cover the truth
             assert 0 < f.stderr[k] < 0.05 * v and abs(f.params[k] - v) < 3 * f.stderr[k], (obj, k)
         assert f.nmse < 1e-3 and f.pearson > 0.999
+
+
+def test_typed_diagnosis_is_the_ranking_once_reshaped():
+    """``workbench.diagnose`` returns a :class:`Diagnosis` whose JSON carries every ranking row's
+    documented fields unchanged (second path: ``rank_candidates`` called directly), and whose
+    greedy steps end at the best significant model."""
+    from cablelab.diagnose import rank_candidates
+    from cablelab.diagnose.result import ROW_KEYS, Diagnosis
+    from cablelab.model import Model
+    from cablelab.plants.axis.plant import dataset_from_arrays
+    from cablelab.workbench import diagnose
+
+    rng = np.random.default_rng(1)
+    t = np.arange(0, 20, 0.005)
+    q = 0.2 * np.sin(2 * np.pi * 0.5 * t) + 0.05 * np.sin(2 * np.pi * 1.7 * t)
+    qd = np.gradient(q, t)
+    qdd = np.gradient(qd, t)
+    force = 2.0 * qdd + 5.0 * qd + 1.5 * np.tanh(qd / 1e-3) + 0.05 * rng.normal(size=t.size)
+    desc = load_description("plant: axis\naxis: {joint_type: prismatic}\n")
+    ds = dataset_from_arrays(t, q, force, desc, qd=qd)
+    model = Model("axis", ("axis_inertia", "joint_viscous_friction"))
+    cands = ("joint_coulomb_friction", "torque_sensor_offset")
+    d = diagnose(ds, model, cands, folds=4)
+    assert isinstance(d, Diagnosis) and d.final is None
+    rows = rank_candidates(model, ds, cands, folds=4).ranking
+    js = d.to_json()
+    assert [r["effect"] for r in js["ranking"]] == [r["effect"] for r in rows]
+    for got, row in zip(js["ranking"], rows):
+        assert got == {k: row[k] for k in ROW_KEYS if k in row}
+    assert d.ranking[0].effect == "joint_coulomb_friction" and d.ranking[0].significant
+    g = diagnose(ds, model, cands, folds=4, greedy_mode=True)
+    assert g.final.effects[-1] == "joint_coulomb_friction" and g.to_json()["final"]["error"] == g.final.error
+    assert g.lines()[0].startswith("plant axis: model axis_inertia + joint_viscous_friction")

@@ -1,7 +1,7 @@
 """The workbench verbs as library functions (what ``cablelab compare/diagnose/identify`` print).
 
 Each takes a plant :class:`~cablelab.model.Dataset` and a :class:`~cablelab.model.Model` and
-returns a JSON-ready dict in the shape of CONTRACT section 5; :func:`load` turns a bag (+ optional
+returns a JSON-ready dict (``diagnose``: a typed :class:`~cablelab.diagnose.result.Diagnosis`) in the shape of CONTRACT section 5; :func:`load` turns a bag (+ optional
 description file) into (plant, description, dataset), :func:`build_model` a plant's baseline plus
 ``--effects`` into a model.
 """
@@ -14,6 +14,7 @@ import numpy as np
 from .diagnose import (channel_metrics, cv_error, derived_regimes, greedy, rank_candidates,
                        residual_by_regime, whiteness, worst_segments)
 from .diagnose.ranking import ALPHA, FOLDS, MIN_GAIN
+from .diagnose.result import Candidate, Diagnosis, step_from_dict
 from .errors import CablelabError
 from .fit import identify as _identify
 from .fit.threads import blas_single
@@ -188,27 +189,16 @@ def identify(ds: Dataset, model: Model, *, folds: int = FOLDS, simulation: str |
 @blas_single
 def diagnose(ds: Dataset, model: Model, candidates: Sequence[str], *, folds: int = FOLDS,
              alpha: float = ALPHA, min_gain: float = MIN_GAIN, greedy_mode: bool = False,
-             quiet: bool = True) -> dict:
+             quiet: bool = True) -> Diagnosis:
     """Rank the missing effects (CONTRACT section 5 ``diagnose``); with ``greedy_mode`` also the
-    waterfall of significant effects added one at a time."""
+    waterfall of significant effects added one at a time. ``.to_json()`` is the contract JSON."""
     cands = [c for c in candidates if c not in model.effects]
     if greedy_mode:
-        steps = greedy(model, ds, cands, folds=folds, alpha=alpha, min_gain=min_gain, quiet=quiet)
+        steps = [step_from_dict(s) for s in greedy(model, ds, cands, folds=folds, alpha=alpha,
+                                                    min_gain=min_gain, quiet=quiet)]
         first = steps[0]
-        out = {"plant": ds.plant, "baseline": {"effects": first["effects"], "error": first["error"]},
-               "ranking": [_row(r) for r in first["ranking"]], "folds": folds,
-               "greedy": [{"effects": s["effects"], "added": s["added"], "error": s["error"],
-                           "params": s["params"], "stderr": s["stderr"], "units": s["units"],
-                           "ranking": [_row(r) for r in s["ranking"]]} for s in steps]}
-        out["final"] = {"effects": steps[-1]["effects"], "error": steps[-1]["error"],
-                        "params": steps[-1]["params"], "stderr": steps[-1]["stderr"]}
-        return out
+        return Diagnosis(plant=ds.plant, baseline_effects=first.effects, baseline_error=first.error,
+                         ranking=first.ranking, folds=folds, greedy=steps)
     d = rank_candidates(model, ds, cands, folds=folds, alpha=alpha, min_gain=min_gain, quiet=quiet)
-    return {"plant": ds.plant, "baseline": {"effects": list(model.effects), "error": d.error},
-            "ranking": [_row(r) for r in d.ranking], "folds": folds}
-
-
-def _row(r: dict) -> dict:
-    keys = ("effect", "error_before", "error_after", "params", "significant", "stderr", "units",
-            "p_value", "delta_bic", "n_eff", "gain", "evidence", "explanation")
-    return {k: r[k] for k in keys if k in r}
+    return Diagnosis(plant=ds.plant, baseline_effects=list(model.effects), baseline_error=d.error,
+                     ranking=[Candidate.from_row(r) for r in d.ranking], folds=folds)

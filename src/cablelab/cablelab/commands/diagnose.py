@@ -31,19 +31,9 @@ def run(args) -> int:
     cands = parse_effect_list(args.candidates) if args.candidates else plant.candidates(desc)
     out = diagnose(ds, model, cands, folds=args.folds, alpha=args.alpha, min_gain=args.min_gain,
                    greedy_mode=args.greedy, quiet=args.json)
-    with_warnings(args, out)
+    doc = with_warnings(args, out.to_json())
     if args.json:
-        print(dump_json(out))
+        print(dump_json(doc))
         return 0
-    b = out["baseline"]
-    print(f"plant {out['plant']}: model {' + '.join(b['effects'])}, held-out NRMSE "
-          f"{100 * b['error']:.2f} % ({out['folds']} folds)")
-    for i, r in enumerate(out["ranking"], 1):
-        after = "-" if r["error_after"] is None else f"{100 * r['error_after']:.2f} %"
-        mark = "*" if r["significant"] else " "
-        print(f" {mark}{i}. {r['effect']:<26} -> {after:>9}  {r['explanation']}")
-    for s in out.get("greedy", [])[1:]:
-        print(f"  + {s['added']:<26} held-out NRMSE {100 * s['error']:.2f} %")
-    if "final" in out:
-        print("final: " + ", ".join(f"{k} = {v:.6g}" for k, v in out["final"]["params"].items()))
+    print("\n".join(out.lines()))
     return 0

@@ -94,7 +94,7 @@ def _rows(ref, base, effects, greedy, folds, report_dir):
                     start_time=start)
         model = build_model(plant, desc, parse_effect_list(list(effects)))
         cands = plant.candidates(desc)
-        out = diagnose(ds, model, cands, folds=folds, greedy_mode=greedy, quiet=True)
+        out = diagnose(ds, model, cands, folds=folds, greedy_mode=greedy, quiet=True).to_json()
         first = {r["effect"]: (i, r) for i, r in enumerate(out["ranking"])}
         if greedy:
             final_effects = list(out["final"]["effects"])

@@ -199,7 +199,7 @@ def cdpr_analysis(out: Path, a, runs: tuple) -> PartResult:
          f"{'-' if ez_pd is None else f'{1000 * np.abs(ez_pd).max():.1f}'} / {1000 * np.abs(ez).max():.1f}",
          f"~{PAPER['pd_z']:.0f} / < {PAPER['pdff_z']:.0f}"],
         ["diagnose, Model I + dynamometers: first effect", d1["ranking"][0]["effect"], "pulleys (sec. V-A)"],
-        ["diagnose, motor torques: first effect", d2["ranking"][0]["effect"], "friction (eq. 15)"],
+        ["diagnose, motor torques: first effect", d2.ranking[0].effect, "friction (eq. 15)"],
     ]
     page = cdpr_page(out, pdff, pd, rows, rep["index"])
     return PartResult(rows=rows, bags=[b for b in (pdff, pd) if b is not None], report=rep["index"],

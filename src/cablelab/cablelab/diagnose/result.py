@@ -1,0 +1,115 @@
+"""The typed result of a diagnosis (``cablelab diagnose``, CONTRACT section 5).
+
+:class:`Diagnosis` holds the baseline, the ranked :class:`Candidate` list and, in greedy mode, the
+waterfall :class:`Step` list. ``to_json()`` is the contract JSON (``plant``, ``baseline``,
+``ranking`` with ``effect``, ``error_before``, ``error_after``, ``params``, ``significant`` and the
+documented extras); ``lines()`` the text the command prints. Built once from the ranking rows of
+:mod:`cablelab.diagnose.ranking`; every consumer (command, report, fleet) reads this object.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+#: keys of a ranking row that are part of the JSON, in order (contract keys first)
+ROW_KEYS = ("effect", "error_before", "error_after", "params", "significant", "stderr", "units",
+            "p_value", "delta_bic", "n_eff", "gain", "evidence", "explanation")
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """One ranked candidate effect: held-out errors before/after, its own fitted parameters
+    (name -> value, with ``stderr`` and ``units``), significance and the one-line explanation;
+    ``extra`` holds any further documented fields the ranking reports (JSON order kept)."""
+
+    effect: str
+    error_before: float | None
+    error_after: float | None
+    params: dict
+    significant: bool
+    explanation: str | None = None
+    extra: dict = field(default_factory=dict)
+
+    @classmethod
+    def from_row(cls, row: dict) -> "Candidate":
+        """From a ranking row (:func:`cablelab.diagnose.ranking.rank_candidates`)."""
+        return cls(effect=row["effect"], error_before=row.get("error_before"),
+                   error_after=row.get("error_after"), params=row.get("params") or {},
+                   significant=bool(row.get("significant")), explanation=row.get("explanation"),
+                   extra={k: row[k] for k in ROW_KEYS[5:-1] if k in row})
+
+    def to_json(self) -> dict:
+        base = {"effect": self.effect, "error_before": self.error_before,
+                "error_after": self.error_after, "params": self.params,
+                "significant": self.significant, **self.extra, "explanation": self.explanation}
+        return {k: base[k] for k in ROW_KEYS if k in base and base[k] is not None
+                or k in ("error_after", "error_before")}
+
+
+@dataclass(frozen=True)
+class Step:
+    """One step of the greedy waterfall: the model's effects, the one added (None first), its
+    held-out error, identified parameters and the ranking of the remaining candidates."""
+
+    effects: list
+    added: str | None
+    error: float
+    params: dict
+    stderr: dict
+    units: dict
+    ranking: list
+
+    def to_json(self) -> dict:
+        return {"effects": self.effects, "added": self.added, "error": self.error,
+                "params": self.params, "stderr": self.stderr, "units": self.units,
+                "ranking": [c.to_json() for c in self.ranking]}
+
+
+@dataclass(frozen=True)
+class Diagnosis:
+    """What ``cablelab diagnose`` found (see module docstring)."""
+
+    plant: str
+    baseline_effects: list
+    baseline_error: float
+    ranking: list
+    folds: int
+    greedy: list = field(default_factory=list)
+
+    @property
+    def final(self) -> Step | None:
+        """The last waterfall step (greedy mode), else None."""
+        return self.greedy[-1] if self.greedy else None
+
+    def to_json(self) -> dict:
+        out = {"plant": self.plant,
+               "baseline": {"effects": self.baseline_effects, "error": self.baseline_error},
+               "ranking": [c.to_json() for c in self.ranking], "folds": self.folds}
+        if self.greedy:
+            out["greedy"] = [s.to_json() for s in self.greedy]
+            f = self.final
+            out["final"] = {"effects": f.effects, "error": f.error, "params": f.params,
+                            "stderr": f.stderr}
+        return out
+
+    def lines(self) -> list[str]:
+        """The text report: baseline, ranking (``*`` = significant), waterfall, final values."""
+        out = [f"plant {self.plant}: model {' + '.join(self.baseline_effects)}, held-out NRMSE "
+               f"{100 * self.baseline_error:.2f} % ({self.folds} folds)"]
+        for i, c in enumerate(self.ranking, 1):
+            after = "-" if c.error_after is None else f"{100 * c.error_after:.2f} %"
+            mark = "*" if c.significant else " "
+            out.append(f" {mark}{i}. {c.effect:<26} -> {after:>9}  {c.explanation or ''}")
+        for s in self.greedy[1:]:
+            out.append(f"  + {s.added:<26} held-out NRMSE {100 * s.error:.2f} %")
+        if self.final is not None:
+            out.append("final: " + ", ".join(f"{k} = {v:.6g}" for k, v in self.final.params.items()))
+        return out
+
+
+def step_from_dict(s: dict) -> Step:
+    return Step(effects=list(s["effects"]), added=s["added"], error=s["error"], params=s["params"],
+                stderr=s["stderr"], units=s["units"],
+                ranking=[Candidate.from_row(r) for r in s["ranking"]])
+
+
+__all__ = ["Candidate", "Diagnosis", "Step", "step_from_dict"]
