@@ -90,6 +90,7 @@ def main() -> int:
         existing = d / "existing"
         existing.mkdir()
         cases = [
+            ("reference: the complete EMPS recording", ["compare", EMPS, "--json"]),
             ("3 s gap in the recording", ["compare", gap, "--json"]),
             ("header clock jumps back 0.5 s", ["compare", back]),
             ("header clock jumps ahead 2 s", ["compare", fwd, "--json"]),
@@ -118,7 +119,10 @@ def main() -> int:
             code, out, err = run(argv)
             if code == 0:
                 try:
-                    what = "; ".join(json.loads(out).get("warnings", [])) or "(no warning)"
+                    js = json.loads(out)
+                    what = "; ".join(js.get("warnings", [])) or "(no warning)"
+                    if "M" in js.get("params", {}):
+                        what += f" -> M = {js['params']['M']['value']:.2f} kg from {js['samples']} samples"
                 except ValueError:
                     what = out.strip().splitlines()[0] if out.strip() else ""
             else:
