@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from conftest import EMPS
+from robust_helpers import EMPS
 
 
 @pytest.mark.parametrize("argv, words", [

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 import yaml
 
-from conftest import CDPR, EMPS, axis_bag, copy_bag, tree_snapshot
+from robust_helpers import CDPR, EMPS, axis_bag, copy_bag, tree_snapshot
 
 
 def _json(res):

@@ -12,7 +12,7 @@ import time
 
 import pytest
 
-from conftest import CDPR, EMPS, REPO, tree_snapshot
+from robust_helpers import CDPR, EMPS, REPO, tree_snapshot
 
 IMPORT_DESC = "{plant: axis, axis: {joint_type: prismatic}}"
 

@@ -8,7 +8,7 @@ import sys
 
 import numpy as np
 
-from conftest import tree_snapshot
+from robust_helpers import tree_snapshot
 
 
 def test_sigkilled_recording_is_repaired(launcher, tmp_path, cli):
