@@ -144,3 +144,25 @@ def test_crane_joint_names_must_match(cli, tmp_path):
     bag = copy_bag(src.path, tmp_path / "crane", skip={"/crane/joint_states"}, edit=edit)
     res = cli("compare", bag, "--json")
     assert res.code == 2 and len(res.err_lines) == 1 and "missing hoist" in res.err, res.err
+
+
+def test_cdpr_estimate_excludes_samples_inside_a_pose_gap(cli, tmp_path):
+    """2 s of /cdpr/reference missing: the tensions are still there, but the per-sample mass in
+    the gap would rest on an interpolated pose; it is reported and not counted."""
+    def edit(bag, w):
+        ref_t, raws = bag.raw("/cdpr/reference")
+        t = ref_t * 1e-9
+        cut = (t > 20.0) & (t < 22.0)
+        w.add_topic("/cdpr/reference", bag.topics["/cdpr/reference"])
+        for tn, r, c in zip(ref_t.tolist(), raws, cut):
+            if not c:
+                w.write_raw("/cdpr/reference", tn, r)
+    bag = copy_bag(CDPR, tmp_path / "refgap", skip={"/cdpr/reference"}, edit=edit)
+    full = _json(cli("estimate", CDPR, "--json"))
+    out = _json(cli("estimate", bag, "--json"))
+    assert any("/cdpr/reference: 1 recording gap" in w for w in out["warnings"]), out["warnings"]
+    t = np.asarray(__import__("cablelab.bags", fromlist=["open_bag"]).open_bag(CDPR)
+                   .joint_state("/cdpr/cable_tensions").t)
+    inside = int(((t > 20.0) & (t < 22.0)).sum())
+    assert inside > 0 and full["samples"] - inside - 2 <= out["samples"] <= full["samples"] - inside + 2
+    assert abs(out["mass"]["mean"] - full["mass"]["mean"]) < 0.01 * full["mass"]["mean"]

@@ -29,6 +29,21 @@ def add_arguments(p) -> None:
     add_json(p)
 
 
+def _without_gaps(res, check):
+    """Per-sample estimates (``res.t``, ``res.mass``) inside a gap of any input topic rest on
+    interpolated inputs: they become NaN, so the summary counts and averages only the samples
+    of the contiguous segments (the written ``--out`` bag keeps every sample)."""
+    import dataclasses
+
+    import numpy as np
+
+    if check is None or not check.gaps or not dataclasses.is_dataclass(res) \
+            or not hasattr(res, "t") or not hasattr(res, "mass"):
+        return res
+    keep = check.mask(np.asarray(res.t, dtype=float), 0.0)
+    return dataclasses.replace(res, mass=np.where(keep, res.mass, np.nan))
+
+
 def run(args) -> int:
     import contextlib
 
@@ -48,7 +63,8 @@ def run(args) -> int:
     except CablelabError:
         plant = None
     if plant is not None:
-        args.warnings = check_bag(bag, plant, desc, {"tensions": args.tensions}).warnings
+        args.check = check_bag(bag, plant, desc, {"tensions": args.tensions})
+        args.warnings = args.check.warnings
     try:
         mod = importlib.import_module(f"cablelab.plants.{desc.plant}")
     except ModuleNotFoundError:
@@ -67,6 +83,7 @@ def run(args) -> int:
         if tmp is not None:
             kwargs["out"] = str(tmp)
         res = fn(bag, desc, **kwargs)
+    res = _without_gaps(res, getattr(args, "check", None))
     out = with_warnings(args, res.summary() if hasattr(res, "summary") else dict(res))
     if args.json:
         print(dump_json(out))
