@@ -4,13 +4,14 @@ that does not match the bag are one-line errors, NaN samples and negative tensio
 in the text and the JSON. Oracle: the fit of the complete EMPS recording (001-style real data)."""
 from __future__ import annotations
 
+import html
 import json
 
 import numpy as np
 import pytest
 import yaml
 
-from conftest import CDPR, EMPS, axis_bag, copy_bag, tree_snapshot
+from robust_helpers import CDPR, EMPS, axis_bag, copy_bag, tree_snapshot
 
 
 def _json(res):
@@ -144,3 +145,34 @@ def test_crane_joint_names_must_match(cli, tmp_path):
     bag = copy_bag(src.path, tmp_path / "crane", skip={"/crane/joint_states"}, edit=edit)
     res = cli("compare", bag, "--json")
     assert res.code == 2 and len(res.err_lines) == 1 and "missing hoist" in res.err, res.err
+
+
+def test_cdpr_estimate_excludes_samples_inside_a_pose_gap(cli, tmp_path):
+    """2 s of /cdpr/reference missing: the tensions are still there, but the per-sample mass in
+    the gap would rest on an interpolated pose; it is reported and not counted."""
+    def edit(bag, w):
+        ref_t, raws = bag.raw("/cdpr/reference")
+        t = ref_t * 1e-9
+        cut = (t > 20.0) & (t < 22.0)
+        w.add_topic("/cdpr/reference", bag.topics["/cdpr/reference"])
+        for tn, r, c in zip(ref_t.tolist(), raws, cut):
+            if not c:
+                w.write_raw("/cdpr/reference", tn, r)
+    bag = copy_bag(CDPR, tmp_path / "refgap", skip={"/cdpr/reference"}, edit=edit)
+    full = _json(cli("estimate", CDPR, "--json"))
+    out = _json(cli("estimate", bag, "--json"))
+    assert any("/cdpr/reference: 1 recording gap" in w for w in out["warnings"]), out["warnings"]
+    t = np.asarray(__import__("cablelab.bags", fromlist=["open_bag"]).open_bag(CDPR)
+                   .joint_state("/cdpr/cable_tensions").t)
+    inside = int(((t > 20.0) & (t < 22.0)).sum())
+    assert inside > 0 and full["samples"] - inside - 2 <= out["samples"] <= full["samples"] - inside + 2
+    assert abs(out["mass"]["mean"] - full["mass"]["mean"]) < 0.01 * full["mass"]["mean"]
+
+
+def test_report_page_shows_the_input_warnings(cli, tmp_path):
+    """The HTML report carries the same warning lines as the JSON (a gap here)."""
+    bag = axis_bag(tmp_path / "gap", keep=lambda t: ~((t > 12.0) & (t < 15.0)))
+    out = _json(cli("report", bag, "-o", tmp_path / "rep", "--json", "--folds", "3"))
+    page = (tmp_path / "rep" / "index.html").read_text()
+    assert out["warnings"] and "Input warnings" in page
+    assert all(html.escape(w) in page for w in out["warnings"])

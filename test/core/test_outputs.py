@@ -12,7 +12,7 @@ import time
 
 import pytest
 
-from conftest import CDPR, EMPS, REPO, tree_snapshot
+from robust_helpers import CDPR, EMPS, REPO, tree_snapshot
 
 IMPORT_DESC = "{plant: axis, axis: {joint_type: prismatic}}"
 
@@ -174,3 +174,20 @@ def test_import_empty_cells_are_counted(cli, tmp_path):
     out = json.loads(res.out)
     assert out["warnings"] == [f"{tmp_path / 'a.csv'}: 1 of 400 samples have no finite position value "
                                f"(missing cells)"]
+
+
+def test_import_refuses_ms_time_column_and_reports_gaps(cli, tmp_path):
+    rows = 400
+    ms = tmp_path / "ms.csv"
+    ms.write_text("t,q,f\n" + "\n".join(f"{i},{0.01 * i},{i % 5}" for i in range(rows)) + "\n")
+    res = _import(cli, ms, tmp_path / "out")
+    _one_line_error(res, "milliseconds", "--map time=0.001*")
+    assert not (tmp_path / "out").exists()
+    gap = tmp_path / "gap.csv"
+    t = [0.001 * i for i in range(rows)]
+    t = t[:200] + [x + 1.0 for x in t[200:]]
+    gap.write_text("t,q,f\n" + "\n".join(f"{x:.3f},{0.01 * i},{i % 5}" for i, x in enumerate(t)) + "\n")
+    res = _import(cli, gap, tmp_path / "out2", "--json")
+    assert res.code == 0, res.err
+    w = json.loads(res.out)["warnings"]
+    assert len(w) == 1 and "1 recording gap" in w[0] and "1 s" in w[0], w

@@ -8,7 +8,7 @@ import sys
 
 import numpy as np
 
-from conftest import tree_snapshot
+from robust_helpers import tree_snapshot
 
 
 def test_sigkilled_recording_is_repaired(launcher, tmp_path, cli):
@@ -79,3 +79,23 @@ def test_sigkilled_recording_is_repaired(launcher, tmp_path, cli):
     info2 = json.loads(res2.out)
     assert info2["topics"] == out["topics"] and info2["messages"] == out["messages"]
     assert not info2.get("recovered")
+
+
+def test_recorder_on_a_full_disk_stops_with_one_line(launcher, tiny_fs, tmp_path, cli):
+    """A 96 KiB file system fills up while recording: the recorder exits 2 with one line naming
+    the bag and the cause (no traceback), and what it flushed before is repairable."""
+    bag_dir = tiny_fs / "bag"
+    rec = launcher.start("recorder", [sys.executable, "-m", "cablelab.cli", "record", "--plant", "axis",
+                                      "-o", str(bag_dir), "--quiet", "--flush-period", "0.1"])
+    launcher.wait_for_subscribers(["/axis/joint_states", "/clock"], timeout=120,
+                                  node_name="cablelab_recorder")
+    launcher.node("sim", "cable_sim_node", "axis", {"rate": 1000.0})
+    code = rec.wait(180)
+    log = rec.log()
+    assert code == 2, log
+    lines = [ln for ln in log.splitlines() if ln.strip()]
+    assert "Traceback" not in log and len(lines) == 1, log
+    assert "no space left on device" in lines[0] and str(bag_dir) in lines[0] and "--recover" in lines[0]
+    res = cli("repair", bag_dir, "-o", tmp_path / "rescued", "--json")
+    assert res.code == 0, res.err
+    assert json.loads(res.out)["topics"].get("/axis/joint_states", 0) > 0

@@ -60,11 +60,15 @@ def check_bag(bag, plant, desc, options: dict | None = None, limits: Limits = Li
     """Check the topics ``plant`` reads from ``bag`` against ``desc``.
 
     Raises:
-        CablelabError: stamps going back in time; joint or cable names that do not match the
-            description (one line naming the bag, topic and both counts).
+        CablelabError: no section for the plant in the description; stamps going back in time;
+            joint or cable names that do not match the description (one line naming the bag,
+            topic and both counts).
     """
     options = options or {}
     out = BagCheck()
+    if getattr(desc, plant.name, "absent") is None:     # e.g. "axis: null" parses to no section
+        raise CablelabError(f"{bag.path}: plant description for plant {plant.name} has no '{plant.name}' "
+                            f"section (key {plant.name}: is missing or empty)")
     if getattr(bag, "recovered", False):
         out.warnings.append(f"{bag.path}: unfinished bag (recorder killed?), read up to its last "
                             f"complete chunk")

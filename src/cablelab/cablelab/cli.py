@@ -30,14 +30,22 @@ VERBS = {
 }
 
 
+class OneLineParser(argparse.ArgumentParser):
+    """Usage errors as one line naming the option (CONTRACT: one line, exit 2), with a pointer
+    to ``--help`` instead of the multi-line usage block."""
+
+    def error(self, message):
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = OneLineParser(
         prog="cablelab",
         description="Compare cable-robot and crane models with measurements, find the missing "
         "physical effect, add it and watch the error fall. Every verb reads a rosbag2 directory "
         "(or its .mcap file) and the /plant_description in it unless --description is given.",
     )
-    sub = parser.add_subparsers(dest="verb", metavar="VERB")
+    sub = parser.add_subparsers(dest="verb", metavar="VERB", parser_class=OneLineParser)
     for verb, module in VERBS.items():
         try:
             mod = importlib.import_module(f"cablelab.commands.{module}")
@@ -60,7 +68,8 @@ def main(argv: list[str] | None = None) -> int:
     try:
         return int(args._run(args) or 0)
     except CablelabError as exc:
-        print(f"cablelab {args.verb}: error: {exc}", file=sys.stderr)
+        line = " ".join(str(exc).split())   # one line, whatever the message's source wrapped
+        print(f"cablelab {args.verb}: error: {line}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print(f"cablelab {args.verb}: interrupted", file=sys.stderr)

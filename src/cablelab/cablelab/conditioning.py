@@ -99,7 +99,8 @@ def lowpass(x: np.ndarray, fs: float, cutoff_hz: float, order: int = 4) -> np.nd
     """
     x = np.asarray(x, dtype=float)
     if not 0 < cutoff_hz < fs / 2:
-        raise CablelabError(f"filter cut-off {cutoff_hz:g} Hz must be between 0 and fs/2 = {fs / 2:g} Hz")
+        raise CablelabError(f"filter cut-off {cutoff_hz:g} Hz (--cutoff) must be between 0 and fs/2 = "
+                            f"{fs / 2:g} Hz")
     sos = scipy.signal.butter(order, cutoff_hz, fs=fs, output="sos")
     padlen = min(x.shape[0] - 1, 3 * (2 * len(sos) + 1) * 3)
     return scipy.signal.sosfiltfilt(sos, x, axis=0, padlen=padlen)

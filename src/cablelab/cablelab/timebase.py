@@ -15,7 +15,8 @@ Definitions (``dt`` = successive header-stamp differences in log order, ``T`` = 
 * duplicate: ``dt == 0`` -> warning (the repeated sample is dropped by the plant loaders);
 * gap: ``dt > gap_factor * T`` -> warning, segments split there. A gap is a *clock jump* when
   the log (receive) time did not advance with the header stamp (``dt_log < dt / 2``), else a
-  *recording gap*;
+  *recording gap*; a run of NaN/inf samples spanning more than ``gap_factor * T`` is a *NaN run*
+  gap (short runs are bridged by the conditioning's interpolation);
 * irregular rate: ``rate_factor * T < dt <= gap_factor * T`` or ``dt < T / rate_factor``;
 * milliseconds: header span ~1000x the log span, or ``T >= 0.5`` s with integer stamps -> error.
 """
@@ -90,7 +91,7 @@ class TimebaseReport:
         if self.gaps:
             longest = max(self.gaps, key=lambda g: g.duration)
             kinds = sorted({g.kind for g in self.gaps})
-            out.append(f"{self.topic}: {len(self.gaps)} {' / '.join(kinds)}(s) in the stamps, longest "
+            out.append(f"{self.topic}: {len(self.gaps)} {' / '.join(kinds)}(s) in the record, longest "
                        f"{longest.duration:.3g} s at t = {longest.start:.6g} s; fitting {len(self.segments)} "
                        f"contiguous segments, samples across the gaps are not used")
         if self.duplicates:
@@ -100,7 +101,7 @@ class TimebaseReport:
                        f"differ from the median {self.period:.3g} s by more than a factor 2")
         if self.nan_rows:
             out.append(f"{self.topic}: {self.nan_rows} of {self.samples} samples have NaN/inf values "
-                       f"(dropped)")
+                       f"(not used; runs longer than a gap split the record)")
         return out
 
     def as_dict(self) -> dict:
@@ -129,10 +130,12 @@ def check_stamps(t, t_log=None, *, topic: str = "data", values=None,
     t = np.asarray(t, dtype=float).reshape(-1)
     ok = np.isfinite(t)
     nan_rows = int((~ok).sum())
+    good = ok.copy()                  # rows usable as measurements (finite stamp and values)
     if values is not None:
         v = np.asarray(values, dtype=float).reshape(t.size, -1)
         bad_v = ~np.all(np.isfinite(v), axis=1) & ok
         nan_rows += int(bad_v.sum())
+        good &= ~bad_v
     rep = TimebaseReport(topic=topic, samples=int(t.size), nan_rows=nan_rows)
     idx = np.flatnonzero(ok)
     ts = t[idx]
@@ -169,7 +172,20 @@ def check_stamps(t, t_log=None, *, topic: str = "data", values=None,
     kinds = np.full(gi.size, "recording gap", dtype=object)
     if dl is not None and gi.size:
         kinds[dl[gi] < 0.5 * dt[gi]] = "clock jump"
-    rep.gaps = [Gap(int(idx[i + 1]), float(ts[i]), float(ts[i + 1]), str(k)) for i, k in zip(gi, kinds)]
+    gaps = [Gap(int(idx[i + 1]), float(ts[i]), float(ts[i + 1]), str(k)) for i, k in zip(gi, kinds)]
+    # a run of NaN/inf samples longer than a gap is a gap too (never interpolated across)
+    gidx = np.flatnonzero(good)
+    if gidx.size >= 2 and gidx.size < idx.size:
+        tg = t[gidx]
+        dg = np.diff(tg)
+        nan_gap = np.flatnonzero((dg > limits.gap_factor * T) & (np.diff(gidx) > 1))
+        pa, pb = np.searchsorted(idx, gidx[nan_gap]), np.searchsorted(idx, gidx[nan_gap + 1])
+        cum = np.concatenate([[0], np.cumsum(big)])          # stamp gaps between positions pa..pb
+        only_nan = cum[pb] - cum[pa] == 0
+        gaps += [Gap(int(gidx[i + 1]), float(tg[i]), float(tg[i + 1]), "NaN run")
+                 for i in nan_gap[only_nan]]
+        gaps.sort(key=lambda g: g.index)
+    rep.gaps = gaps
     cuts = [0] + [g.index for g in rep.gaps] + [int(t.size)]
     rep.segments = [(a, b) for a, b in zip(cuts[:-1], cuts[1:]) if b > a]
     return rep

@@ -367,6 +367,9 @@ def open_bag(path, *, recover: bool = False) -> Bag:
     if mcap_file is not None and (not mcap_file.exists() or mcap_file.stat().st_size == 0):
         raise _bag_error(mcap_file, "empty MCAP file")
     if mcap_file is not None and _mcap_truncated(mcap_file):
+        with open(mcap_file, "rb") as fh:
+            if fh.read(8) != b"\x89MCAP0\r\n":
+                raise _bag_error(mcap_file, "not an MCAP file (bad magic bytes)")
         if not recover:
             raise _bag_error(mcap_file, "truncated MCAP file (writer killed before closing?); "
                                         "read its complete part with --recover")

@@ -95,7 +95,13 @@ def load_from_args(args):
     baseline = None
     if args.baseline is not None:
         baseline = () if args.baseline.strip() in ("", "none") else parse_effect_list(args.baseline)
-    model = build_model(plant, desc, parse_effect_list(args.effects), baseline, parse_fixed(args.fix))
+    fixed = parse_fixed(args.fix)
+    for name, value in fixed.items():
+        if not math.isfinite(value):
+            from ..errors import CablelabError
+
+            raise CablelabError(f"--fix {name}={value}: the value must be a finite number")
+    model = build_model(plant, desc, parse_effect_list(args.effects), baseline, fixed)
     if not model.effects:
         from ..errors import CablelabError
 

@@ -28,6 +28,21 @@ def add_arguments(p) -> None:
     add_json(p)
 
 
+def _without_gaps(res, check):
+    """Per-sample estimates (``res.t``, ``res.mass``) inside a gap of any input topic rest on
+    interpolated inputs: they become NaN, so the summary counts and averages only the samples
+    of the contiguous segments (the written ``--out`` bag keeps every sample)."""
+    import dataclasses
+
+    import numpy as np
+
+    if check is None or not check.gaps or not dataclasses.is_dataclass(res) \
+            or not hasattr(res, "t") or not hasattr(res, "mass"):
+        return res
+    keep = check.mask(np.asarray(res.t, dtype=float), 0.0)
+    return dataclasses.replace(res, mass=np.where(keep, res.mass, np.nan))
+
+
 def run(args) -> int:
     import contextlib
 
@@ -43,7 +58,8 @@ def run(args) -> int:
     bag = open_bag(args.bag, recover=args.recover)
     desc = load_bag_description(args.bag, args.description, bag)
     plant = get_plant(desc.plant)
-    args.warnings = check_bag(bag, plant, desc, {"tensions": args.tensions}).warnings
+    args.check = check_bag(bag, plant, desc, {"tensions": args.tensions})
+    args.warnings = args.check.warnings
     fn = plant.estimate
     if fn is None:
         able = [p for p in available_plants() if get_plant(p).estimate is not None]
@@ -60,6 +76,7 @@ def run(args) -> int:
         if tmp is not None:
             kwargs["out"] = str(tmp)
         res = fn(bag, desc, **kwargs)
+    res = _without_gaps(res, getattr(args, "check", None))
     out = with_warnings(args, res.summary() if hasattr(res, "summary") else dict(res))
     if args.json:
         print(dump_json(out))

@@ -194,6 +194,10 @@ def run(args) -> int:
     inputs = [args.file] + ([args.description] if os.path.exists(args.description) else [])
     check_target(args.out, overwrite=args.overwrite, inputs=inputs, option="-o")
     s = import_series(args.file, args.plant, args.map)
+    from ..timebase import check_stamps, raise_if_impossible
+
+    tb = check_stamps(s["t"], topic=f"{args.file}: time column")
+    raise_if_impossible(tb)                 # stamps in ms: refuse with the --map fix
     with atomic_output(args.out, overwrite=args.overwrite, inputs=inputs, option="-o") as tmp:
         with BagWriter(tmp) as w:
             w.write_description(desc.to_yaml(), t=float(s["t"][0]))
@@ -205,6 +209,7 @@ def run(args) -> int:
             nan[f] = int((~np.isfinite(mapped)).any(axis=1).sum())
     warnings = [f"{args.file}: {n} of {s['t'].size} samples have no finite {f} value (missing cells)"
                 for f, n in nan.items() if n]
+    warnings += tb.warnings()               # gaps, irregular rate
     info = {"bag": args.out, "plant": args.plant, "topic": s["topic"], "samples": int(s["t"].size),
             "duration": float(s["t"][-1] - s["t"][0]), "warnings": warnings}
     if not args.json:

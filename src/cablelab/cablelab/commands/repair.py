@@ -1,7 +1,7 @@
 """``cablelab repair BAG [-o OUT]``: rewrite a killed recording as a complete bag."""
 from __future__ import annotations
 
-from ._workbench_args import add_json, add_overwrite, dump_json
+from ._workbench_args import add_json, add_overwrite, add_recover, dump_json
 
 HELP = "rewrite an unfinished recording (recorder killed) as a complete bag (metadata, index)"
 
@@ -11,6 +11,7 @@ def add_arguments(p) -> None:
     p.add_argument("-o", "--out", metavar="BAG2", default=None,
                    help="bag directory to write (default: BAG_repaired next to BAG)")
     add_overwrite(p)
+    add_recover(p)   # accepted for uniformity: repair always reads up to the last complete chunk
     add_json(p)
 
 

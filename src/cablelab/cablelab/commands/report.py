@@ -35,7 +35,8 @@ def run(args) -> int:
     plant, desc, ds, model = load_from_args(args)
     with atomic_output(args.out, overwrite=args.overwrite, inputs=inputs, option="-o") as tmp:
         res = build_report(ds, model, plant.candidates(desc), str(tmp), folds=args.folds,
-                           title=f"cablelab report: {desc.name or plant.name}", quiet=args.json)
+                           title=f"cablelab report: {desc.name or plant.name}", quiet=args.json,
+                           warnings=getattr(args, "warnings", ()))
     res["index"] = _moved(res["index"], tmp, args.out)
     res["figures"] = [_moved(f, tmp, args.out) for f in res["figures"]]
     out = with_warnings(args, {"index": res["index"], "figures": res["figures"], "seconds": res["seconds"],

@@ -34,13 +34,15 @@ def _num(v, fmt="{:.5g}") -> str:
 
 CSS = ("body{font-family:sans-serif;max-width:1100px;margin:auto;padding:1em}"
        "table{border-collapse:collapse;margin:0.5em 0}td,th{border:1px solid #ccc;padding:3px 8px;"
-       "font-size:90%;text-align:left}th{background:#eee}img{max-width:100%}.sig{color:#060;font-weight:bold}")
+       "font-size:90%;text-align:left}th{background:#eee}img{max-width:100%}.sig{color:#060;font-weight:bold}"
+       ".warnings{background:#fff4e0;border:1px solid #e0a040;padding:0.3em 1em}")
 
 
 @blas_single
 def build_report(ds: Dataset, model: Model, candidates, out_dir, *, folds: int = 5,
-                 title: str = "", quiet: bool = True) -> dict:
-    """Analyse and write ``out_dir/index.html`` + PNGs.
+                 title: str = "", quiet: bool = True, warnings=()) -> dict:
+    """Analyse and write ``out_dir/index.html`` + PNGs; ``warnings`` (the input checks' lines,
+    :func:`cablelab.bagcheck.check_bag`) are shown at the top of the page.
 
     Returns:
         ``{"index": path, "figures": [...], "steps": greedy steps, "seconds": elapsed}``.
@@ -84,6 +86,9 @@ def build_report(ds: Dataset, model: Model, candidates, out_dir, *, folds: int =
     parts = [f"<h1>{html.escape(title or 'cablelab report')}</h1>",
              f"<p>plant <b>{ds.plant}</b>, {ds.n} samples at {ds.fs:.4g} Hz from "
              f"{html.escape(ds.source)}; held-out errors by blocked {folds}-fold cross-validation.</p>"]
+    if warnings:
+        parts.append("<div class='warnings'><b>Input warnings</b><ul>"
+                     + "".join(f"<li>{html.escape(w)}</li>" for w in warnings) + "</ul></div>")
     parts.append("<h2>Adding the missing effects</h2><img src='waterfall.png'>")
     rows = [[i, html.escape(s["added"] or "nominal: " + " + ".join(s["effects"])),
              _num(100 * s["error"], "{:.2f} %"),

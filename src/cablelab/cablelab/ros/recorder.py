@@ -46,6 +46,7 @@ class RecorderNode(Node):
         self.t_start = time.monotonic()
         self.done = False
         self.closed = False
+        self.failed: str | None = None
         for topic, msgtype in self.wanted.items():
             if msgtype:
                 self._subscribe(topic, msgtype)
@@ -69,10 +70,13 @@ class RecorderNode(Node):
         registered = self.registered
 
         def callback(data: bytes) -> None:
-            if topic not in registered:
-                self.writer.add_topic(topic, msgtype, transient_local=topic == "/plant_description")
-                registered.add(topic)
-            write(topic, time.time_ns(), data)
+            try:
+                if topic not in registered:
+                    self.writer.add_topic(topic, msgtype, transient_local=topic == "/plant_description")
+                    registered.add(topic)
+                write(topic, time.time_ns(), data)
+            except OSError as exc:
+                self._write_failed(exc)
             counts[topic] += 1
 
         self.subs[topic] = self.create_subscription(cls, topic, callback,
@@ -129,8 +133,22 @@ class RecorderNode(Node):
                 break
 
     def _flush(self) -> None:
-        if not self.closed:
-            self.writer.flush()
+        if not self.closed and self.failed is None:
+            try:
+                self.writer.flush()
+            except OSError as exc:
+                self._write_failed(exc)
+
+    def _write_failed(self, exc: OSError) -> None:
+        """Disk full / read-only / I/O error while recording: stop with one line (the run loop
+        prints it, exit 2); the chunks flushed so far stay readable (--recover, cablelab repair)."""
+        from ..atomic import os_error_message
+
+        self.failed = os_error_message(self.writer.path, exc).replace(
+            "; nothing was written", "; the part flushed before is kept: read it with --recover or "
+                                     "rewrite it with cablelab repair")
+        self.closed = True          # no footer can be written: leave the flushed chunks as they are
+        raise CablelabError(self.failed)
 
     def _check_duration(self) -> None:
         if time.monotonic() - self.t_start >= self.duration:

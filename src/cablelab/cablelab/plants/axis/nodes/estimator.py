@@ -54,8 +54,9 @@ class AxisEstimator(PlantNode):
 
     def on_state(self, msg: JointState) -> None:
         t, _names, q, qd, eff = convert.joint_state_arrays(msg)
-        both = np.concatenate([q if q is not None else [], eff if eff is not None else []])
-        if not self.inputs.accept("joint_states", both, time.monotonic()):  # position + effort
+        one = q is not None and eff is not None and q.size == 1 and eff.size == 1
+        both = np.concatenate([q, eff]) if one else None     # one position and one effort
+        if not self.inputs.accept("joint_states", both, time.monotonic()):
             return
         if qd is None or qd.size != 1:
             qd = np.array([np.nan])

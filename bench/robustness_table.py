@@ -1,0 +1,140 @@
+"""Run the hostile cases of issue 14 through ``cablelab.cli.main`` (in-process) and print the
+markdown table of docs/robustness.md: case, command, exit status, the one stderr line or the
+warnings (nothing here is written by hand).
+
+    ./run python bench/robustness_table.py
+"""
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+import shutil
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+REPO = Path(__file__).resolve().parent.parent
+EMPS, CDPR = REPO / "bags" / "emps", REPO / "bags" / "cdpr_m1_reference"
+DESC = "{plant: axis, axis: {joint_type: prismatic}}"
+
+
+def run(argv):
+    from cablelab.cli import main
+
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        try:
+            code = main([str(a) for a in argv])
+        except SystemExit as exc:
+            code = exc.code
+    return code, out.getvalue(), err.getvalue()
+
+
+def axis_bag(dst, stamps=None, keep=None, log=None, effort=None):  # log: header stamps != log times
+    from cablelab.bags import BagWriter, open_bag
+
+    bag = open_bag(EMPS)
+    js = bag.joint_state("/axis/joint_states")
+    t = js.t.copy() if stamps is None else stamps(js.t.copy())
+    k = np.ones(t.size, bool) if keep is None else keep(js.t)
+    eff = js.effort if effort is None else effort(js.effort.copy())
+    kw = {} if log is None else {"log_time": js.t[k]}
+    with BagWriter(dst) as w:
+        w.write_description(bag.description_yaml, t=float(t[k].min()))
+        w.write_joint_states("/axis/joint_states", t[k], js.names, js.position[k], js.velocity[k], eff[k], **kw)
+    return dst
+
+
+def main() -> int:
+    d = Path(tempfile.mkdtemp(prefix="cablelab-robust-"))
+    try:
+        rows = []
+        mid = 12.42
+
+        def sh(t, dt):
+            t[t > mid] += dt
+            return t
+
+        def rev(t):
+            i = np.searchsorted(t, mid)
+            t[i:i + 100] = t[i:i + 100][::-1].copy()
+            return t
+
+        def nan(e):
+            e[1000:1037] = np.nan
+            return e
+
+        gap = axis_bag(d / "gap", keep=lambda t: ~((t > mid) & (t < mid + 3)))
+        back = axis_bag(d / "jump_back", stamps=lambda t: sh(t, -0.5), log=True)
+        fwd = axis_bag(d / "jump_fwd", stamps=lambda t: sh(t, 2.0), log=True)
+        revb = axis_bag(d / "reversed", stamps=rev, log=True)
+        ms = axis_bag(d / "ms", stamps=lambda t: 1000 * t, log=True)
+        nanb = axis_bag(d / "nan", effort=nan)
+        from cablelab.bags import open_bag
+
+        doc = yaml.safe_load(open_bag(CDPR).description_yaml)
+        doc["cdpr"]["cables"] = doc["cdpr"]["cables"][:5]
+        five = d / "cdpr5.yaml"
+        five.write_text(yaml.safe_dump(doc))
+        csv = d / "text.csv"
+        csv.write_text("t,q,f\n" + "\n".join(f"{0.001 * i:.3f},{'abc' if i == 16 else i},{i}" for i in range(300)))
+        trunc = d / "killed"
+        shutil.copytree(CDPR, trunc)
+        (trunc / "metadata.yaml").unlink()
+        mc = trunc / "cdpr_m1_reference.mcap"
+        mc.write_bytes(mc.read_bytes()[: int(0.95 * mc.stat().st_size)])
+        existing = d / "existing"
+        existing.mkdir()
+        cases = [
+            ("reference: the complete EMPS recording", ["compare", EMPS, "--json"]),
+            ("3 s gap in the recording", ["compare", gap, "--json"]),
+            ("header clock jumps back 0.5 s", ["compare", back]),
+            ("header clock jumps ahead 2 s", ["compare", fwd, "--json"]),
+            ("100 stamps reversed", ["diagnose", revb]),
+            ("stamps in ms", ["identify", ms]),
+            ("37 NaN effort samples", ["compare", nanb, "--json"]),
+            ("5-cable description on an 8-cable bag", ["compare", CDPR, "--description", five]),
+            ("estimate --out = the input bag", ["estimate", CDPR, "--out", CDPR]),
+            ("estimate --out existing, no --overwrite", ["estimate", CDPR, "--out", existing]),
+            ("CSV with a text cell", ["import", csv, "--plant", "axis", "--map", "time=t,position=q,effort=f",
+                                      "--description", DESC, "-o", d / "imp"]),
+            ("--baseline none (no effects left)", ["compare", EMPS, "--baseline", "none"]),
+            ("diagnose --alpha 2", ["diagnose", EMPS, "--alpha", "2"]),
+            ("replay --rate nan", ["replay", EMPS, "--rate", "nan"]),
+            ("replay --topics /nope", ["replay", EMPS, "--topics", "/nope"]),
+            ("record --duration -1", ["record", "-o", d / "rec", "--plant", "axis", "--duration", "-1"]),
+            ("record into a missing directory", ["record", "-o", d / "no" / "rec", "--plant", "axis"]),
+            ("killed recording, no --recover", ["compare", trunc]),
+            ("killed recording, estimate --recover", ["estimate", trunc, "--recover", "--json"]),
+            ("repair the killed recording", ["repair", trunc, "-o", d / "repaired"]),
+            ("unknown option", ["compare", EMPS, "--frob"]),
+        ]
+        print("| case | command | exit | stderr line / warnings |")
+        print("|---|---|---|---|")
+        for name, argv in cases:
+            code, out, err = run(argv)
+            if code == 0:
+                try:
+                    js = json.loads(out)
+                    what = "; ".join(js.get("warnings", [])) or "(no warning)"
+                    if "M" in js.get("params", {}):
+                        what += f" -> M = {js['params']['M']['value']:.2f} kg from {js['samples']} samples"
+                except ValueError:
+                    what = out.strip().splitlines()[0] if out.strip() else ""
+            else:
+                what = err.strip()
+            what = what.replace(str(d) + "/", "").replace(str(REPO) + "/", "").replace("|", "\\|")
+            cmd = "cablelab " + " ".join(str(a).replace(str(d) + "/", "").replace(str(REPO) + "/", "")
+                                         for a in argv)
+            print(f"| {name} | `{cmd}` | {code} | {what} |")
+    finally:
+        shutil.rmtree(d, ignore_errors=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,47 @@
+"""The hostile options listed in issue 14, each a one-line error naming the option and value
+(exit 2, nothing on stdout), and the advice in messages names flags the verb really has."""
+from __future__ import annotations
+
+import pytest
+
+from robust_helpers import EMPS
+
+
+@pytest.mark.parametrize("argv, words", [
+    (["compare", EMPS, "--baseline", "none"], ["--baseline none", "--effects"]),
+    (["diagnose", EMPS, "--baseline", "none", "--json"], ["--baseline none"]),
+    (["diagnose", EMPS, "--alpha", "2"], ["--alpha 2.0", "between 0 and 1"]),
+    (["diagnose", EMPS, "--alpha", "nan"], ["--alpha nan"]),
+    (["diagnose", EMPS, "--min-gain", "-1"], ["--min-gain -1.0"]),
+    (["compare", EMPS, "--cutoff", "0"], ["--cutoff 0.0"]),
+    (["compare", EMPS, "--cutoff", "5000"], ["--cutoff", "fs/2"]),
+    (["compare", EMPS, "--decimate", "0"], ["--decimate 0"]),
+    (["identify", EMPS, "--folds", "1"], ["--folds 1"]),
+    (["compare", EMPS, "--segments", "0"], ["--segments 0"]),
+    (["compare", EMPS, "--fix", "M=nan"], ["--fix M=nan", "finite"]),
+    (["replay", EMPS, "--rate", "nan"], ["--rate nan"]),
+    (["replay", EMPS, "--rate", "-2"], ["--rate -2.0"]),
+    (["replay", EMPS, "--topics", "/nope"], ["--topics /nope", "/axis/joint_states"]),
+    (["replay", EMPS, "--start-delay", "inf"], ["--start-delay inf"]),
+    (["record", "-o", "x", "--plant", "axis", "--duration", "-1"], ["--duration -1.0"]),
+    (["record", "-o", "x", "--plant", "axis", "--flush-period", "0"], ["--flush-period 0.0"]),
+    (["compare", EMPS, "--frob"], ["unrecognized arguments: --frob", "cablelab --help"]),
+    (["compare"], ["cablelab compare: error: the following arguments are required: bag"]),
+])
+def test_bad_option_is_one_line(cli, tmp_path, monkeypatch, argv, words):
+    monkeypatch.chdir(tmp_path)
+    res = cli(*argv)
+    assert res.code == 2 and res.out == "", (res.code, res.out, res.err)
+    assert len(res.err_lines) == 1 and "Traceback" not in res.err, res.err
+    for w in words:
+        assert w in res.err, (w, res.err)
+    assert list(tmp_path.iterdir()) == []          # record wrote nothing
+
+
+@pytest.mark.parametrize("verb", ["estimate", "compare", "diagnose", "identify", "report", "replay", "info"])
+def test_every_bag_verb_has_the_flags_its_messages_advise(cli, verb):
+    text = cli(verb, "--help").out
+    for flag in ("--recover", "--description"):
+        if flag == "--description" and verb in ("replay", "info"):
+            continue
+        assert flag in text, (verb, flag)
