@@ -156,6 +156,10 @@ def condition_motion(t: np.ndarray, q: np.ndarray, effort: np.ndarray,
             raise CablelabError(f"{source}: {name} has no finite samples in some column")
     fs = 1.0 / float(np.median(np.diff(t)))
     cutoff = default_cutoff(fs, opts)
+    if opts.cutoff_hz is None:  # quantized encoder: lower the cut-off until qdd is not noise
+        from .velocity import quantization_aware_cutoff
+
+        cutoff = quantization_aware_cutoff(q, fs, cutoff, opts.order)
     rev = np.broadcast_to(np.asarray(revolute, dtype=bool), q.shape[1:] if q.ndim > 1 else ())
     if opts.unwrap and np.any(rev):
         q = np.where(rev, unwrap_angle(q), q)

@@ -40,7 +40,7 @@ def dataset_from_arrays(t, q, effort, description, options: dict | None = None, 
                          source=source)
     unit = "N m" if revolute else "N"
     qd_c = c["qd"].reshape(-1)
-    return Dataset(
+    ds = Dataset(
         plant="axis", t=c["t"], y=c["effort"].reshape(-1, 1), channels=("joint",), units=(unit,),
         signals={"q": c["q"].reshape(-1), "qd": qd_c, "qdd": c["qdd"].reshape(-1)},
         actuators=("joint",), act_vel=qd_c[:, None], act_units=((unit, "rad" if revolute else "m"),),
@@ -48,6 +48,11 @@ def dataset_from_arrays(t, q, effort, description, options: dict | None = None, 
         regimes={"position": _position_bins(c["q"].reshape(-1))},
         description=description, source=source,
     )
+    # drives that stop: the zero-speed zone is not fitted (cablelab.velocity, issue 10)
+    from ..velocity import exclude_zero_speed, position_quantum, speed_resolution
+
+    res = 0.0 if qd is not None else speed_resolution(position_quantum(q), c["cutoff_hz"])
+    return exclude_zero_speed(ds, floor=res)
 
 
 def _position_bins(q: np.ndarray, bins: int = 4) -> np.ndarray:

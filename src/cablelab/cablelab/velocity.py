@@ -1,0 +1,117 @@
+"""Velocities of drives that stop: the zero-speed zone and honest handling of rest samples.
+
+Real drives spend much of a recording at rest, and their friction passes smoothly through zero
+speed (a narrow tanh band, stiction while stopped). Near and at zero speed:
+
+* the measured effort is not a function of the motion: a stopped drive holds any effort inside
+  its stiction band (the controller's integral and position error decide it), and inside the
+  smooth band the friction is somewhere between -F_c and +F_c;
+* the sign of a low-pass-filtered, differentiated (quantized) encoder position is filter noise,
+  so a ``sign(qd)`` Coulomb column is wrong exactly there. With 40 % of the time at rest this
+  biases the fitted Coulomb level 30-45 % low and lets viscous friction absorb the rest
+  (issue 10, failure 1).
+
+The remedy here is to *exclude* those samples from every fit (the same samples for every
+candidate model, so scores stay comparable): a sample is in the zero-speed zone of an actuator
+when ``|v| < ZONE_FRACTION * p99(|v|)`` (the 99th-percentile speed of that actuator in the
+record) or below the speed resolution of the encoder (quantum x fs, one count per sample
+stretched over the filter's smoothing, :func:`speed_resolution`). Motion samples keep the sign
+model of 001 eq. 15 / the EMPS reference (the smooth band is much narrower than the zone).
+Documented in docs/workbench.md "Drives that stop".
+"""
+from __future__ import annotations
+
+import numpy as np
+
+#: zero-speed zone: |v| below this fraction of the actuator's 99th-percentile speed
+ZONE_FRACTION = 0.03
+#: a sample is also in the zone within this many filter time constants of a zone sample? (no:
+#: the zone is pointwise; the filter smear is far shorter than a move)
+
+
+def position_quantum(q: np.ndarray) -> float:
+    """Encoder resolution of a raw position record (N,): the most common smallest non-zero step
+    between consecutive samples (0 if the record is not quantized or not finite)."""
+    q = np.asarray(q, dtype=float).reshape(-1)
+    d = np.abs(np.diff(q[np.isfinite(q)]))
+    d = d[d > 0]
+    if d.size < 10:
+        return 0.0
+    small = np.quantile(d, 0.05)
+    # quantized: the 5 % smallest steps are (near) integer multiples of one count
+    ratio = d[d <= 3 * small] / small
+    return float(small) if np.all(np.abs(ratio - np.round(ratio)) < 0.05) else 0.0
+
+
+def speed_resolution(quantum: float, cutoff_hz: float) -> float:
+    """Speed resolution of a filtered, differentiated quantized position: one count over the
+    filter's time scale 1 / (2 pi f_c), in (unit of q)/s."""
+    return float(quantum) * 2.0 * np.pi * float(cutoff_hz) if quantum > 0 and cutoff_hz else 0.0
+
+
+def zero_speed_zone(act_vel: np.ndarray, floor: np.ndarray | float = 0.0,
+                    fraction: float = ZONE_FRACTION) -> np.ndarray:
+    """(n_act,) zone half-width per actuator: ``max(fraction * p99(|v|), floor)``."""
+    v = np.abs(np.asarray(act_vel, dtype=float))
+    v = v.reshape(v.shape[0], -1)
+    p99 = np.nanpercentile(v, 99, axis=0)
+    return np.maximum(fraction * p99, np.broadcast_to(np.asarray(floor, float), p99.shape))
+
+
+def moving_mask(act_vel: np.ndarray, zone: np.ndarray) -> np.ndarray:
+    """(N,) True where every actuator is outside its zero-speed zone."""
+    v = np.abs(np.asarray(act_vel, dtype=float)).reshape(len(act_vel), -1)
+    return np.all(v >= zone[None, :], axis=1)
+
+
+def exclude_zero_speed(ds, floor: np.ndarray | float = 0.0, fraction: float = ZONE_FRACTION):
+    """The dataset with samples in any actuator's zero-speed zone marked invalid (not fitted,
+    not scored); the zone and the excluded share are kept in ``ds.signals`` (``zero_speed_zone``,
+    ``rest_share``) for reports. Datasets without actuator velocities are returned unchanged."""
+    if ds.act_vel is None or ds.n < 3:
+        return ds
+    zone = zero_speed_zone(ds.act_vel, floor, fraction)
+    moving = moving_mask(ds.act_vel, zone)
+    return ds.replace(valid=ds.valid & moving,
+                      signals={**ds.signals, "zero_speed_zone": zone,
+                               "rest_share": float(1.0 - moving.mean())})
+
+
+#: quantization noise allowed in the filtered acceleration, as a fraction of its RMS
+QDD_NOISE_FRACTION = 0.02
+#: lowest cut-off the quantization-aware choice goes down to, Hz
+MIN_CUTOFF_HZ = 2.0
+
+
+def quantization_qdd_noise(quantum: float, fs: float, cutoff_hz: float) -> float:
+    """RMS of the acceleration noise that encoder quantization leaves after an ideal low-pass at
+    ``cutoff_hz`` and two differentiations: white quantization noise of variance quantum^2 / 12
+    over [0, fs/2], times |2 pi f|^4 integrated to f_c:
+    ``sigma = quantum / sqrt(12) (2 pi)^2 sqrt(2 f_c^5 / (5 fs))`` (unit of q / s^2)."""
+    return float(quantum / np.sqrt(12.0) * (2 * np.pi) ** 2 * np.sqrt(2.0 * cutoff_hz**5 / (5.0 * fs)))
+
+
+def quantization_aware_cutoff(q: np.ndarray, fs: float, default_hz: float, order: int = 4) -> float:
+    """Largest cut-off (``default_hz``, halved step by step down to :data:`MIN_CUTOFF_HZ`) at
+    which the quantization noise of the acceleration stays below
+    :data:`QDD_NOISE_FRACTION` of the acceleration RMS, for every column of the raw position
+    ``q`` (N,) or (N, k). Unquantized positions keep ``default_hz``."""
+    from .conditioning import lowpass
+
+    q = np.asarray(q, dtype=float).reshape(len(q), -1)
+    cut = float(default_hz)
+    for j in range(q.shape[1]):
+        col = q[:, j]
+        if not np.all(np.isfinite(col)):
+            continue
+        quantum = position_quantum(col)
+        if quantum <= 0:
+            continue
+        while cut > MIN_CUTOFF_HZ:
+            qf = lowpass(col, fs, cut, order)
+            qdd = np.gradient(np.gradient(qf, 1.0 / fs), 1.0 / fs)
+            rms = float(np.sqrt(np.mean(qdd**2)))
+            if quantization_qdd_noise(quantum, fs, cut) <= QDD_NOISE_FRACTION * rms:
+                break
+            cut = max(cut / 1.5, MIN_CUTOFF_HZ)
+    return cut
