@@ -137,7 +137,10 @@ def reference(case: Case, rng) -> callable:
         else:
             amp = case.vmax * rng.uniform(0.3, 1.0)
             f0, f1 = rng.uniform(0.2, 0.5), rng.uniform(1.0, 3.0)
+            if case.flavour == "pendulum" and abs(q) > 0.8:
+                amp = -amp if np.sign(amp) == np.sign(q) else amp
             segs.append((t, t + move_d, "chirp", (q, amp, f0, f1)))
+            q += float(_chirp_pos(np.array([move_d]), amp, f0, (f1 - f0) / move_d, move_d)[0])
         t += move_d + rest_d
 
     def r(tt):

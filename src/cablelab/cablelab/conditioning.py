@@ -166,7 +166,8 @@ def condition_motion(t: np.ndarray, q: np.ndarray, effort: np.ndarray,
     qf, qd_pos, qdd_pos = derivatives(q, fs, cutoff, opts.order)
     if qd is not None and np.all(np.isfinite(qd)):
         qd_f = lowpass(qd, fs, cutoff, opts.order)
-        qdd = np.gradient(qd_f, 1.0 / fs, axis=0)
+        # acceleration from the encoder (its noise is known, the velocity sensor's is not)
+        qdd = qdd_pos if opts.cutoff_hz is None else np.gradient(qd_f, 1.0 / fs, axis=0)
         qd_out = qd_f
     else:
         qd_out, qdd = qd_pos, qdd_pos

@@ -37,9 +37,12 @@ def position_quantum(q: np.ndarray) -> float:
     d = d[d > 0]
     if d.size < 10:
         return 0.0
-    small = np.quantile(d, 0.05)
-    # quantized: the 5 % smallest steps are (near) integer multiples of one count
-    ratio = d[d <= 3 * small] / small
+    d = d[d > 1e-9 * max(float(np.max(np.abs(q))), 1e-300)]  # float round-off is not a step
+    if d.size < 10:
+        return 0.0
+    small = float(np.min(d))
+    # quantized: the small steps are (near) integer multiples of one count
+    ratio = d[d <= 20 * small] / small
     return float(small) if np.all(np.abs(ratio - np.round(ratio)) < 0.05) else 0.0
 
 
@@ -78,7 +81,7 @@ def exclude_zero_speed(ds, floor: np.ndarray | float = 0.0, fraction: float = ZO
 
 
 #: quantization noise allowed in the filtered acceleration, as a fraction of its RMS
-QDD_NOISE_FRACTION = 0.02
+QDD_NOISE_FRACTION = 0.005
 #: lowest cut-off the quantization-aware choice goes down to, Hz
 MIN_CUTOFF_HZ = 2.0
 
@@ -92,7 +95,7 @@ def quantization_qdd_noise(quantum: float, fs: float, cutoff_hz: float) -> float
 
 
 def quantization_aware_cutoff(q: np.ndarray, fs: float, default_hz: float, order: int = 4) -> float:
-    """Largest cut-off (``default_hz``, halved step by step down to :data:`MIN_CUTOFF_HZ`) at
+    """Largest cut-off (``default_hz``, lowered step by step down to :data:`MIN_CUTOFF_HZ`) at
     which the quantization noise of the acceleration stays below
     :data:`QDD_NOISE_FRACTION` of the acceleration RMS, for every column of the raw position
     ``q`` (N,) or (N, k). Unquantized positions keep ``default_hz``."""
@@ -107,11 +110,10 @@ def quantization_aware_cutoff(q: np.ndarray, fs: float, default_hz: float, order
         quantum = position_quantum(col)
         if quantum <= 0:
             continue
-        while cut > MIN_CUTOFF_HZ:
-            qf = lowpass(col, fs, cut, order)
-            qdd = np.gradient(np.gradient(qf, 1.0 / fs), 1.0 / fs)
-            rms = float(np.sqrt(np.mean(qdd**2)))
-            if quantization_qdd_noise(quantum, fs, cut) <= QDD_NOISE_FRACTION * rms:
-                break
-            cut = max(cut / 1.5, MIN_CUTOFF_HZ)
+        # the acceleration's size, from a cut-off low enough that quantization cannot inflate it
+        low = max(MIN_CUTOFF_HZ, min(cut, fs / 200.0))
+        qdd = np.gradient(np.gradient(lowpass(col, fs, low, order), 1.0 / fs), 1.0 / fs)
+        rms = float(np.sqrt(np.mean(qdd**2)))
+        while cut > MIN_CUTOFF_HZ and quantization_qdd_noise(quantum, fs, cut) > QDD_NOISE_FRACTION * rms:
+            cut = max(cut / 1.25, MIN_CUTOFF_HZ)
     return cut
