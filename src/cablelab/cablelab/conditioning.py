@@ -145,6 +145,9 @@ def condition_motion(t: np.ndarray, q: np.ndarray, effort: np.ndarray,
     if n0 < need:
         raise CablelabError(f"{source}: only {n0} samples, need at least {need} "
                             f"(2 x border {opts.border} + 10)")
+    from .diagnose.checks import check_raw_series
+
+    check_raw_series(t, source, position=q, effort=effort)
     sig = [q, effort] + ([qd] if qd is not None else [])
     resampled = not is_uniform(t, opts.max_jitter)
     if resampled or any(not np.all(np.isfinite(s)) for s in sig):

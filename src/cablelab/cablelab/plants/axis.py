@@ -42,7 +42,8 @@ def dataset_from_arrays(t, q, effort, description, options: dict | None = None, 
     qd_c = c["qd"].reshape(-1)
     ds = Dataset(
         plant="axis", t=c["t"], y=c["effort"].reshape(-1, 1), channels=("joint",), units=(unit,),
-        signals={"q": c["q"].reshape(-1), "qd": qd_c, "qdd": c["qdd"].reshape(-1)},
+        signals={"q": c["q"].reshape(-1), "qd": qd_c, "qdd": c["qdd"].reshape(-1),
+                 "cutoff_hz": c["cutoff_hz"]},
         actuators=("joint",), act_vel=qd_c[:, None], act_units=((unit, "rad" if revolute else "m"),),
         inputs={"velocity": qd_c, "acceleration": c["qdd"].reshape(-1)},
         regimes={"position": _position_bins(c["q"].reshape(-1))},
