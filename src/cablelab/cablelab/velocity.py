@@ -41,9 +41,14 @@ def position_quantum(q: np.ndarray) -> float:
     if d.size < 10:
         return 0.0
     small = float(np.min(d))
-    # quantized: the small steps are (near) integer multiples of one count
+    # quantized: the small steps are (near) integer multiples of one count, and the record
+    # shows it (repeated samples, or several multiples); a clean ramp of equal steps does not
     ratio = d[d <= 20 * small] / small
-    return float(small) if np.all(np.abs(ratio - np.round(ratio)) < 0.05) else 0.0
+    if not np.all(np.abs(ratio - np.round(ratio)) < 0.05):
+        return 0.0
+    dq = np.abs(np.diff(q[np.isfinite(q)]))
+    repeats = np.mean(dq <= 1e-9 * max(float(np.max(np.abs(q))), 1e-300)) > 0.01
+    return float(small) if repeats or np.unique(np.round(ratio)).size >= 2 else 0.0
 
 
 def speed_resolution(quantum: float, cutoff_hz: float) -> float:
@@ -86,6 +91,20 @@ QDD_NOISE_FRACTION = 0.005
 MIN_CUTOFF_HZ = 2.0
 
 
+def white_position_noise(q: np.ndarray) -> float:
+    """Std of white noise on a position record (N,) (e.g. stamp jitter resampled onto a grid), from
+    its second difference d2: white noise of std s gives std(d2) = sqrt(6) s and a lag-1
+    autocorrelation of -2/3, a smooth motion a correlation near +1. Returns 0 unless d2 looks
+    like noise (correlation < -0.3)."""
+    d2 = np.diff(np.asarray(q, dtype=float).reshape(-1), 2)
+    d2 = d2[np.isfinite(d2)]
+    if d2.size < 20 or not np.any(d2):
+        return 0.0
+    d2 = d2 - d2.mean()
+    rho = float(np.sum(d2[1:] * d2[:-1]) / np.sum(d2 * d2))
+    return float(np.std(d2) / np.sqrt(6.0)) if rho < -0.3 else 0.0
+
+
 def quantization_qdd_noise(quantum: float, fs: float, cutoff_hz: float) -> float:
     """RMS of the acceleration noise that encoder quantization leaves after an ideal low-pass at
     ``cutoff_hz`` and two differentiations: white quantization noise of variance quantum^2 / 12
@@ -98,7 +117,8 @@ def quantization_aware_cutoff(q: np.ndarray, fs: float, default_hz: float, order
     """Largest cut-off (``default_hz``, lowered step by step down to :data:`MIN_CUTOFF_HZ`) at
     which the quantization noise of the acceleration stays below
     :data:`QDD_NOISE_FRACTION` of the acceleration RMS, for every column of the raw position
-    ``q`` (N,) or (N, k). Unquantized positions keep ``default_hz``."""
+    ``q`` (N,) or (N, k). White position noise (:func:`white_position_noise`) counts like
+    quantization; clean, unquantized positions keep ``default_hz``."""
     from .conditioning import lowpass
 
     q = np.asarray(q, dtype=float).reshape(len(q), -1)
@@ -107,7 +127,8 @@ def quantization_aware_cutoff(q: np.ndarray, fs: float, default_hz: float, order
         col = q[:, j]
         if not np.all(np.isfinite(col)):
             continue
-        quantum = position_quantum(col)
+        # white-equivalent count: quantization (uniform, quantum^2 / 12) or measured white noise
+        quantum = max(position_quantum(col), np.sqrt(12.0) * white_position_noise(col))
         if quantum <= 0:
             continue
         # the acceleration's size, from a cut-off low enough that quantization cannot inflate it

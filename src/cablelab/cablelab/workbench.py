@@ -170,6 +170,9 @@ def diagnose(ds: Dataset, model: Model, candidates: Sequence[str], *, folds: int
     waterfall of significant effects added one at a time."""
     from .diagnose.checks import check_dataset
 
+    from .diagnose import fold_indices
+
+    fold_indices(ds.n, folds)  # too short for the folds: that message first
     check_dataset(ds)  # bad input: a one-line refusal, never a confident ranking
     cands = [c for c in candidates if c not in model.effects]
     if greedy_mode:
