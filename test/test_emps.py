@@ -83,7 +83,7 @@ def test_identify_and_compare_on_emps(capsys):
     full = _json(capsys, ["compare", str(BAG), "--effects", "joint_coulomb_friction,torque_sensor_offset",
                           "--json"])
     assert full["free_run"]["nrmse"] < 0.05 < cmp_["free_run"]["nrmse"]
-    assert full["joint"]["nrmse"] == pytest.approx(0.0443, abs=0.003)
+    assert full["joint"]["nrmse"] == pytest.approx(0.041, abs=0.003)  # zero-speed zone not fitted
 
 
 @pytest.mark.skipif(not MAT.exists(), reason="EMPS data set not present")
