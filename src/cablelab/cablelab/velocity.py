@@ -86,7 +86,7 @@ def exclude_zero_speed(ds, floor: np.ndarray | float = 0.0, fraction: float = ZO
 
 
 #: quantization noise allowed in the filtered acceleration, as a fraction of its RMS
-QDD_NOISE_FRACTION = 0.05
+QDD_NOISE_FRACTION = 0.005
 #: lowest cut-off the quantization-aware choice goes down to, Hz
 MIN_CUTOFF_HZ = 2.0
 
