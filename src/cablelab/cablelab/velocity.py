@@ -25,8 +25,6 @@ import numpy as np
 
 #: zero-speed zone: |v| below this fraction of the actuator's 99th-percentile speed
 ZONE_FRACTION = 0.03
-#: a sample is also in the zone within this many filter time constants of a zone sample? (no:
-#: the zone is pointwise; the filter smear is far shorter than a move)
 
 
 def position_quantum(q: np.ndarray) -> float:
