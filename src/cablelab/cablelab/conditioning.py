@@ -146,6 +146,9 @@ def condition_motion(t: np.ndarray, q: np.ndarray, effort: np.ndarray,
     if n0 < need:
         raise CablelabError(f"{source}: only {n0} samples, need at least {need} "
                             f"(2 x border {opts.border} + 10)")
+    from .diagnose.checks import check_raw_series
+
+    check_raw_series(t, source, position=q, effort=effort)
     sig = [q, effort] + ([qd] if qd is not None else [])
     resampled = not is_uniform(t, opts.max_jitter)
     if resampled or any(not np.all(np.isfinite(s)) for s in sig):
@@ -157,13 +160,18 @@ def condition_motion(t: np.ndarray, q: np.ndarray, effort: np.ndarray,
             raise CablelabError(f"{source}: {name} has no finite samples in some column")
     fs = 1.0 / float(np.median(np.diff(t)))
     cutoff = default_cutoff(fs, opts)
+    if opts.cutoff_hz is None:  # quantized encoder: lower the cut-off until qdd is not noise
+        from .velocity import quantization_aware_cutoff
+
+        cutoff = quantization_aware_cutoff(q, fs, cutoff, opts.order)
     rev = np.broadcast_to(np.asarray(revolute, dtype=bool), q.shape[1:] if q.ndim > 1 else ())
     if opts.unwrap and np.any(rev):
         q = np.where(rev, unwrap_angle(q), q)
     qf, qd_pos, qdd_pos = derivatives(q, fs, cutoff, opts.order)
     if qd is not None and np.all(np.isfinite(qd)):
         qd_f = lowpass(qd, fs, cutoff, opts.order)
-        qdd = np.gradient(qd_f, 1.0 / fs, axis=0)
+        # acceleration from the encoder (its noise is known, the velocity sensor's is not)
+        qdd = qdd_pos if opts.cutoff_hz is None else np.gradient(qd_f, 1.0 / fs, axis=0)
         qd_out = qd_f
     else:
         qd_out, qdd = qd_pos, qdd_pos

@@ -131,7 +131,7 @@ def compare(ds: Dataset, model: Model, *, segments: int = 5) -> dict:
     out["worst_segments"] = worst_segments(ds.t, ident.residual, y_meas, ds.channels, count=segments)
     out["params"] = _effect_table(ident)
     out["regimes"] = residual_by_regime(ident.residual, y_meas, derived_regimes(ds), ds.channels)
-    out["whiteness"] = {ch: _whiteness_summary(ident.residual[:, c], ds.inputs)
+    out["whiteness"] = {ch: _whiteness_summary(ident.residual[:, c], ds.inputs, _decimation(ds))
                         for c, ch in enumerate(ds.channels)}
     out["rank"], out["condition"] = ident.linear.rank, ident.linear.cond
     plant = _plant_of(ds)
@@ -149,9 +149,17 @@ def _plant_of(ds: Dataset):
         return None
 
 
-def _whiteness_summary(res, inputs) -> dict:
-    w = whiteness(res, inputs)
+def _decimation(ds: Dataset) -> int:
+    """Samples per independent sample of a residual of signals low-passed at the dataset's
+    cut-off (``signals["cutoff_hz"]``): fs / (2 f_c); 1 when unknown."""
+    fc = ds.signals.get("cutoff_hz")
+    return max(1, int(ds.fs / (2.0 * float(fc)))) if fc else 1
+
+
+def _whiteness_summary(res, inputs, decimate: int = 1) -> dict:
+    w = whiteness(res, inputs, decimate=decimate)
     return {"band": w["band"], "white": w["white"], "autocorr_outside": w["outside"],
+            "decimate": w["decimate"],
             "autocorr_lag1": w["autocorr"][1] if len(w["autocorr"]) > 1 else None,
             "cross": {k: {"outside": v["outside"], "uncorrelated": v["uncorrelated"],
                           "max_abs": float(np.max(np.abs(v["xcorr"])))} for k, v in w["cross"].items()}}
@@ -192,6 +200,12 @@ def diagnose(ds: Dataset, model: Model, candidates: Sequence[str], *, folds: int
              quiet: bool = True) -> Diagnosis:
     """Rank the missing effects (CONTRACT section 5 ``diagnose``); with ``greedy_mode`` also the
     waterfall of significant effects added one at a time. ``.to_json()`` is the contract JSON."""
+    from .diagnose.checks import check_dataset
+
+    from .diagnose import fold_indices
+
+    fold_indices(ds.n, folds)  # too short for the folds: that message first
+    check_dataset(ds)  # bad input: a one-line refusal, never a confident ranking
     cands = [c for c in candidates if c not in model.effects]
     if greedy_mode:
         steps = [step_from_dict(s) for s in greedy(model, ds, cands, folds=folds, alpha=alpha,

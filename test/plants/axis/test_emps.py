@@ -36,13 +36,19 @@ def test_greedy_diagnosis_rediscovers_coulomb_then_offset_and_the_published_para
     assert errs == sorted(errs)
     assert sum(r["significant"] for r in rank) == 1
     steps = out["greedy"]
-    assert [s["added"] for s in steps] == [None, "joint_coulomb_friction", "torque_sensor_offset"]
+    # issue 10: with the zero-speed zone excluded, a sub-sample lead of the force command (the
+    # controller's zero-order hold, about half a 1 ms sample) is significant after the two
+    added = [s["added"] for s in steps]
+    assert added[:3] == [None, "joint_coulomb_friction", "torque_sensor_offset"]
+    assert added[3:] in ([], ["time_delay"])
+    if added[3:]:
+        assert -1e-3 < out["final"]["params"]["tau"] < 0
     assert steps[1]["error"] == pytest.approx(0.07, abs=0.01)  # README: about 7 %
     second = steps[1]["ranking"][0]
     assert second["effect"] == "torque_sensor_offset" and second["significant"]
     final = out["final"]
     assert final["effects"] == ["axis_inertia", "joint_viscous_friction", "joint_coulomb_friction",
-                                "torque_sensor_offset"]
+                                "torque_sensor_offset"] + added[3:]
     assert final["error"] == pytest.approx(0.04, abs=0.008)  # README: about 4 %, held out
     for k, v in PUBLISHED.items():
         assert final["params"][k] == pytest.approx(v, rel=0.02), k
@@ -62,7 +68,8 @@ def test_identify_and_compare_on_emps(capsys):
         assert abs(p[k]["value"] - v) < 3 * p[k]["stderr"], k
     assert p["M"]["unit"] == "kg" and p["Fv"]["unit"] == "N s/m"
     assert ident["fit"]["rank"] == 4 and ident["fit"]["unidentifiable"] == []
-    assert ident["fit"]["nrmse"] == pytest.approx(0.0443, abs=0.003)
+    # issue 10: the zero-speed zone (1.8 % of EMPS) is not fitted: 4.1 % instead of 4.4 %
+    assert ident["fit"]["nrmse"] == pytest.approx(0.041, abs=0.003)
     cmp_ = _json(capsys, ["compare", str(BAG), "--json"])
     ch = cmp_["joint"]
     assert set(ch) >= {"nrmse", "pearson", "mae", "max_abs"}
@@ -76,7 +83,7 @@ def test_identify_and_compare_on_emps(capsys):
     full = _json(capsys, ["compare", str(BAG), "--effects", "joint_coulomb_friction,torque_sensor_offset",
                           "--json"])
     assert full["free_run"]["nrmse"] < 0.05 < cmp_["free_run"]["nrmse"]
-    assert full["joint"]["nrmse"] == pytest.approx(0.0443, abs=0.003)
+    assert full["joint"]["nrmse"] == pytest.approx(0.041, abs=0.003)  # zero-speed zone not fitted
 
 
 @pytest.mark.skipif(not MAT.exists(), reason="EMPS data set not present")

@@ -33,7 +33,8 @@ from ..fit.identify import lag1_autocorrelation
 from ..fit.threads import blas_single
 from ..model import Dataset, Model
 from .localise import derived_regimes, residual_by_regime
-from .metrics import nrmse
+from .metrics import nrmse  # noqa: F401  (re-exported name used by older callers)
+from .score import channel_nrmse, heldout_error, lr_significance
 
 #: default number of folds, significance level, guard band (fraction of samples per side)
 FOLDS = 5
@@ -72,11 +73,12 @@ def fold_indices(n: int, k: int = FOLDS, guard: int | None = None) -> list[tuple
 
 def cv_error(model: Model, ds: Dataset, folds: int = FOLDS, start: dict | None = None
              ) -> tuple[float, np.ndarray, np.ndarray]:
-    """Held-out NRMSE of a model (blocked k-fold). ``start``: nonlinear parameter values to start
+    """Held-out error of a model (blocked k-fold): the geometric mean over channels of the
+    per-channel NRMSE (:func:`~cablelab.diagnose.score.heldout_error`; one channel: the NRMSE). ``start``: nonlinear parameter values to start
     each fold's outer search from (the full-record fit), instead of a grid.
 
     Returns:
-        ``(nrmse, y_meas (N, C), y_hat (N, C))`` with the held-out predictions of every sample
+        ``(error, y_meas (N, C), y_hat (N, C))`` with the held-out predictions of every sample
         (NaN where not valid).
     """
     y_meas = np.full_like(ds.y, np.nan)
@@ -87,7 +89,7 @@ def cv_error(model: Model, ds: Dataset, folds: int = FOLDS, start: dict | None =
         ym = np.where(ok[:, None], ym, np.nan)
         y_meas[test], y_hat[test] = ym, yh
     ok = np.isfinite(y_meas).all(axis=1) & np.isfinite(y_hat).all(axis=1)
-    return nrmse(y_meas, y_hat, ok), y_meas, y_hat
+    return heldout_error(y_meas, y_hat, ok), y_meas, y_hat
 
 
 def _n_params(ident) -> int:
@@ -231,20 +233,26 @@ def rank_candidates(model: Model, ds: Dataset, candidates, *, folds: int = FOLDS
         m2 = model.with_effect(c)
         try:
             full = identify(m2, ds)
-            err1, _, _ = cv_error(m2, ds, folds, start=full.params)
+            err1, ym1, yh1 = cv_error(m2, ds, folds, start=full.params)
         except CablelabError as exc:  # e.g. the effect is not excited: rank-deficient
             rows.append({"effect": c, "error_before": err0, "error_after": None, "params": {},
                          "significant": False, "explanation": f"{c}: cannot be fitted ({exc})"})
             prog.step(c)
             continue
-        sig = significance(base_full, full, len(cands), alpha)
+        sig = lr_significance(base_full, full, len(cands), alpha)
         significant = bool(sig["passes"] and err1 < (1.0 - min_gain) * err0)
         own = full.effect_params(c, ds)
         row = {"effect": c, "error_before": err0, "error_after": err1, "params": own,
                "stderr": {k: full.stderr.get(k, 0.0) for k in own},
                "units": {k: full.units.get(k, "") for k in own},
                "significant": significant, "p_value": sig["p_value"], "delta_bic": sig["delta_bic"],
-               "n_eff": sig["n_eff"], "gain": 1.0 - err1 / err0 if err0 > 0 else 0.0}
+               "n_eff": sig["n_eff"], "gain": 1.0 - err1 / err0 if err0 > 0 else 0.0,
+               "channels": dict(zip(ds.channels, map(float, channel_nrmse(ym1, yh1))))}
+        from .identifiability import confounding, describe
+
+        row["identifiability"] = confounding(full, list(own))
+        if not row["identifiability"]["identifiable"]:
+            significant = row["significant"] = False
         row["evidence"] = _evidence(by_regime0, residual_by_regime(full.residual, y_ref, regimes,
                                                                   ds.channels))
         row["explanation"] = explain(c, own, row["stderr"], row["units"], err0, err1, significant)
@@ -253,6 +261,7 @@ def rank_candidates(model: Model, ds: Dataset, candidates, *, folds: int = FOLDS
             row["explanation"] += (f"; largest drop where {ev['regime']} is {ev['label']} "
                                    f"({100 * ev['before']:.0f} % -> {100 * ev['after']:.0f} % of the "
                                    f"{ev['channel']} RMS)")
+        row["explanation"] += describe(row["identifiability"])
         rows.append(row)
         prog.step(c)
     rows.sort(key=lambda r: (r["error_after"] is None, r["error_after"] if r["error_after"] is not None else 0))

@@ -75,10 +75,11 @@ def _linear_system(model: Model, ds: Dataset):
 
 
 def _inner(model: Model, ds: Dataset, nl: Mapping[str, float], valid: np.ndarray,
-           on_deficient: str) -> tuple[LinearFit, np.ndarray, np.ndarray, list[Param], Dataset]:
+           on_deficient: str, channel_scale="rms") -> tuple[LinearFit, np.ndarray, np.ndarray, list[Param], Dataset]:
     ds2 = model.apply_nonlinear(ds, nl)
     phi, cols, lhs, _ = _linear_system(model, ds2)
-    fit = solve_linear(phi, lhs, cols, valid=valid, on_deficient=on_deficient)
+    fit = solve_linear(phi, lhs, cols, valid=valid, on_deficient=on_deficient,
+                       channel_scale=channel_scale)
     return fit, phi, lhs, cols, ds2
 
 
@@ -89,7 +90,8 @@ def _weighted_residual(fit: LinearFit, phi, lhs, valid) -> np.ndarray:
 
 
 def identify(model: Model, ds: Dataset, *, on_deficient: str = "raise",
-             outer_grid: int = OUTER_GRID, start: Mapping[str, float] | None = None) -> Identification:
+             outer_grid: int = OUTER_GRID, start: Mapping[str, float] | None = None,
+             channel_scale=None) -> Identification:
     """Fit the model's free parameters to the dataset.
 
     Args:
@@ -99,11 +101,22 @@ def identify(model: Model, ds: Dataset, *, on_deficient: str = "raise",
         outer_grid: grid points per nonlinear parameter for the outer search start.
         start: start values of the nonlinear parameters (e.g. the full-record fit when fitting
             cross-validation folds); skips the grid.
+        channel_scale: channel weights; default (None): with several channels, noise weights
+            1 / sigma_c from the residual of a first RMS-weighted fit (:func:`noise_weights`,
+            feasible generalised least squares), so a channel that carries an effect is not
+            drowned by channels that do not care; one channel: unweighted.
     Raises:
         CablelabError: too few samples, rank-deficient regressor (names the directions).
     """
     if ds.plant != model.plant:
         raise CablelabError(f"dataset of plant {ds.plant} given to a {model.plant} model")
+    if channel_scale is None:
+        channel_scale = "rms"
+        if ds.n_channels > 1:
+            first = identify(model, ds, on_deficient=on_deficient, outer_grid=outer_grid,
+                             start=start, channel_scale="rms")
+            channel_scale = noise_weights(first.residual)
+            start = {p.name: first.params[p.name] for p in model.nonlinear_params()} or start
     nl_params = model.nonlinear_params()
     nl_values: dict[str, float] = {}
     valid = ds.valid.copy()
@@ -116,7 +129,7 @@ def identify(model: Model, ds: Dataset, *, on_deficient: str = "raise",
         lo = np.array([p.lower for p in nl_params])
         hi = np.array([p.upper for p in nl_params])
 
-        outer = _OuterProblem(model, ds, valid, names)
+        outer = _OuterProblem(model, ds, valid, names, channel_scale)
 
         def cost(x):
             r = outer.residual(x)
@@ -145,7 +158,7 @@ def identify(model: Model, ds: Dataset, *, on_deficient: str = "raise",
             x_best = x0
         nl_values = dict(zip(names, map(float, x_best)))
         # Jacobian of the residual w.r.t. the nonlinear parameters (theta held) for the covariance
-        f0, phi0, lhs0, _, _ = _inner(model, ds, nl_values, valid, "raise")
+        f0, phi0, lhs0, _, _ = _inner(model, ds, nl_values, valid, "raise", channel_scale)
         cols_j = []
         for i, p in enumerate(nl_params):
             h = 0.1 * step[i]
@@ -157,7 +170,7 @@ def identify(model: Model, ds: Dataset, *, on_deficient: str = "raise",
             cols_j.append((rp - rm) / (xp[p.name] - xm[p.name]))
         jac_nl = np.stack(cols_j, axis=1)
 
-    fit, phi, lhs, cols, ds2 = _inner(model, ds, nl_values, valid, on_deficient)
+    fit, phi, lhs, cols, ds2 = _inner(model, ds, nl_values, valid, on_deficient, channel_scale)
     params: dict[str, float] = {}
     stderr: dict[str, float] = {}
     units: dict[str, str] = {}
@@ -201,6 +214,19 @@ def identify(model: Model, ds: Dataset, *, on_deficient: str = "raise",
                           extra={"stderr_white": white, "lag1": r1, "stderr_inflation": inflation})
 
 
+def noise_weights(residual: np.ndarray) -> np.ndarray:
+    """(C,) channel weights 1 / sigma_c, sigma_c = robust (MAD) standard deviation of each
+    channel's residual (NaN rows dropped), normalised to a geometric mean of 1."""
+    r = np.asarray(residual, dtype=float)
+    r = r[np.isfinite(r).all(axis=1)]
+    if r.shape[0] < 3:
+        return np.ones(r.shape[1])
+    sig = 1.4826 * np.median(np.abs(r - np.median(r, axis=0)), axis=0)
+    sig = np.where(sig > 0, sig, np.maximum(r.std(axis=0), 1e-300))
+    w = 1.0 / sig
+    return w / np.exp(np.mean(np.log(w)))
+
+
 def lag1_autocorrelation(residual: np.ndarray) -> float:
     """Lag-1 autocorrelation of a residual (N,) or (N, C) (channels pooled, NaN rows dropped),
     clipped to [0, 0.999]."""
@@ -220,7 +246,8 @@ class _OuterProblem:
     (e.g. a delay shifts only the measurement) the regressor is factorised once (QR) and every
     evaluation is a projection; otherwise the inner LS is solved afresh."""
 
-    def __init__(self, model: Model, ds: Dataset, valid: np.ndarray, names: list[str]):
+    def __init__(self, model: Model, ds: Dataset, valid: np.ndarray, names: list[str],
+                 channel_scale="rms"):
         self.model, self.ds, self.valid, self.names = model, ds, valid, names
         nl = model.nonlinear_params()
         nominal = {p.name: p.nominal for p in nl}
@@ -232,7 +259,8 @@ class _OuterProblem:
         self.constant = all(dsp.signals.get(k) is v for k, v in ds0.signals.items()) and \
             dsp.act_map is ds0.act_map and dsp.act_vel is ds0.act_vel
         phi, self.cols, self.y_known = model.regressor(ds0)
-        fit0 = solve_linear(phi, ds0.y - self.y_known, self.cols, valid=valid, bounded=False)
+        fit0 = solve_linear(phi, ds0.y - self.y_known, self.cols, valid=valid, bounded=False,
+                            channel_scale=channel_scale)
         self.w = fit0.channel_scale
         if self.constant:
             a = (phi[valid] * self.w[None, :, None]).reshape(-1, phi.shape[2])

@@ -19,6 +19,7 @@ from ..errors import CablelabError
 from ..fit import identify
 from ..fit.threads import blas_single
 from ..model import Dataset, Model
+from ..workbench import _decimation
 from . import plots
 
 
@@ -80,7 +81,7 @@ def build_report(ds: Dataset, model: Model, candidates, out_dir, *, folds: int =
     white = {}
     for c, ch in enumerate(ds.channels):
         plots.residual_regimes(fig(f"regimes_{c}.png"), reg_b, reg_f, ch)
-        white[ch] = whiteness(fin.residual[:, c], ds.inputs)
+        white[ch] = whiteness(fin.residual[:, c], ds.inputs, decimate=_decimation(ds))  # issue 10
         plots.correlations(fig(f"whiteness_{c}.png"), white[ch], ch)
 
     parts = [f"<h1>{html.escape(title or 'cablelab report')}</h1>",

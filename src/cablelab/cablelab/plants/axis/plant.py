@@ -41,14 +41,20 @@ def dataset_from_arrays(t, q, effort, description, options: dict | None = None, 
                          source=source)
     unit = "N m" if revolute else "N"
     qd_c = c["qd"].reshape(-1)
-    return Dataset(
+    ds = Dataset(
         plant="axis", t=c["t"], y=c["effort"].reshape(-1, 1), channels=("joint",), units=(unit,),
-        signals={"q": c["q"].reshape(-1), "qd": qd_c, "qdd": c["qdd"].reshape(-1)},
+        signals={"q": c["q"].reshape(-1), "qd": qd_c, "qdd": c["qdd"].reshape(-1),
+                 "cutoff_hz": c["cutoff_hz"]},
         actuators=("joint",), act_vel=qd_c[:, None], act_units=((unit, "rad" if revolute else "m"),),
         inputs={"velocity": qd_c, "acceleration": c["qdd"].reshape(-1)},
         regimes={"position": _position_bins(c["q"].reshape(-1))},
         description=description, source=source,
     )
+    # drives that stop: the zero-speed zone is not fitted (cablelab.velocity, issue 10)
+    from ...velocity import exclude_zero_speed, position_quantum, speed_resolution
+
+    res = 0.0 if qd is not None else speed_resolution(position_quantum(q), c["cutoff_hz"])
+    return exclude_zero_speed(ds, floor=res)
 
 
 def _position_bins(q: np.ndarray, bins: int = 4) -> np.ndarray:
@@ -136,7 +142,7 @@ def free_run(ds: Dataset, param_sets: list[dict], horizon_s: float = FREE_RUN_HO
         mc = float(ps.get("mc", 0.0))
         d2 = desc
         if desc.axis.joint_type == "revolute":
-            d2 = dataclasses.replace(desc, axis=dataclasses.replace(desc.axis, gravity_moment=max(mc, 0.0)))
+            d2 = desc.with_section("axis", dataclasses.replace(desc.axis, gravity_moment=max(mc, 0.0)))
         truth = AxisTruth(inertia=max(float(ps.get("M", 0.0)), 1e-9),
                           viscous=max(float(ps.get("Fv", 0.0)), 0.0),
                           coulomb=max(float(ps.get("Fc", 0.0)), 0.0), timestep=dt)

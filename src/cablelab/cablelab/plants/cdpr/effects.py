@@ -22,7 +22,7 @@ import numpy as np
 from ...model import Dataset, Effect, Param
 from ...rotations import cross
 from ...effects import register
-from ...effects.friction import coulomb_regressor, viscous_regressor
+from ...effects.friction import coulomb_regressor, stribeck_effect, viscous_regressor
 
 #: search range of the sheave radius r_p, m
 PULLEY_BOUNDS = (0.0, 0.4)
@@ -125,3 +125,6 @@ TENSION_SENSOR_OFFSET = register(Effect(
     regressor=_tension_offset,
     per_actuator=True,
 ))
+
+WINCH_STRIBECK_FRICTION = register(stribeck_effect("winch_stribeck_friction", ("cdpr",),
+                                             "CONTRACT sec. 4; 001 eq. 15 with a Stribeck term"))
