@@ -219,3 +219,33 @@ def test_existing_cluster_via_scheduler_gives_the_same_rows(fleet, tmp_path):
     local = {(r["effect"], r["start_time"]): r["params"] for r in pq.read_table(out / "results.parquet").to_pylist()
              if r["machine"] == "winch-04"}
     assert mine == local
+
+
+def test_repository_bags_of_every_plant_match_the_diagnose_verb(tmp_path):
+    """A tree of the repository's recorded bags (axis: real EMPS data, crane, cdpr): each row's
+    ranking equals `cablelab diagnose --json` of that bag (the verb, run separately)."""
+    from pathlib import Path
+
+    repo_bags = Path(__file__).resolve().parents[2] / "bags"
+    root = tmp_path / "bags"
+    for name in ("emps", "crane_tilt", "cdpr_m2_fast"):
+        shutil.copytree(repo_bags / name, root / name)
+    out = tmp_path / "out"
+    summary, _ = _batch(root, out)
+    assert summary == {"bags": 3, "failed": 0, "drift": []}
+    rows = pq.read_table(out / "results.parquet").to_pylist()
+    assert {r["plant"] for r in rows} == {"axis", "crane", "cdpr"}
+    for name in ("emps", "crane_tilt", "cdpr_m2_fast"):
+        p = subprocess.run([sys.executable, "-m", "cablelab.cli", "diagnose", str(root / name), "--json"],
+                           capture_output=True, text=True, timeout=120)
+        assert p.returncode == 0, p.stderr
+        verb = json.loads(p.stdout)
+        mine = {r["effect"]: r for r in rows if r["bag"] == name}
+        assert set(verb["baseline"]["effects"]) == {e for e, r in mine.items() if r["in_model"]}
+        for v in verb["ranking"]:
+            r = mine[v["effect"]]
+            assert not r["in_model"] and r["significant"] == v["significant"]
+            assert r["error_after"] == pytest.approx(v["error_after"], rel=1e-9)
+            assert r["error_before"] == pytest.approx(verb["baseline"]["error"], rel=1e-9)
+            got = {k: x["value"] for k, x in json.loads(r["params"]).items()}
+            assert got == pytest.approx(v["params"], rel=1e-9)
