@@ -64,6 +64,7 @@ class LoadMeter:
     def __init__(self):
         self.cores = os.cpu_count() or 1
         self._last = None
+        self.ours = None        # cores used by our tree over the last interval
 
     def sample(self) -> float | None:
         """Cores used by others since the previous call (None on the first call or off Linux)."""
@@ -76,8 +77,9 @@ class LoadMeter:
             return None
         hz = os.sysconf("SC_CLK_TCK")
         # our tree's CPU includes children that exited meanwhile only until they exit: clamp at 0
-        others = ((now[1] - last[1]) - (now[2] - last[2])) / hz / (now[0] - last[0])
-        return max(0.0, others)
+        dt = now[0] - last[0]
+        self.ours = (now[2] - last[2]) / hz / dt
+        return max(0.0, (now[1] - last[1]) / hz / dt - self.ours)
 
 
 class SimProgress:
