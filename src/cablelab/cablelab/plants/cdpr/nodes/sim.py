@@ -111,6 +111,7 @@ class CdprSimNode(PlantNode):
         self.late_steps = 0
         self.dropped_steps = 0
         self.stale_command_steps = 0
+        self.missed_steps = 0       # steps with any of: late, braked, stale command (each once)
         self.latency = []           # wall time of one step (physics + publishing), s
         self.k = 0
         self.done = False
@@ -170,7 +171,8 @@ class CdprSimNode(PlantNode):
                        "slack cable steps": str(self.slack_steps), "mode": "real time" if self.real_time
                        else "as fast as possible (lock-step)",
                        "late steps": str(self.late_steps), "dropped steps": str(self.dropped_steps),
-                       "stale command steps": str(self.stale_command_steps)})
+                       "stale command steps": str(self.stale_command_steps),
+                       "missed steps": str(self.missed_steps)})
         if self.latency:
             values["latency p99 ms"] = f"{1000 * np.percentile(np.asarray(self.latency[-1000:]), 99):.3f}"
         if slack:
@@ -228,13 +230,14 @@ class CdprSimNode(PlantNode):
                 self.dropped_steps += due - 20
             self._wall0 = now - self.k / self.rate
             due = 20
-        for _ in range(max(0, due)):
-            self.step_once()
+        for i in range(max(0, due)):
+            self.step_once(late=i > 0)       # the first is on time (within its period), the rest late
             if self.done:
                 return
 
-    def step_once(self) -> None:
+    def step_once(self, late: bool = False) -> None:
         t0 = time.perf_counter()
+        missed = late
         now = time.monotonic()
         if not self.real_time:
             if self.u_stamp is not None:      # the controller says which state it answers
@@ -252,12 +255,16 @@ class CdprSimNode(PlantNode):
             self.fallbacks += 1
             if self.commands:
                 self.fallbacks_running += 1
+                missed = True
         else:
             self.brake_q = None
             if self.real_time and self.u_stamp is not None and self.u_stamp < self.sim.time - 1e-6:
                 self.stale_command_steps += 1           # the answer to the last state is not here
+                missed = True
             self.sim.step(self.u, self.nstep)
         self.k += 1
+        if missed and self.commands and self.real_time:
+            self.missed_steps += 1
         if self.sim.slack().any():
             self.slack_steps += 1
         self.publish_state()
