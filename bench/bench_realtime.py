@@ -141,6 +141,9 @@ def main(argv=None) -> int:
     bench.parser.add_argument("--skip-offline", action="store_true", help="closed loop only")
     bench.parser.add_argument("--publication-mode", choices=("synchronous", "asynchronous"), default=None,
                               help="RMW_FASTRTPS_PUBLICATION_MODE for the three nodes (default: rmw's)")
+    bench.parser.add_argument("--transports", default=None, metavar="T",
+                              help="FASTDDS_BUILTIN_TRANSPORTS for the three nodes (e.g. SHM, UDPv4, "
+                                   "DEFAULT); default: what cablelab.ros.launch sets")
     bench.parser.add_argument("--py-spy", default=None, metavar="PATH",
                               help="py-spy executable: sample each node and print where its time goes")
     args = bench.parse(argv)
@@ -149,8 +152,11 @@ def main(argv=None) -> int:
         bench.log("offline simulation vs bare mj_step ...")
         out["offline_sim"] = offline_sim(repeat=args.repeat)
     if not args.skip_loop:
-        env = ({"RMW_FASTRTPS_PUBLICATION_MODE": args.publication_mode.upper()}
-               if args.publication_mode else None)
+        env = {}
+        if args.publication_mode:
+            env["RMW_FASTRTPS_PUBLICATION_MODE"] = args.publication_mode.upper()
+        if args.transports:
+            env["FASTDDS_BUILTIN_TRANSPORTS"] = args.transports
         r = closed_loop(args.seconds, bench.log, env, args.py_spy)
         out["closed_loop"] = {"rate_hz": r["rate_hz"], "seconds": r["seconds"],
                               "realtime_factor": r["realtime_factor"], "missed_cycles": r["missed_cycles"],
