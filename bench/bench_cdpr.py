@@ -236,8 +236,20 @@ def estimator_node(bench: Bench, launch, seconds: float, params: dict) -> None:
     launch.stop("estimator")
 
 
-def closed_loop_1khz(bench: Bench, launch, seconds: float, params: dict) -> None:
-    bench.section(f"closed loop sim -> estimator -> controller -> sim at 1 kHz, real time, {seconds:g} s")
+def run_closed_loop(launch, seconds: float, params: dict, log=print, on_started=None) -> dict | None:
+    """Three node processes (estimator, controller, simulator in real-time mode at 1 kHz) on the
+    launcher's domain for ``seconds`` of simulated time; measured from the simulator's and the
+    nodes' own /diagnostics (1 Hz) and /proc CPU times, over the steady state (from 1 s of sim time,
+    start-up and DDS discovery excluded). None when the simulator never reported.
+
+    Returns the steady-state figures: ``realtime_factor`` (sim time / wall time), ``steps``,
+    ``commands_per_state``, ``braked`` (steps without a fresh command after the first one),
+    ``late`` / ``dropped`` / ``stale`` (steps run a period or more late, dropped when too far
+    behind, applying a command that answers an older state), ``missed_cycles`` (steps with any
+    of braked / late / stale, each counted once, plus the dropped ones),
+    ``cpu_ms`` {node: CPU per step}, ``p99_ms`` {sim, estimator, controller}: the largest in-node
+    processing p99 any node reported over the steady state (each report is the p99 of its last
+    1000 samples, so this is the worst 1 s window), ``load`` (before, after)."""
     launch.node("estimator", "payload_estimator", "cdpr", params)
     launch.node("controller", "pd_feedforward", "cdpr", params)
     cl = _Client(launch.domain_id)       # listens to /diagnostics only (1 Hz): no extra 1 kHz load
@@ -247,11 +259,22 @@ def closed_loop_1khz(bench: Bench, launch, seconds: float, params: dict) -> None
     launch.node("sim", "cable_sim_node", "cdpr", {"rate": 1000.0, "real_time": True, "payload_mass": 249.0,
                                                   "duration": seconds + 1.0, "settle": 1.0,
                                                   "extras_every": 10} | params)
-    pids = {name: launch.procs[name].popen.pid for name in ("sim", "estimator", "controller")}
+    names = {"sim": "cable_sim_node", "estimator": "payload_estimator", "controller": "pd_feedforward"}
+    pids = {name: launch.procs[name].popen.pid for name in names}
+    if on_started is not None:
+        on_started(pids)                 # e.g. attach a sampling profiler
     load0 = _load()
     t0 = time.monotonic()
-    samples = []        # (wall, sim time, commands received by the sim, {name: cpu s}) per sim status
+    samples = []        # (wall, sim time, commands received by the sim, {name: cpu s}, sim status)
+    worst = dict.fromkeys(names, 0.0)
     last_stamp = None
+    progress = None
+    try:
+        from tqdm import tqdm
+        progress = tqdm(total=round(seconds + 1.0), unit="sim s", desc="closed loop 1 kHz", file=sys.stderr,
+                        bar_format="{desc}: {n:.0f}/{total:.0f} sim s [{elapsed}<{remaining}, {rate_fmt}]")
+    except ImportError:
+        pass
     while launch.procs["sim"].alive() and time.monotonic() - t0 < 20 * seconds + 60:
         cl.spin(0.05)
         d = cl.diag.get("cable_sim_node")
@@ -262,36 +285,58 @@ def closed_loop_1khz(bench: Bench, launch, seconds: float, params: dict) -> None
             cpu = {name: _cpu_seconds(pid) for name, pid in pids.items()}
         except OSError:
             break
-        samples.append((time.monotonic(), float(d["sim time s"]), int(d.get("effort_commands received", 0)),
-                        cpu, dict(d)))
-    # steady state: from the first status after 1 s of sim time (process start-up, imports and
-    # DDS discovery excluded) to the last one
-    steady = [s for s in samples if s[1] >= 1.0]
-    if len(steady) < 2:
-        bench.log("  closed loop: not enough /diagnostics samples from the simulator")
-        cl.close()
-        launch.stop_all()
-        return
-    (w0, s0, c0, cpu0, _), (w1, s1, c1, cpu1, last) = steady[0], steady[-1]
-    steps = round((s1 - s0) * 1000)
-    brakes = int(last.get("brake steps after the first command", "-1"))
-    bench.row(case="achieved real-time factor (sim time / wall time, steady state)", value=(s1 - s0) / (w1 - w0),
-              unit="x", target="1 (real time)")
-    bench.row(case="commands received by the sim / states published", value=(c1 - c0) / max(steps, 1),
-              unit="", target="1")
-    bench.row(case="simulator steps braked (no fresh command) after the first one", value=brakes,
-              unit=f"of {round(s1 * 1000)}", target="0")
-    bench.row(case="CPU per step: sim / estimator / controller (all threads)",
-              value=" / ".join(f"{1000 * (cpu1[k] - cpu0[k]) / max(steps, 1):.3f}" for k in pids),
-              unit="ms", target="")
-    bench.log(f"  load average before/after: {load0} / {_load()}")
-    ctl = cl.diag.get("pd_feedforward", {})
-    est = cl.diag.get("payload_estimator", {})
-    bench.row(case="controller / estimator processing p99 (in node)",
-              value=f"{ctl.get('latency p99 ms', '?')} / {est.get('latency p99 ms', '?')}", unit="ms",
-              target="< 1 ms")
+        st = float(d["sim time s"])
+        if progress is not None:
+            progress.update(min(st, progress.total) - progress.n)
+        if st >= 1.0:
+            for name, node in names.items():
+                v = cl.diag.get(node, {}).get("latency p99 ms")
+                if v not in (None, "?"):
+                    worst[name] = max(worst[name], float(v))
+        samples.append((time.monotonic(), st, int(d.get("effort_commands received", 0)), cpu, dict(d)))
+    if progress is not None:
+        progress.close()
     cl.close()
     launch.stop_all()
+    steady = [s for s in samples if s[1] >= 1.0]
+    if len(steady) < 2:
+        log("  closed loop: not enough /diagnostics samples from the simulator")
+        return None
+    (w0, s0, c0, cpu0, first), (w1, s1, c1, cpu1, last) = steady[0], steady[-1]
+    steps = round((s1 - s0) * 1000)
+
+    def delta(key):
+        return int(last.get(key, "0")) - int(first.get(key, "0"))
+
+    out = {"realtime_factor": (s1 - s0) / (w1 - w0), "seconds": s1 - s0, "steps": steps,
+           "commands_per_state": (c1 - c0) / max(steps, 1),
+           "braked": delta("brake steps after the first command"), "late": delta("late steps"),
+           "dropped": delta("dropped steps"), "stale": delta("stale command steps"),
+           "cpu_ms": {k: 1000 * (cpu1[k] - cpu0[k]) / max(steps, 1) for k in pids},
+           "p99_ms": worst, "load": (load0, _load()),
+           "brakes_total": int(last.get("brake steps after the first command", "-1"))}
+    out["missed_cycles"] = delta("missed steps") + out["dropped"]   # each step counted once
+    return out
+
+
+def closed_loop_1khz(bench: Bench, launch, seconds: float, params: dict) -> None:
+    bench.section(f"closed loop sim -> estimator -> controller -> sim at 1 kHz, real time, {seconds:g} s")
+    r = run_closed_loop(launch, seconds, params, bench.log)
+    if r is None:
+        return
+    bench.row(case="achieved real-time factor (sim time / wall time, steady state)", value=r["realtime_factor"],
+              unit="x", target="1 (real time)")
+    bench.row(case="commands received by the sim / states published", value=r["commands_per_state"],
+              unit="", target="1")
+    bench.row(case="missed cycles (steps braked, late or with a stale command, + dropped)",
+              value=f"{r['missed_cycles']} (braked {r['braked']}, late {r['late']}, dropped {r['dropped']}, "
+                    f"stale {r['stale']})",
+              unit=f"of {r['steps']}", target="0")
+    bench.row(case="CPU per step: sim / estimator / controller (all threads)",
+              value=" / ".join(f"{v:.3f}" for v in r["cpu_ms"].values()), unit="ms", target="")
+    bench.log(f"  load average before/after: {r['load'][0]} / {r['load'][1]}")
+    bench.row(case="sim / estimator / controller processing p99 (in node, worst 1 s window)",
+              value=" / ".join(f"{v:.3f}" for v in r["p99_ms"].values()), unit="ms", target="< 1 ms")
 
 
 def paper_tables(bench: Bench) -> None:

@@ -109,8 +109,8 @@ def pdff_torques(q: np.ndarray, qdot: np.ndarray, q_des: np.ndarray, qdot_des: n
     friction compensation, saturated at max_torque."""
     k = drum_radius / gear_ratio
     tau = config.kp * (np.asarray(q_des) - q) + config.kd * (np.asarray(qdot_des) - qdot)
-    fric = winch_friction(qdot_des, config.coulomb, config.viscous)
     if tensions_ff is not None:
-        tau = tau + k * np.asarray(tensions_ff)
-    tau = np.maximum(tau, k * config.min_tension) + fric
-    return np.clip(tau, -config.max_torque, config.max_torque)
+        tau += k * np.asarray(tensions_ff)
+    tau = np.maximum(tau, k * config.min_tension)
+    tau += winch_friction(qdot_des, config.coulomb, config.viscous)
+    return np.minimum(np.maximum(tau, -config.max_torque), config.max_torque, out=tau)

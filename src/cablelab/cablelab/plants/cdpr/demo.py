@@ -43,25 +43,27 @@ def run_nodes(out: Path, name: str, feedforward: bool, duration: float, domain: 
         # live estimate of its own stamp, so a loaded machine cannot starve the feedforward
         launch.node("controller", "pd_feedforward", "cdpr",
                     {"feedforward": feedforward, "estimate_wait": 5.0 if feedforward else 0.0})
-        launch.wait_for_topics({"/diagnostics": 2}, timeout=90)
-        time.sleep(1.0)
+        # every reader discovered before time starts (the estimator reads /cdpr/cable_tensions,
+        # not /cdpr/joint_states: waiting there for 3 subscribers cost 60 s of timeout per run)
+        launch.wait_for_subscribers(["/cdpr/joint_states", "/cdpr/cable_tensions", "/cdpr/reference",
+                                     "/cdpr/payload_estimate", "/cdpr/effort_commands"],
+                                    timeout=90, node_name="cablelab_recorder")
+        launch.wait_for_subscribers(["/cdpr/cable_tensions", "/cdpr/reference"], timeout=90,
+                                    node_name="payload_estimator")
+        launch.wait_for_subscribers(["/cdpr/joint_states", "/cdpr/reference"], timeout=90,
+                                    node_name="pd_feedforward")
         launch.node("sim", "cable_sim_node", "cdpr", {"real_time": False, "payload_mass": PAYLOAD,
                                                       "duration": duration, "settle": 1.0,
-                                                      "wait_for_subscribers": 3})
+                                                      "wait_for_subscribers": 2})  # recorder, controller
         t0 = time.monotonic()
-        last = 0.0
-        while launch.procs["sim"].alive():
-            time.sleep(0.5)
-            launch.check_alive()
-            el = time.monotonic() - t0
-            if el - last >= 10.0:
-                last = el
-                eta = duration / 1.5 - el
-                log(f"{name}: running {el:.0f} s, {duration:.0f} s to simulate " +
-                    (f"(ETA ~{eta:.0f} s at ~1.5x real time)" if eta > 0 else
-                     "(slower than 1.5x real time: the machine is loaded; lock-step keeps it exact)"))
-            if el > 20 * duration + 60:
-                raise RuntimeError(f"{name}: simulator did not finish; logs in {logs}")
+        from ...ros.sim_progress import SimProgress
+
+        with SimProgress(launch.probe(), duration, f"cdpr {name}") as bar:
+            while launch.procs["sim"].alive():
+                bar.poll(0.5)                # simulated time from /clock: rate and ETA from it
+                launch.check_alive()
+                if time.monotonic() - t0 > 20 * duration + 60:
+                    raise RuntimeError(f"{name}: simulator did not finish; logs in {logs}")
         time.sleep(1.5)                     # let the recorder take the last messages
         codes = launch.stop_all()
     bad = {k: v for k, v in codes.items() if v != 0}

@@ -14,9 +14,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .description import CdprDescription
-from .control import PdffConfig, feedforward_tensions, motor_angles, motor_rates, pdff_torques
-from .estimation import mass_com, tensions_from_torques
-from .geometry import CableGeometry, pose_geometry, quat_to_matrix, wrench_matrix
+from .control import PdffConfig, pdff_torques
+from .estimation import mass_com_from_wrench, tensions_from_torques
+from .geometry import pose_geometry, quat_to_matrix, wrench_matrix
 
 __all__ = ["EstimatorConfig", "LiveEstimator", "ControllerConfig", "LiveController"]
 
@@ -53,20 +53,43 @@ class EstimatorConfig:
     pulley_radius: float | None = None
 
 
-def _geometry(desc: CdprDescription, p, R, r: float) -> CableGeometry:
-    """One-sample :class:`CableGeometry` from the fast single-pose path (directions, lengths and
-    anchors; the other fields are not needed live and left zero)."""
-    e, L, bw = pose_geometry(desc.exit_points, desc.anchor_points, p, R, r, desc.swivel_axes)
-    z = np.zeros((1, len(L)))
-    return CableGeometry(e[None], L[None], bw[None], L[None], z, z, e[None] * 0.0)
-
-
 def _zero_if_bad(x) -> np.ndarray:
     """A (3,) twist/acceleration; missing or non-finite -> zeros (a missing feedforward term)."""
     if x is None:
         return np.zeros(3)
     a = np.asarray(x, float)
     return a if a.shape == (3,) and np.isfinite(a).all() else np.zeros(3)
+
+
+def _wrench_one(d: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """(6, n) wrench matrix of one pose (001 eq. 4 / 7) from directions d (n, 3) and anchors
+    b (n, 3): the single-sample form of :func:`~.geometry.wrench_matrix`, without its batch axis."""
+    W = np.empty((6, len(d)))
+    W[:3] = d.T
+    W[3] = b[:, 1] * d[:, 2] - b[:, 2] * d[:, 1]
+    W[4] = b[:, 2] * d[:, 0] - b[:, 0] * d[:, 2]
+    W[5] = b[:, 0] * d[:, 1] - b[:, 1] * d[:, 0]
+    return W
+
+
+def _feedforward_one(W: np.ndarray, mass: float, acc: np.ndarray, gravity: float, com, preload: float,
+                     min_tension: float, pinv: np.ndarray | None) -> np.ndarray:
+    """001 eq. 14 for one pose: :func:`~.control.feedforward_tensions` on a (6, n) W (and optional
+    (n, 6) W^+) without the batch axis (the live controller calls it at 1 kHz)."""
+    f = acc + np.array([0.0, 0.0, gravity])
+    w = np.empty(6)
+    w[:3] = mass * f
+    if com is None:
+        w[3:] = 0.0
+    else:
+        cx, cy, cz = com
+        w[3:] = mass * np.array([cy * f[2] - cz * f[1], cz * f[0] - cx * f[2], cx * f[1] - cy * f[0]])
+    rhs = w - preload * W.sum(1)
+    if pinv is None:   # W^+ rhs = W^T (W W^T)^-1 rhs for a full-row-rank W (6 x n, n >= 6)
+        t = preload + W.T @ np.linalg.solve(W @ W.T, rhs)
+    else:
+        t = preload + pinv @ rhs
+    return np.maximum(t, min_tension)
 
 
 def _is_identity(q: np.ndarray) -> bool:
@@ -79,7 +102,7 @@ def _finite_vector(x, n: int, what: str):
     a = np.asarray(x, dtype=float).ravel()
     if a.size != n:
         return None, f"{what}: expected {n} values, got {a.size}"
-    if not np.all(np.isfinite(a)):
+    if not np.isfinite(a).all():
         return None, f"{what}: NaN or inf"
     return a, None
 
@@ -103,7 +126,7 @@ class LiveEstimator:
 
     def update(self, t: float, *, tensions=None, effort=None, motor_velocity=None,
                position=None, quat=None, acceleration=None, input_times: dict | None = None,
-               geometry=None, condition: float | None = None):
+               geometry=None, condition: float | None = None, wrench=None):
         """One estimate from the latest inputs.
 
         Args:
@@ -115,6 +138,8 @@ class LiveEstimator:
             input_times: {input name: stamp} used for the staleness check.
             geometry, condition: optional precomputed geometry of this pose (one sample) and
                 cond(W) (batch callers compute them vectorised over the whole reference).
+            wrench: optional precomputed (6, n) wrench matrix W of this pose (then ``geometry``
+                is not needed).
         """
         cfg, n = self.config, len(self.desc.cables)
         self.status = []
@@ -147,21 +172,28 @@ class LiveEstimator:
                 self.status.append((ERROR, err or "pose orientation: zero quaternion"))
                 return None
             R = None if _is_identity(q) else quat_to_matrix(q)
-        neg = np.flatnonzero(tens < -cfg.negative_tolerance)
-        if neg.size:
-            self.status.append((ERROR, "negative tension on cable(s) " + ", ".join(str(i + 1) for i in neg)))
-            return None
-        slack = np.flatnonzero(tens < cfg.slack_tension)
-        if slack.size:
+        if tens.min() < cfg.slack_tension:
+            neg = np.flatnonzero(tens < -cfg.negative_tolerance)
+            if neg.size:
+                self.status.append((ERROR, "negative tension on cable(s) " + ", ".join(str(i + 1) for i in neg)))
+                return None
+            slack = np.flatnonzero(tens < cfg.slack_tension)
             self.status.append((WARN, "slack cable(s) " + ", ".join(str(i + 1) for i in slack)))
-        geom = geometry if geometry is not None else _geometry(self.desc, p, R, self._radius())
+        if wrench is not None:
+            W = wrench
+        elif geometry is not None:
+            W = wrench_matrix(geometry)[0]
+        else:
+            d, _L, b = pose_geometry(self.desc.exit_points, self.desc.anchor_points, p, R, self._radius(),
+                                     self.desc.swivel_axes)
+            W = _wrench_one(d, b)
         if condition is None:
             # cond(W) changes slowly with the pose: recomputed when the pose moved > 1 mm
             key = (p, None if R is None else R)
             if (self._cond_key is None or np.abs(self._cond_key[0] - p).max() > 1e-3
                     or (R is None) != (self._cond_key[1] is None)
                     or (R is not None and np.abs(self._cond_key[1] - R).max() > 1e-3)):
-                self._cond = float(np.linalg.cond(wrench_matrix(geom)[0]))
+                self._cond = float(np.linalg.cond(W))
                 self._cond_key = key
             condition = self._cond
         cond = float(condition)
@@ -174,10 +206,17 @@ class LiveEstimator:
             if err:
                 self.status.append((WARN, err + "; estimating without platform_inertia"))
                 acc = None
-        est = mass_com(geom, tens[None], self.gravity, None if acc is None else acc[None],
-                       None if R is None else R[None])
-        m, c = float(est.mass[0]), est.com[0]
-        if not np.isfinite(m) or m <= 0 or not np.all(np.isfinite(c)):
+        wt = W @ tens                                         # cable wrench W t (001 eq. 12)
+        if acc is None and R is None:
+            # static, level: 001 eq. 13 on one sample (mass_com_from_wrench's first branch)
+            mg = float(wt[2])
+            m = mg / self.gravity
+            c = np.array([-wt[4] / mg, wt[3] / mg]) if m > 0 and np.isfinite(m) else np.full(2, np.nan)
+        else:
+            est = mass_com_from_wrench(wt[None], self.gravity, None if acc is None else acc[None],
+                                       None if R is None else R[None])      # 001 eq. 13 with eq. 10
+            m, c = float(est.mass[0]), est.com[0]
+        if not np.isfinite(m) or m <= 0 or not np.isfinite(c).all():
             self.status.append((ERROR, f"no valid estimate (mass {m:.3g} kg)"))
             return None
         if not self.status:
@@ -244,9 +283,13 @@ class LiveController:
         return True
 
     def update(self, t: float, q, qdot, position, quat=None, velocity=None, acceleration=None,
-               geometry=None, pinv=None):
+               geometry=None, pinv=None, wrench=None):
         """Torques (n,) N m, or None when the motor state or reference is unusable
-        (``geometry``/``pinv``: optional precomputed geometry and W^+ of this reference pose)."""
+        (``geometry``/``pinv``/``wrench``: optional precomputed geometry (one sample), W^+ (1, n, 6)
+        and W (6, n) of this reference pose).
+
+        One sample, no batch axis: the IGM q_d = -(R/r) l, the rates q_d' = (R/r) d . v (001
+        eq. 5), the feedforward of 001 eq. 14 and the PD of Fig. 6 (:func:`~.control.pdff_torques`)."""
         cfg, n, d = self.config, len(self.desc.cables), self.desc
         self.status = []
         q, e1 = _finite_vector(q, n, "motor angles")
@@ -262,9 +305,13 @@ class LiveController:
             R = quat_to_matrix(np.asarray(quat, float))
         r = 0.0 if cfg.model == "I" else (cfg.gains.pulley_radius if cfg.gains.pulley_radius is not None
                                            else d.pulley_radius)
-        geom = geometry if geometry is not None else _geometry(d, p, R, r)
-        q_des = motor_angles(geom.lengths, d.drum_radius, d.gear_ratio)[0]
-        qd_des = motor_rates(geom, v, d.drum_radius, d.gear_ratio)[0]
+        if geometry is not None:
+            dirs, L, b = geometry.directions[0], geometry.lengths[0], geometry.anchors[0]
+        else:
+            dirs, L, b = pose_geometry(d.exit_points, d.anchor_points, p, R, r, d.swivel_axes)
+        k = d.gear_ratio / d.drum_radius
+        q_des = -k * L                                    # control.motor_angles
+        qd_des = k * (dirs @ v)                           # control.motor_rates (no angular velocity)
         t_ff = None
         if cfg.feedforward:
             fresh = self._t_est is not None and t - self._t_est <= cfg.estimate_timeout
@@ -274,9 +321,10 @@ class LiveController:
                 m, com = cfg.nominal_mass, np.zeros(2)
                 self.status.append((WARN, "live mass estimate stale or missing: nominal mass "
                                     f"{m:.0f} kg in the feedforward"))
-            c3 = np.array([com[0], com[1], 0.0]) if cfg.use_com else None
-            t_ff = feedforward_tensions(geom, m, a[None], self.gravity, c3, cfg.gains.preload,
-                                        cfg.gains.min_tension, pinv=pinv)[0]
+            c3 = (com[0], com[1], 0.0) if cfg.use_com else None
+            W = wrench if wrench is not None else _wrench_one(dirs, b)
+            t_ff = _feedforward_one(W, m, a, self.gravity, c3, cfg.gains.preload, cfg.gains.min_tension,
+                                    None if pinv is None else pinv[0])
         tau = pdff_torques(q, qdot, q_des, qd_des, t_ff, d.drum_radius, d.gear_ratio, cfg.gains)
         if not self.status:
             self.status.append((OK, "PDFF" if cfg.feedforward else "PD"))

@@ -226,6 +226,12 @@ class CdprSim:
         if self.truth.pulleys:
             self._swivel_q = np.array([m.jnt_qposadr[m.joint(f"swivel_{i}").id] for i in range(1, self.n + 1)])
         self._rng = np.random.default_rng(self.truth.seed)
+        self._noise = np.empty((0, 2 * self.n + 3))       # standard normals drawn in blocks (measure)
+        self._noise_i = 0
+        d = self.data       # views of MjData's buffers, taken once (each attribute access builds one)
+        self._qpos, self._qvel, self._sens, self._act = d.qpos, d.qvel, d.sensordata, d.actuator_force
+        self._ten_len, self._ten_max = d.ten_length, m.tendon_range[:, 1]
+        self._free = self._qpos[self._free_q:self._free_q + 7]
         bias = self.truth.tension_bias
         self._bias = np.zeros(self.n) if bias is None else np.broadcast_to(np.asarray(bias, float), (self.n,)).copy()
         self.reset(self.position)
@@ -259,12 +265,12 @@ class CdprSim:
 
     def truth_pose(self):
         """(position (3,), quaternion (4,) w-x-y-z) of the platform, world."""
-        q = self.data.qpos[self._free_q:self._free_q + 7]
+        q = self._free
         return q[:3].copy(), q[3:].copy()
 
     def slack(self) -> np.ndarray:
         """(n,) True where a cable is slack (shorter than its taut length: the tendon limit)."""
-        return self.data.ten_length < self.model.tendon_range[:, 1] - 1e-6
+        return self._ten_len < self._ten_max - 1e-6
 
     def truth_state(self) -> dict:
         """Ground truth: pose, twist, tensions, swivel angles, slack flags."""
@@ -280,20 +286,25 @@ class CdprSim:
     def measure(self) -> dict:
         """Contract measurements with sensor noise: motor angle/rate/torque (winch_1..n),
         dynamometer tension and paid-out cable length (cable_1..n), measured pose."""
-        d, t, rng = self.data, self.truth, self._rng
-        s = d.qpos[self._reel_q]
-        sd = d.qvel[self._reel_v]
+        t, n = self.truth, self.n
+        if self._noise_i == len(self._noise):
+            # one block of draws: the same stream as three draws (n, n, 3) per call
+            self._noise, self._noise_i = self._rng.standard_normal((256, 2 * n + 3)), 0
+        z = self._noise[self._noise_i]
+        self._noise_i += 1
+        s = self._qpos[self._reel_q]
+        sd = self._qvel[self._reel_v]
         paid = self.cable_total - _RUN - s
-        tension = np.abs(d.sensordata[:self.n])
-        p, q = self.truth_pose()
+        tension = np.abs(self._sens[:n])
+        q = self._free
         return {
             "motor_angle": -self.k * paid,
             "motor_velocity": self.k * sd,
-            "motor_torque": d.actuator_force.copy() + t.torque_noise * rng.standard_normal(self.n),
-            "tension": tension + self._bias + t.tension_noise * rng.standard_normal(self.n),
+            "motor_torque": self._act + t.torque_noise * z[:n],
+            "tension": tension + self._bias + t.tension_noise * z[n:2 * n],
             "cable_length": paid,
-            "position": p + t.pose_noise * rng.standard_normal(3),
-            "quat": q,
+            "position": q[:3] + t.pose_noise * z[2 * n:],
+            "quat": q[3:].copy(),
         }
 
 
@@ -384,8 +395,9 @@ def simulate(desc: Description, truth: CdprTruth | None = None, *, controller: s
     g_est, W_est = _geoms(est._radius())
     cond_est = np.linalg.cond(W_est)
 
-    def _one(g, k):
-        return CableGeometry(*(getattr(g, f)[k:k + 1] for f in g.__dataclass_fields__))
+    def _one(g, k):     # what LiveController.update reads of one sample (directions, lengths, anchors)
+        return CableGeometry(g.directions[k:k + 1], g.lengths[k:k + 1], g.anchors[k:k + 1], None, None,
+                             None, None)
 
     desired = est.config.pose == "desired"
     # settle: hold the start pose with the controller until the cables carry the platform
@@ -393,11 +405,13 @@ def simulate(desc: Description, truth: CdprTruth | None = None, *, controller: s
         ms = sim.measure()
         e = est.update(0.0, tensions=ms["tension"], effort=ms["motor_torque"],
                        motor_velocity=ms["motor_velocity"], position=ref.position[0],
-                       quat=ref.orientation[0], geometry=_one(g_est, 0), condition=cond_est[0])
+                       quat=ref.orientation[0], condition=cond_est[0],
+                       wrench=W_est[0])
         if e is not None and controller == "pdff":
             ctl.estimate(0.0, *e)
         sim.step(ctl.update(0.0, ms["motor_angle"], ms["motor_velocity"], ref.position[0],
-                            ref.orientation[0], geometry=_one(g_ctl, 0), pinv=pinv_ctl[:1]), nstep)
+                            ref.orientation[0], geometry=_one(g_ctl, 0), pinv=pinv_ctl[:1],
+                            wrench=W_ctl[0]), nstep)
     ctl._t_est = ctl._t_filter = 0.0 if ctl._t_est is not None else None
     t0 = _time.monotonic()
     for k in range(N):
@@ -414,15 +428,15 @@ def simulate(desc: Description, truth: CdprTruth | None = None, *, controller: s
                        position=ref.position[k] if desired else ms["position"],
                        quat=ref.orientation[k] if desired else ms["quat"],
                        acceleration=ref.acceleration[k],
-                       geometry=_one(g_est, k) if desired else None,
-                       condition=cond_est[k] if desired else None)
+                       condition=cond_est[k] if desired else None,
+                       wrench=W_est[k] if desired else None)
         if e is not None:
             A["est_mass"][k], A["est_com"][k] = e
             if controller == "pdff":
                 ctl.estimate(t, *e)
         tau = ctl.update(t, ms["motor_angle"], ms["motor_velocity"], ref.position[k],
                          ref.orientation[k], ref.velocity[k], ref.acceleration[k],
-                         geometry=_one(g_ctl, k), pinv=pinv_ctl[k:k + 1])
+                         geometry=_one(g_ctl, k), pinv=pinv_ctl[k:k + 1], wrench=W_ctl[k])
         A["command"][k] = tau
         sim.step(tau, nstep)
         if progress is not None and k % max(1, N // 10) == 0:

@@ -61,14 +61,18 @@ def run_nodes(out: Path, duration: float, domain: int, tilt: float) -> Path:
             "rate": rate, "base_tilt": f"[{tilt!r}, 0.0]", "mocap_noise": 0.001,
             "mocap_dropout": 0.01, "wait_for_subscribers": 3})   # recorder, estimator, controller
         t0 = time.monotonic()
-        target = int(duration * rate)
-        seen = 0
-        while seen < target:               # count the states as they flow, with a progress line
-            chunk = min(500, target - seen)
-            seen += launch.wait_for_topics({"/crane/joint_states": chunk}, timeout=120)["/crane/joint_states"]
-            el = time.monotonic() - t0
-            log(f"crane: {seen / rate:.0f} of {duration:.0f} simulated s in {el:.0f} s "
-                f"(ETA ~{max(0.0, el * (target - seen) / max(seen, 1)):.0f} s)")
+        from ...ros.sim_progress import SimProgress
+
+        # simulated time from /clock (rate and ETA from it); no sample for 120 s wall is an error
+        with SimProgress(launch.probe(), duration, "crane") as bar:
+            last, t_last = 0.0, time.monotonic()
+            while bar.sim_time < duration - 0.5 / rate:
+                bar.poll(0.5)
+                launch.check_alive()
+                if bar.sim_time > last:
+                    last, t_last = bar.sim_time, time.monotonic()
+                elif time.monotonic() - t_last > 120:
+                    raise RuntimeError(f"crane: no simulated time for 120 s (at {last:.1f} s); logs in {logs}")
         time.sleep(1.0)
         codes = launch.stop_all()
     bad = {k: v for k, v in codes.items() if v != 0}

@@ -105,6 +105,14 @@ class CdprSimNode(PlantNode):
         self.fallbacks = 0
         self.fallbacks_running = 0  # ... after the first command (not the start-up wait)
         self.slack_steps = 0
+        # real-time misses (what bench/bench_realtime.py sums as missed cycles): steps run one or
+        # more periods after they were due, steps dropped when too far behind, and steps that had
+        # to apply a command answering an older state (the controller did not answer in time)
+        self.late_steps = 0
+        self.dropped_steps = 0
+        self.stale_command_steps = 0
+        self.missed_steps = 0       # steps with any of: late, braked, stale command (each once)
+        self.latency = []           # wall time of one step (physics + publishing), s
         self.k = 0
         self.done = False
         # the robot is switched on hanging on its locked winch brakes at A: settle that first, so
@@ -161,7 +169,12 @@ class CdprSimNode(PlantNode):
         values.update({"sim time s": f"{self.sim.time:.3f}", "brake (fallback) steps": str(self.fallbacks),
                        "brake steps after the first command": str(self.fallbacks_running),
                        "slack cable steps": str(self.slack_steps), "mode": "real time" if self.real_time
-                       else "as fast as possible (lock-step)"})
+                       else "as fast as possible (lock-step)",
+                       "late steps": str(self.late_steps), "dropped steps": str(self.dropped_steps),
+                       "stale command steps": str(self.stale_command_steps),
+                       "missed steps": str(self.missed_steps)})
+        if self.latency:
+            values["latency p99 ms"] = f"{1000 * np.percentile(np.asarray(self.latency[-1000:]), 99):.3f}"
         if slack:
             level = max(level, WARN)
             extra = "slack cable(s) " + ", ".join(slack)
@@ -209,15 +222,22 @@ class CdprSimNode(PlantNode):
         now = time.monotonic()
         if self._wall0 is None:
             self._wall0 = now - self.k / self.rate
-        due = min(20, int((now - self._wall0) * self.rate) - self.k)
+        due = int((now - self._wall0) * self.rate) - self.k
+        if self.commands and due > 1:
+            self.late_steps += min(due, 20) - 1        # ran at least one period after they were due
         if due > 19:                                   # far behind: do not try to catch up forever
+            if self.commands:
+                self.dropped_steps += due - 20
             self._wall0 = now - self.k / self.rate
-        for _ in range(max(0, due)):
-            self.step_once()
+            due = 20
+        for i in range(max(0, due)):
+            self.step_once(late=i > 0)       # the first is on time (within its period), the rest late
             if self.done:
                 return
 
-    def step_once(self) -> None:
+    def step_once(self, late: bool = False) -> None:
+        t0 = time.perf_counter()
+        missed = late
         now = time.monotonic()
         if not self.real_time:
             if self.u_stamp is not None:      # the controller says which state it answers
@@ -235,13 +255,22 @@ class CdprSimNode(PlantNode):
             self.fallbacks += 1
             if self.commands:
                 self.fallbacks_running += 1
+                missed = True
         else:
             self.brake_q = None
+            if self.real_time and self.u_stamp is not None and self.u_stamp < self.sim.time - 1e-6:
+                self.stale_command_steps += 1           # the answer to the last state is not here
+                missed = True
             self.sim.step(self.u, self.nstep)
         self.k += 1
+        if missed and self.commands and self.real_time:
+            self.missed_steps += 1
         if self.sim.slack().any():
             self.slack_steps += 1
         self.publish_state()
+        self.latency.append(time.perf_counter() - t0)
+        if len(self.latency) > 100000:
+            del self.latency[:50000]
         if self.duration and self.sim.time >= self.duration:
             self.done = True
 
