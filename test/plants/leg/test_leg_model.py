@@ -122,7 +122,8 @@ def test_b5_e1_frozen_length_guard():
     lo = [e for e in ref.events if e[1] == "liftoff"]
     assert lo[0][2] == pytest.approx(0.2658, abs=5e-4)
     assert lo[0][3] < 0.0  # lift-off by F_GRF = 0 while still moving down, below z_td (E1)
-    nxt = [e for e in ref.events if e[1] == "touchdown" and e[0] > lo[0][0]][0]
+    nxt = ref.events[ref.events.index(lo[0]) + 1]
+    assert nxt[1] == "touchdown"
     assert nxt[2] == pytest.approx(lo[0][2], abs=1e-6)  # touch-down at the frozen length
     t = np.arange(0, ref.t_end, 1e-3)
     z, _, _ = ref.sample(t)

@@ -32,7 +32,7 @@ class ReferenceResult:
         t = np.asarray(t, float)
         z, zd, ph = np.full(t.shape, np.nan), np.full(t.shape, np.nan), np.zeros(t.shape, int)
         for t0, t1, phase, sol in self.segments:
-            sel = (t >= t0) & (t <= t1)
+            sel = (t >= t0 - 1e-9) & (t <= t1 + 1e-9)
             if sel.any():
                 y = sol(t[sel])
                 z[sel], zd[sel], ph[sel] = y[0], y[1], phase

@@ -153,6 +153,11 @@ class LegSim:
             f_in = self.f_in = input_force(tau, z0, p)
             base = spring_force(z0, p) - p.d_s * zd0          # F_GRF - F_in (eq. 25)
             g0 = min((f_in + base) / p.k, p.z_td - z0)        # lift-off guard
+            if g0 < 0.0 and not self._fresh_stance:
+                # the new ZOH input sample itself drives F_GRF below 0: lift off at the sample
+                self._switch()
+                stance, zd0 = False, float(v[0])
+        if stance:
             d.ctrl[0] = f_in
             d.qfrc_applied[0] = base - (p.Fc * ((zd0 > 0) - (zd0 < 0)) if p.Fc else 0.0)
         else:
