@@ -112,7 +112,9 @@ def _sign(x):
 
 def input_force(tau, z, p: LegParams):
     """F_in = tau / (2 L sin theta), theta = acos(z / 2L) (003 eq. 2-3), N. ``tau`` in N m."""
-    return tau / (4.0 * p.L * p.L - z * z) ** 0.5
+    d = 4.0 * p.L * p.L - z * z  # (2 L sin theta)^2; <= 0 only above the fully extended leg
+    d = (d if d > 1e-12 else 1e-12) if type(d) is float else np.maximum(d, 1e-12)
+    return tau / d ** 0.5
 
 
 def spring_force(z, p: LegParams):

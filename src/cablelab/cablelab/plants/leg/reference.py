@@ -121,3 +121,25 @@ def run_reference(p: LegParams, z0: float, zd0: float, duration: float, T: float
             break
     events.sort(key=lambda e: e[0])
     return ReferenceResult(segments, events, t)
+
+
+def sampled_trajectory(p: LegParams, z0: float, zd0: float, duration: float, T: float = 0.0,
+                       P: float = 0.3, dt: float = 1e-3, *, resolution: float = 9e-5,
+                       seed: int | None = 0, rtol: float | None = None):
+    """The reference solution sampled at ``dt`` like the hardware (continuous eq. 26 torque,
+    sampled; 0.09 mm encoder, differentiated velocity, contact switch) as a
+    :class:`~cablelab.plants.leg.sim.Trajectory`: data for tests that the MuJoCo code did not
+    generate."""
+    from .sim import Trajectory, measure
+
+    ref = run_reference(p, z0, zd0, duration, T, P)
+    t = np.arange(0.0, ref.t_end + 1e-12, dt)
+    z, zd, ph = ref.sample(t)
+    td = np.array([e[0] for e in ref.events if e[1] == "touchdown"])
+    k = np.searchsorted(td, t, side="right") - 1
+    t_d = np.where(k >= 0, td[np.maximum(k, 0)], 0.0)
+    tau = np.where(ph == 1, T * np.sin(2 * np.pi * (t - t_d) / P), 0.0)
+    f_in = np.where(ph == 1, tau / np.sqrt(4 * p.L**2 - z * z), 0.0)
+    g = np.where(ph == 1, f_in + p.k * (p.spring_rest - z) + p.F0 - p.d_s * zd, 0.0)
+    traj = Trajectory(t, z, zd, ph, tau, f_in, g, [])
+    return measure(traj, resolution=resolution, seed=seed)

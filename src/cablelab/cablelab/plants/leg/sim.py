@@ -38,11 +38,11 @@ def build_model(p: LegParams, dt: float = DT) -> mujoco.MjModel:
     """The MuJoCo model: body on a vertical slide joint, one force motor, Euler at ``dt``."""
     xml = f"""
 <mujoco model="leg">
-  <option timestep="{dt!r}" gravity="0 0 {-p.g!r}" integrator="Euler"/>
+  <option timestep="{float(dt)!r}" gravity="0 0 {-float(p.g)!r}" integrator="Euler"/>
   <worldbody>
     <body name="body">
       <joint name="hop" type="slide" axis="0 0 1" limited="false"/>
-      <inertial pos="0 0 0" mass="{p.m!r}" diaginertia="1e-6 1e-6 1e-6"/>
+      <inertial pos="0 0 0" mass="{float(p.m)!r}" diaginertia="1e-6 1e-6 1e-6"/>
     </body>
   </worldbody>
   <actuator>
@@ -82,7 +82,8 @@ class LegSim:
         self._q[0] = z
         self._v[0] = zd
         self.phase = (STANCE if z < params.z_td else FLIGHT) if phase is None else phase
-        self.l_fl = params.z_td
+        # leg length frozen in flight (E1); a flight started below z_td lifted off there or lower
+        self.l_fl = min(params.z_td, float(z))
         self.t_d = 0.0  # last touch-down time (eq. 26)
         self.events: list[Event] = []
         self.f_in = 0.0
