@@ -226,7 +226,7 @@ def parse_description(data: Any, source: str = "description") -> Description:
     plant = data["plant"]
     if plant not in PLANTS:
         raise _fail("plant", f"unknown plant {plant!r} (expected one of {', '.join(PLANTS)})")
-    if plant in _SECTIONS and plant not in data:
+    if (plant in _SECTIONS or plant == "leg") and plant not in data:
         raise _fail(plant, "missing required key (the section of the plant named by 'plant')")
     name = data.get("name", "")
     if name is None:
@@ -242,6 +242,9 @@ def parse_description(data: Any, source: str = "description") -> Description:
                 kwargs[key] = _SECTIONS[key](data[key])
             else:
                 extra[key] = _mapping(data[key], key)
+                if key == "leg":  # temporary wiring (branch leg): validate the section at load
+                    from .plants.leg.description import parse_section
+                    parse_section(data[key])
     return Description(plant=plant, name=name, gravity=gravity, extra=extra, **kwargs)
 
 

@@ -38,6 +38,14 @@ PLANT_TOPICS: dict[str, dict[str, str]] = {
         "/axis/parameter_estimate": "std_msgs/msg/Float64MultiArray",
         "/axis/ground_truth/joint_states": "sensor_msgs/msg/JointState",
     },
+    "leg": {  # spec 003_leg.md sec. 5
+        "/leg/joint_states": "sensor_msgs/msg/JointState",
+        "/leg/contact": "sensor_msgs/msg/JointState",
+        "/leg/reference": "trajectory_msgs/msg/JointTrajectory",
+        "/leg/effort_commands": "std_msgs/msg/Float64MultiArray",
+        "/leg/hop_estimate": "sensor_msgs/msg/JointState",
+        "/leg/ground_truth/state": "sensor_msgs/msg/JointState",
+    },
 }
 
 

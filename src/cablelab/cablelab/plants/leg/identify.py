@@ -38,6 +38,9 @@ FILTER_HZ, FILTER_ORDER = 15.0, 3
 #: shortest phase segment used in a fit, s (E1 micro-flights of a few samples carry no information)
 MIN_SEGMENT_S = 0.04
 
+#: optimiser iterations of each CV fold started from the all-data fit (``warm``)
+WARM_FOLD_ITER = 2
+
 #: proposed physical bounds (spec sec. 6)
 BOUNDS = {"m": (1.0, 2.5), "d_s": (0.0, 30.0), "d_f": (0.0, 10.0), "beta_td": (0.2, 1.0),
           "beta_lo": (0.8, 1.5)}
@@ -299,7 +302,7 @@ def cross_validate(segs, simulate, base: LegParams, names, k: int, name: str, ma
     for f in _folds(len(segs), k):
         train = [s for i, s in enumerate(segs) if i not in set(f)]
         val = [segs[i] for i in f]
-        pv = _fit(train, simulate, base, names, max_iter if not warm else 3, x0)
+        pv = _fit(train, simulate, base, names, max_iter if not warm else WARM_FOLD_ITER, x0)
         fits.append(pv)
         mets.append(segment_metrics(val, simulate(val, [base.replace(**pv)])[0]))
     params = {n: float(np.mean([f[n] for f in fits])) for n in names}
