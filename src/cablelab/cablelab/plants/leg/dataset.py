@@ -97,7 +97,7 @@ def dataset(bag, description, options: dict | None = None) -> Dataset:
     tau = js.effort[:, js.names.index("motor")] if "motor" in js.names else np.zeros_like(z)
     tau = np.nan_to_num(tau)
     contact = None
-    if bag.has_topic("/leg/contact") if hasattr(bag, "has_topic") else False:
+    if bag.has("/leg/contact"):
         c = bag.joint_state("/leg/contact")
         contact = np.interp(js.t, c.t, c.position[:, 0]) > 0.5
     if contact is None:

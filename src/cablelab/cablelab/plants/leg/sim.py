@@ -270,3 +270,27 @@ def measure(traj: Trajectory, *, resolution: float = 9e-5, contact_delay: float 
         contact = np.concatenate([np.full(shift, contact[0]), contact[:-shift]]) if shift else contact
     traj.z_meas, traj.zd_meas, traj.contact = zq, zdq, contact
     return traj
+
+
+def write_bag(path, traj: Trajectory, description_yaml: str, *, contact: bool = True,
+              overwrite: bool = False) -> None:
+    """Write a simulated run as a contract bag (spec sec. 5 ``/leg/*`` topics, /clock,
+    /plant_description): measured height (encoder) and velocity, motor torque, the contact switch
+    (unless ``contact=False``: a bag without one) and the simulation truth."""
+    from ...bags import BagWriter
+
+    with BagWriter(path, overwrite=overwrite) as w:
+        w.write_description(description_yaml)
+        w.write_clock(traj.t)
+        n = len(traj.t)
+        theta = np.arccos(np.clip(traj.z_meas / (2 * 0.15), -1, 1))
+        w.write_joint_states("/leg/joint_states", traj.t, ("body", "motor"),
+                             position=np.c_[traj.z_meas, theta], velocity=np.c_[traj.zd_meas, np.zeros(n)],
+                             effort=np.c_[traj.f_in, traj.tau])
+        if contact:
+            w.write_joint_states("/leg/contact", traj.t, ("contact",), position=traj.contact[:, None])
+        w.write_float_arrays("/leg/effort_commands", traj.t, traj.tau[:, None])
+        w.write_joint_states("/leg/ground_truth/state", traj.t, ("height", "phase", "grf"),
+                             position=np.c_[traj.z, traj.phase, np.zeros(n)],
+                             velocity=np.c_[traj.zd, np.zeros(n), np.zeros(n)],
+                             effort=np.c_[np.zeros(n), np.zeros(n), traj.grf])
