@@ -139,7 +139,7 @@ def sampled_trajectory(p: LegParams, z0: float, zd0: float, duration: float, T: 
     k = np.searchsorted(td, t, side="right") - 1
     t_d = np.where(k >= 0, td[np.maximum(k, 0)], 0.0)
     tau = np.where(ph == 1, T * np.sin(2 * np.pi * (t - t_d) / P), 0.0)
-    f_in = np.where(ph == 1, tau / np.sqrt(4 * p.L**2 - z * z), 0.0)
+    f_in = np.where(ph == 1, tau / np.sqrt(np.maximum(4 * p.L**2 - z * z, 1e-12)), 0.0)
     g = np.where(ph == 1, f_in + p.k * (p.spring_rest - z) + p.F0 - p.d_s * zd, 0.0)
     traj = Trajectory(t, z, zd, ph, tau, f_in, g, [])
     return measure(traj, resolution=resolution, seed=seed)
