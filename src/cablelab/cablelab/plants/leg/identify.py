@@ -99,6 +99,24 @@ def start_state(t: np.ndarray, z: np.ndarray, a: int, n_fit: int = 25, order: in
     return float(c[0]), float(c[1])
 
 
+def impact_ratio_estimates(records: list[HopRecord], n_fit: int = 12) -> dict:
+    """Direct estimates of beta_td and beta_lo (003 eq. 24): median over the contact-switch edges
+    of zdot+ / zdot-, each from a quadratic fit of the encoder height on its side of the edge
+    (edges with |zdot-| < 0.1 m/s are skipped: the ratio is undefined there). The start of the
+    stage-3 fit."""
+    ratios = {"beta_td": [], "beta_lo": []}
+    for r in records:
+        runs = phase_runs(r.contact)
+        for (a0, b0, _), (a, b, ph) in zip(runs[:-1], runs[1:]):
+            if b0 - a0 < n_fit or b - a < n_fit:
+                continue
+            _, vm = start_state(r.t, r.z, a - 1, n_fit, 2, forward=False)
+            _, vp = start_state(r.t, r.z, a, n_fit, 2, forward=True)
+            if abs(vm) > 0.1:
+                ratios["beta_td" if ph == STANCE else "beta_lo"].append(vp / vm)
+    return {k: float(np.clip(np.median(v), *BOUNDS[k])) for k, v in ratios.items() if v}
+
+
 def record_from_trajectory(traj) -> HopRecord:
     """A :class:`HopRecord` of the measured signals of a simulated
     :class:`~cablelab.plants.leg.sim.Trajectory`."""
@@ -396,6 +414,7 @@ def identify(records: list[HopRecord], base: LegParams | None = None, *, folds=(
                         ("m", "d_s"), folds[1], "stance", max_iter, warm=True)
     lap("stance")
     im_base = st_base.replace(**st.params)
+    im_base = im_base.replace(**impact_ratio_estimates(records))
     strides_ = stride_segments(records)
     im = cross_validate(strides_, simulate_strides, im_base, ("beta_td", "beta_lo"), folds[2], "impact",
                         max_iter, warm=True)

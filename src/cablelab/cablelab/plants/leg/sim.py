@@ -27,6 +27,7 @@ import mujoco
 import numpy as np
 
 from .hybrid import (FLIGHT, LIFTOFF, STANCE, TOUCHDOWN, LegParams, flight_accel, grf, input_force,
+                     stance_accel,
                      liftoff_guard, liftoff_map, spring_force, touchdown_map)
 
 __all__ = ["LegSim", "Trajectory", "Event", "build_model", "simulate", "open_loop", "measure"]
@@ -79,9 +80,13 @@ class LegSim:
         self.model = build_model(params, dt)
         self.data = mujoco.MjData(self.model)
         self._q, self._v = self.data.qpos, self.data.qvel  # cached views (hot loop)
-        self._q[0] = z
-        self._v[0] = zd
         self.phase = (STANCE if z < params.z_td else FLIGHT) if phase is None else phase
+        self._q[0] = z
+        # MuJoCo's semi-implicit Euler is a leapfrog whose velocity lives half a step after the
+        # position it moves; starting it from zdot(t0 - dt/2) makes the positions second order
+        # (removes the g t dt / 2 free-fall lag of a start from zdot(t0))
+        a0 = stance_accel(z, zd, 0.0, params) if self.phase == STANCE else flight_accel(zd, params)
+        self._v[0] = zd - 0.5 * dt * a0
         # leg length frozen in flight (E1); a flight started below z_td lifted off there or lower
         self.l_fl = min(params.z_td, float(z))
         self.t_d = 0.0  # last touch-down time (eq. 26)
