@@ -87,6 +87,22 @@ def main() -> int:
         for name in ("m", "d_s", "d_f", "beta_td", "beta_lo"):
             bench.row(param=name, true=getattr(p, name), identified=getattr(q, name),
                       error_pct=100 * (getattr(q, name) / getattr(p, name) - 1))
+        bench.section("validation (Table 1 format: CV mean NMSE %, MAE mm or mm/s; Fig. 9, Fig. 11)")
+        for label, st in (("stance", res.stance), ("flight", res.flight)):
+            for ch in ("pos", "vel"):
+                mm = st.metrics
+                bench.row(phase=f"{label} {'position' if ch == 'pos' else 'velocity'}",
+                          nmse_pct=100 * float(np.mean(mm["nmse_" + ch])), mae=1e3 * float(np.mean(mm["mae_" + ch])),
+                          max_abs=1e3 * float(np.mean(mm["max_" + ch])))
+        sm = res.stride_metrics
+        bench.row(phase="whole stride position", nmse_pct=100 * float(np.mean(sm["nmse_pos"])),
+                  mae=1e3 * float(np.mean(sm["mae_pos"])), max_abs=1e3 * float(np.mean(sm["max_pos"])))
+        bench.row(phase="whole stride velocity", nmse_pct=100 * float(np.mean(sm["nmse_vel"])),
+                  mae=1e3 * float(np.mean(sm["mae_vel"])), max_abs=1e3 * float(np.mean(sm["max_vel"])))
+        for key in ("full", "no_impact"):
+            a = res.apex[key]
+            bench.row(phase=f"apex MAE, {'with' if key == 'full' else 'without'} impact map",
+                      height_mm=1e3 * float(np.mean(a["height"])), time_ms=1e3 * float(np.mean(a["time"])))
     bench.done()
     return 0
 
