@@ -117,6 +117,27 @@ def impact_ratio_estimates(records: list[HopRecord], n_fit: int = 12) -> dict:
     return {k: float(np.clip(np.median(v), *BOUNDS[k])) for k, v in ratios.items() if v}
 
 
+def stance_linear_estimate(records: list[HopRecord], p: LegParams, guard: int = 30,
+                           cutoff_hz: float = 40.0) -> dict:
+    """m and d_s by linear least squares on the stance samples (003 eq. 1 as an inverse model:
+    ``F_in + k (z_0 - z) = m (zdd + g) + d_s zdot``, derivatives of the 40 Hz zero-phase filtered
+    height, ``guard`` samples from every contact edge skipped). The start of the stage-2 fit."""
+    from ...conditioning import derivatives
+
+    rows, rhs = [], []
+    for r in records:
+        fs = 1.0 / float(np.median(np.diff(r.t)))
+        _, zd, zdd = derivatives(r.z, fs, cutoff_hz, 4)
+        for a, b in segments(r.contact, STANCE, guard):
+            sl = slice(a, b)
+            rows.append(np.c_[zdd[sl] + p.g, zd[sl]])
+            rhs.append(input_force(r.tau[sl], r.z[sl], p) + p.k * (p.spring_rest - r.z[sl]) + p.F0)
+    if not rows:
+        return {}
+    (m, d_s), *_ = np.linalg.lstsq(np.concatenate(rows), np.concatenate(rhs), rcond=None)
+    return {"m": float(np.clip(m, *BOUNDS["m"])), "d_s": float(np.clip(d_s, *BOUNDS["d_s"]))}
+
+
 def record_from_trajectory(traj) -> HopRecord:
     """A :class:`HopRecord` of the measured signals of a simulated
     :class:`~cablelab.plants.leg.sim.Trajectory`."""
@@ -410,6 +431,7 @@ def identify(records: list[HopRecord], base: LegParams | None = None, *, folds=(
                         folds[0], "flight", max_iter, warm=True)
     lap("flight")
     st_base = start.replace(d_f=fl.params["d_f"])
+    st_base = st_base.replace(**stance_linear_estimate(records, st_base))
     st = cross_validate(phase_segments(records, STANCE, base), simulate_phase_segments, st_base,
                         ("m", "d_s"), folds[1], "stance", max_iter, warm=True)
     lap("stance")
