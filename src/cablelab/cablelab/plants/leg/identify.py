@@ -221,9 +221,22 @@ def _initial_state(model, z0: float, zd0: float) -> np.ndarray:
     return x
 
 
-def simulate_phase_segments(segs: list[Segment], param_sets: list[LegParams], dt: float = DT) -> np.ndarray:
+def simulate_phase_segments(segs: list[Segment], param_sets: list[LegParams], dt: float = DT,
+                            buckets: int = 4) -> np.ndarray:
     """(k, S, n_max, 2) simulated [z, zdot] of every segment for every parameter set (NaN past a
-    segment's end), one :func:`mujoco.rollout.rollout` batch (003 eq. 27)."""
+    segment's end) by :func:`mujoco.rollout.rollout` (003 eq. 27); the segments are rolled out in
+    ``buckets`` batches of similar length (padding every segment to the longest one cost 4x)."""
+    lens = np.array([s.n for s in segs])
+    out = np.full((len(param_sets), len(segs), int(lens.max()), 2), np.nan)
+    order = np.argsort(lens)
+    for grp in np.array_split(order, min(buckets, len(segs))):
+        if len(grp):
+            sub = _rollout_segments([segs[i] for i in grp], param_sets, dt)
+            out[:, grp, : sub.shape[2]] = sub
+    return out
+
+
+def _rollout_segments(segs: list[Segment], param_sets: list[LegParams], dt: float) -> np.ndarray:
     import mujoco.rollout
 
     n_max = max(s.n for s in segs)
@@ -239,6 +252,8 @@ def simulate_phase_segments(segs: list[Segment], param_sets: list[LegParams], dt
             # measured torque is known at the samples only; trapezoid = 2nd order)
             u[: s.n - 1] = 0.5 * (s.f_in[:-1] + s.f_in[1:]) + (p.F0 if s.phase == STANCE else 0.0)
             ctrl.append(u)
+    if n_max < 2:
+        return np.array(x0)[:, None, 1:3].reshape(len(param_sets), len(segs), 1, 2)
     data = [mujoco.MjData(models[0]) for _ in range(2)]
     state, _ = mujoco.rollout.rollout(models, data, np.array(x0), np.array(ctrl)[:, :, None])
     # FULLPHYSICS state = [time, qpos, qvel, ...]; row j is the state after step j + 1
