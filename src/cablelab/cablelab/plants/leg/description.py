@@ -1,0 +1,70 @@
+"""The ``leg:`` section of the plant description (spec 003_leg.md sec. 5, CONTRACT section 3).
+
+``parse_section(obj)`` validates the mapping and returns a :class:`LegDescription`; every problem is
+a one-line :class:`~cablelab.errors.CablelabError` naming the key (``leg.link_length: missing
+required key``). :meth:`LegDescription.params` gives the :class:`~.hybrid.LegParams` with the
+nominal 003 Table 2 effect parameters.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ...description import _check_keys, _fail, _mapping, _number
+from .hybrid import LegParams
+
+REQUIRED = ("spring_stiffness", "link_length")
+OPTIONAL = ("mass", "free_angle", "spring_rest", "spring_preload", "encoder_resolution")
+
+
+@dataclass(frozen=True)
+class LegDescription:
+    """Hopping leg of 003 (SI): k (N/m), L (m), theta_0 (rad), m (kg), z_0 (m), F_0 (N)."""
+
+    spring_stiffness: float
+    link_length: float
+    mass: float = 1.55
+    free_angle: float = 0.349066
+    spring_rest: float | None = None
+    spring_preload: float = 0.0
+    encoder_resolution: float = 9.0e-5
+
+    def params(self, gravity: float = 9.81, **effects) -> LegParams:
+        """Model parameters: this description + Table 2 nominal d_s, d_f, betas (or ``effects``)."""
+        return LegParams(m=self.mass, k=self.spring_stiffness, g=gravity, L=self.link_length,
+                         theta0=self.free_angle, z0=self.spring_rest, F0=self.spring_preload, **effects)
+
+
+def parse_section(obj) -> LegDescription:
+    """Validate the ``leg:`` mapping (required: spring_stiffness, link_length)."""
+    path = "leg"
+    obj = _mapping(obj, path)
+    _check_keys(obj, path, REQUIRED, OPTIONAL)
+    L = _number(obj, "link_length", path, positive=True)
+    theta0 = _number(obj, "free_angle", path, positive=True, default=0.349066)
+    if theta0 >= 1.5707963:
+        raise _fail("leg.free_angle", f"expected an angle below pi/2 rad, got {theta0:g}")
+    rest = _number(obj, "spring_rest", path, positive=True)
+    if rest is not None and rest >= 2 * L:
+        raise _fail("leg.spring_rest", f"expected a height below the fully extended leg 2 L = {2 * L:g} m, got {rest:g}")
+    return LegDescription(
+        spring_stiffness=_number(obj, "spring_stiffness", path, positive=True),
+        link_length=L,
+        mass=_number(obj, "mass", path, positive=True, default=1.55),
+        free_angle=theta0,
+        spring_rest=rest,
+        spring_preload=_number(obj, "spring_preload", path, nonneg=True, default=0.0),
+        encoder_resolution=_number(obj, "encoder_resolution", path, nonneg=True, default=9.0e-5),
+    )
+
+
+def leg_of(description) -> LegDescription:
+    """The :class:`LegDescription` of a loaded description (parsed section or raw ``extra``)."""
+    from ...errors import CablelabError
+
+    leg = getattr(description, "leg", None)
+    if leg is None:
+        raw = getattr(description, "extra", {}).get("leg")
+        if raw is None:
+            raise CablelabError("leg: missing required key (the section of the plant named by 'plant')")
+        leg = parse_section(raw)
+    return leg

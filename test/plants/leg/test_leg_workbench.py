@@ -1,0 +1,73 @@
+"""Workbench on leg bags (spec 003_leg.md sec. 7, B7 diagnose part): data from the MuJoCo plant
+with the impact map and a 2.7 N spring preload hidden; ``diagnose --greedy`` on the 003 model
+without impact must add ``impact_restitution`` then ``spring_preload`` and the error must fall.
+The workbench fit is the linear inverse model of plants/leg/dataset.py, which shares no code with
+the hybrid simulator that made the data."""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import pytest
+
+import cablelab.plants.leg as leg_pkg
+from cablelab.description import load_description
+from cablelab.plants.leg.hybrid import LegParams
+from cablelab.plants.leg.sim import simulate, write_bag
+from cablelab.workbench import build_model, diagnose, load
+
+DESC = Path(leg_pkg.__file__).parent / "data" / "leg.yaml"
+TRUE = LegParams(F0=2.7)
+SCHEDULE = [(1.5, 0.30), (2.5, 0.35), (3.0, 0.30), (2.0, 0.35), (2.5, 0.30)]  # (T N m, P s), 4 s each
+
+
+def _law(t, sim):
+    T, P = SCHEDULE[min(int(t // 4.0), len(SCHEDULE) - 1)]
+    return T * math.sin(2 * math.pi * (t - sim.t_d) / P)
+
+
+@pytest.fixture(scope="module")
+def traj():
+    return simulate(TRUE, TRUE.z_td + 0.03, 0.0, 20.0, _law)
+
+
+@pytest.fixture(scope="module")
+def bag(traj, tmp_path_factory):
+    path = tmp_path_factory.mktemp("leg") / "hidden"
+    write_bag(path, traj, DESC.read_text())
+    return path
+
+
+def test_greedy_adds_impact_then_preload(bag):
+    plant, desc, ds = load(bag)
+    assert plant.name == "leg" and ds.n > 19000
+    out = diagnose(ds, build_model(plant, desc), plant.candidates(desc), greedy_mode=True)
+    steps = out["greedy"]
+    assert [s["added"] for s in steps[1:3]] == ["impact_restitution", "spring_preload"]
+    errs = [s["error"] for s in steps]
+    assert errs[1] < 0.5 * errs[0] and errs[2] < errs[1]
+    assert out["ranking"][0]["effect"] == "impact_restitution" and out["ranking"][0]["significant"]
+    p = steps[2]["params"]
+    beta_td, beta_lo = 1 - p["c_td"] / p["m"], 1 - p["c_lo"] / p["m"]
+    assert beta_td == pytest.approx(TRUE.beta_td, rel=0.05)
+    assert beta_lo == pytest.approx(TRUE.beta_lo, rel=0.05)
+    assert p["F0"] == pytest.approx(2.7, rel=0.10)
+    assert p["m"] == pytest.approx(TRUE.m, rel=0.02)
+
+
+def test_bag_without_contact_falls_back_to_height_and_says_so(traj, tmp_path, capsys):
+    path = tmp_path / "nocontact"
+    write_bag(path, traj, DESC.read_text(), contact=False)
+    _, _, ds = load(path)
+    err = capsys.readouterr().err
+    assert "no /leg/contact" in err and "height" in err
+    agree = (ds.signals["contact"] == traj.phase).mean()
+    assert agree > 0.98
+
+
+def test_description_without_link_length_fails_in_one_line(tmp_path):
+    bad = DESC.read_text().replace("  link_length: 0.15", "")
+    from cablelab.errors import CablelabError
+
+    with pytest.raises(CablelabError, match=r"leg\.link_length: missing required key"):
+        load_description(bad)
