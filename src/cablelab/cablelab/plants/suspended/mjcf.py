@@ -51,8 +51,9 @@ def effective_cable_inertias(p: VirtualParams) -> tuple[list, dict]:
     """MuJoCo-valid inertia diagonals of links 7-9 and the armature they move to J7-J9.
 
     Link 7 turns only about z, so only its i_zz enters: diag(i_zz/2, i_zz/2, i_zz). On links 8
-    and 9 an axis whose value exceeds the sum of the other two is lowered to that sum (/1.0001)
-    and the excess goes to the armature of the cable joint about that axis (spec sec. 4.2, D8).
+    and 9 an axis whose value exceeds the sum of the other two is lowered to that sum (x (1 - 1e-6))
+    and the excess goes to the armature of the cable joint about that axis (spec sec. 4.2, D8);
+    each axis is floored at 1e-5 kg m^2.
 
     Raises:
         CablelabError: ``inertia_fix="none"`` and a tensor breaks the triangle inequality.
@@ -68,16 +69,16 @@ def effective_cable_inertias(p: VirtualParams) -> tuple[list, dict]:
     if p.inertia_fix != "armature":
         raise CablelabError(f"suspended inertia_fix: unknown value {p.inertia_fix!r} (armature | none)")
     arm = {"J7": 0.0, "J8": 0.0, "J9": 0.0}
-    izz = diags[0][2]
+    izz = max(diags[0][2], 2e-5)
     out = [np.array([izz / 2, izz / 2, izz])]
     for d in diags[1:]:
-        d = d.copy()
-        for ax in range(3):
-            others = d.sum() - d[ax]
-            if d[ax] > others:
-                new = others / 1.0001
-                arm[_CABLE_JOINT_OF_AXIS[ax]] += d[ax] - new
-                d[ax] = new
+        d = np.maximum(d, 1e-5)            # MuJoCo needs > 0; 1e-5 kg m^2 floor
+        ax = int(np.argmax(d))             # only the largest axis can break A + B >= C
+        others = d.sum() - d[ax]
+        if d[ax] > others:
+            new = others * (1 - 1e-6)
+            arm[_CABLE_JOINT_OF_AXIS[ax]] += d[ax] - new
+            d[ax] = new
         out.append(d)
     return out, arm
 
