@@ -103,12 +103,16 @@ def _arm_xml(p: VirtualParams, side: str, indent: str, frozen: bool = False) -> 
     return "\n".join(parts + close[::-1])
 
 
-def _actuators(p: VirtualParams, frozen: bool = False) -> str:
+def _actuators(p: VirtualParams, frozen: bool = False, motors: bool = False) -> str:
     lines = []
     if frozen:
         return ""
     for side in ("left", "right"):
         for i, a in enumerate(p.arm):
+            if motors:   # torque inputs (N m) for an external controller, saturated at the limit
+                lines.append(f'<motor name="{side}_{i + 1}" joint="{side}_{i + 1}" '
+                             f'ctrlrange="{-a.effort!r} {a.effort!r}"/>')
+                continue
             lines.append(f'<position name="{side}_{i + 1}" joint="{side}_{i + 1}" kp="{a.kp!r}" '
                          f'kv="{a.kd!r}" forcerange="{-a.effort!r} {a.effort!r}"/>')
     return "\n    ".join(lines)
@@ -224,7 +228,7 @@ def levelling_ctrl(p: VirtualParams, qpos_J, qvel_J) -> np.ndarray:
 
 def truth_xml(p: VirtualParams, *, platform_mass: float = 0.7, cable_separation: float = 0.25,
               timestep: float = 1e-3, integrator: str = "implicitfast", cable_elasticity=None,
-              coulomb=None) -> str:
+              arm_motors: bool = False) -> str:
     """MJCF of the physical truth plant.
 
     LiCAS: free platform (``platform_mass`` kg, inertia I10 of 000 Table 3) with the arms, hung by
@@ -233,8 +237,8 @@ def truth_xml(p: VirtualParams, *, platform_mass: float = 0.7, cable_separation:
     spring-damper (default k_c = 2e5 N/m, c_c = 2e3 N s/m).
 
     Args:
-        coulomb: LiCAS only: ``(f_x, f_y)`` Coulomb friction, N, on the platform's horizontal
-            motion, the hidden cable effect of the diagnosis tests (None = off).
+        arm_motors: arms driven by torque motors (ctrl = N m, for :mod:`.controller`) instead of
+            the repo position servos.
     """
     if p.variant == "cranebot":
         return virtual_xml(p, cable_elasticity=cable_elasticity or (2e5, 2e3), timestep=timestep,
@@ -267,7 +271,7 @@ def truth_xml(p: VirtualParams, *, platform_mass: float = 0.7, cable_separation:
     {tend}
   </tendon>
   <actuator>
-    {_actuators(p)}
+    {_actuators(p, motors=arm_motors)}
   </actuator>
   <sensor>
     <framepos objtype="site" objname="platform"/>

@@ -28,7 +28,8 @@ STATE_SPEC = mujoco.mjtState.mjSTATE_FULLPHYSICS
 
 @dataclass
 class Run:
-    """A simulated run: ``t`` (N,) s, ``pos`` (N, 3) m, ``quat`` (N, 4) w x y z, ``qpos`` (N, nq)."""
+    """A simulated run: ``t`` (N,) s, ``pos`` (N, 3) m, ``quat`` (N, 4) w x y z, ``qpos`` (N, nq),
+    all of the same instants."""
 
     t: np.ndarray
     pos: np.ndarray
@@ -84,7 +85,7 @@ def simulate(model: mujoco.MjModel | list, x0, duration: float, ctrl=None, *, nt
         model: one model or a list (one per run, same sizes). x0: (nstate,) or (k, nstate).
         duration: s. ctrl: None (zeros), (nu,), (nstep, nu) or (k, nstep, nu) actuator ctrl.
     Returns:
-        list of :class:`Run` (samples after each step, t = dt .. duration).
+        list of :class:`Run` (t = 0 .. duration - dt; pose sensors and qpos of the same instant).
     """
     models = model if isinstance(model, (list, tuple)) else [model]
     m0 = models[0]
@@ -105,9 +106,13 @@ def simulate(model: mujoco.MjModel | list, x0, duration: float, ctrl=None, *, nt
     datas = [mujoco.MjData(m0) for _ in range(max(1, nthread))]
     state, sens = mujoco.rollout.rollout(models, datas, np.broadcast_to(x0, (k, x0.shape[1])).copy(),
                                          np.broadcast_to(ctrl, (k,) + ctrl.shape[1:]).copy(), nstep=nstep)
-    t = m0.opt.timestep * np.arange(1, nstep + 1)
+    # rollout's sensordata of step i is computed from the state before that step (mj_forward
+    # runs first): pair it with the state at the same time, t = i dt
+    t = m0.opt.timestep * np.arange(nstep)
     nq = m0.nq
-    return [Run(t, sens[i, :, 0:3], sens[i, :, 3:7], state[i, :, 1:1 + nq]) for i in range(k)]
+    x0b = np.broadcast_to(x0, (k, x0.shape[1]))
+    qpos = np.concatenate([x0b[:, None, 1:1 + nq], state[:, :-1, 1:1 + nq]], axis=1)
+    return [Run(t, sens[i, :, 0:3], sens[i, :, 3:7], qpos[i]) for i in range(k)]
 
 
 def simulate_paper_levelling(model: mujoco.MjModel, p: VirtualParams, x0, duration: float,
@@ -143,11 +148,12 @@ def simulate_paper_levelling(model: mujoco.MjModel, p: VirtualParams, x0, durati
         for i in range(nstep):
             if arm_ids:
                 d.ctrl[arm_ids] = ac[i]
+            qpos[i] = d.qpos
             mujoco.mj_step(model, d)
-            pos[i], quat[i], qpos[i] = d.sensordata[:3], d.sensordata[3:7], d.qpos
+            pos[i], quat[i] = d.sensordata[:3], d.sensordata[3:7]   # of the state before the step
     finally:
         mujoco.set_mjcb_control(None)
-    return Run(model.opt.timestep * np.arange(1, nstep + 1), pos, quat, qpos)
+    return Run(model.opt.timestep * np.arange(nstep), pos, quat, qpos)
 
 
 def outputs(run: Run, S, rest_pos, rest_yaw: float = 0.0) -> np.ndarray:
