@@ -242,6 +242,9 @@ def parse_description(data: Any, source: str = "description") -> Description:
                 kwargs[key] = _SECTIONS[key](data[key])
             else:
                 extra[key] = _mapping(data[key], key)
+    if "suspended" in extra:  # issue 11: validate (the section stays in extra until the restructure)
+        from .plants.suspended.description import parse_section
+        parse_section(extra["suspended"])
     return Description(plant=plant, name=name, gravity=gravity, extra=extra, **kwargs)
 
 

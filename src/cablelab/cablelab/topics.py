@@ -38,6 +38,17 @@ PLANT_TOPICS: dict[str, dict[str, str]] = {
         "/axis/parameter_estimate": "std_msgs/msg/Float64MultiArray",
         "/axis/ground_truth/joint_states": "sensor_msgs/msg/JointState",
     },
+    # issue 11 (spec 000_suspended.md sec. 5); temporary wiring until the plant folder owns it
+    "suspended": {
+        "/suspended/joint_states": "sensor_msgs/msg/JointState",
+        "/suspended/platform_pose": "geometry_msgs/msg/PoseStamped",
+        "/suspended/imu": "sensor_msgs/msg/Imu",
+        "/suspended/reference": "trajectory_msgs/msg/JointTrajectory",
+        "/suspended/effort_commands": "std_msgs/msg/Float64MultiArray",
+        "/suspended/swing_estimate": "sensor_msgs/msg/JointState",
+        "/suspended/ground_truth/swing": "sensor_msgs/msg/JointState",
+        "/suspended/ground_truth/virtual_joints": "sensor_msgs/msg/JointState",
+    },
 }
 
 
