@@ -101,7 +101,7 @@ def run_node(node_factory, args, ros_args: list[str], prog: str) -> int:
 
 
 def plant_main(package: str, argv: list[str] | None, description: str,
-               plants: tuple[str, ...] = ("cdpr", "crane", "axis")) -> int:
+               plants: tuple[str, ...] = ("cdpr", "crane", "axis", "suspended")) -> int:
     """``main`` of a node package: ``--plant P`` selects the module ``<package>.<P>``."""
     argv = list(sys.argv[1:] if argv is None else argv)
     user, ros_args = split_ros_args(argv)

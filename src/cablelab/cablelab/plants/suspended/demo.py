@@ -53,10 +53,12 @@ def run(out_dir: Path, quick: bool = False) -> dict:
     p = parameter_set("licas")
     T = 12.0 if quick else 20.0
     e = _arm_record(p, T)
-    names = ["l9z", "fv8", "kp7", "kp10", "kd10"]
-    start = {"l9z": p.l9z, "fv8": p.fv[1], "kp7": p.kp7, "kp10": p.kp10, "kd10": p.kd10}
-    pear = identify([e], p, names, objective="pearson", start=start, max_iter=4 if quick else 8)
-    nm = identify([e], p, names, objective="nmse", start=pear.values, max_iter=4 if quick else 8)
+    # the cable-link masses are free (Table 5 p_0 = 1 kg, bounds 0-10 kg): the 4-tendon truth
+    # has massless cables, the repo LiCAS set 9.3 kg on links 8-9, which damps the arm-induced
+    # swing to a fifth of the truth's amplitude
+    names = ["m8", "m9", "l9z", "fv8", "kp7", "kp10"]
+    pear = identify([e], p, names, objective="pearson", max_iter=6 if quick else 10)
+    nm = identify([e], p, names, objective="nmse", start=pear.values, max_iter=6 if quick else 10)
     v = validate(nm.params, [e])[0]
     model_max = float(np.max(v["max_abs"][:2]))
     rows = [{"model": "virtual-joint (identified)", "max_error_m": model_max,

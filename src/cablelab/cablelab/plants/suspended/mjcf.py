@@ -139,6 +139,7 @@ def virtual_xml(p: VirtualParams, *, levelling: str = "tendon", cable_elasticity
     if levelling not in ("tendon", "paper"):
         raise CablelabError(f"suspended levelling: unknown value {levelling!r} (tendon | paper)")
     (I7, I8, I9), armature = effective_cable_inertias(p)
+    m7, m8, m9 = (max(float(v), 1e-4) for v in (p.m7, p.m8, p.m9))   # MuJoCo needs mass > 0 (1e-4 kg floor)
     fv, fs = p.fv, p.fs
     lvl_joint = p.level_to_swing and levelling == "tendon"
     lvl_pairs = [(n, a, b, k, c) for n, a, b, k, c in
@@ -169,13 +170,13 @@ def virtual_xml(p: VirtualParams, *, levelling: str = "tendon", cable_elasticity
     <site name="S" pos="{_f(p.S)}"/>
     <body name="link7" pos="{_f(p.S)}">
       {"" if "J7" in lock else f'<joint name="J7" axis="0 0 1" stiffness="{p.kp7!r}" damping="{p.kd7 + fv[0]!r}" frictionloss="{fs[0]!r}" armature="{float(armature["J7"])!r}"/>'}
-      <inertial pos="0 0 {-p.l7z!r}" mass="{p.m7!r}" diaginertia="{_f(I7)}"/>
+      <inertial pos="0 0 {-p.l7z!r}" mass="{m7!r}" diaginertia="{_f(I7)}"/>
       <body name="link8">
         {"" if "J8" in lock else f'<joint name="J8" axis="1 0 0" damping="{fv[1]!r}" frictionloss="{fs[1]!r}" armature="{float(armature["J8"])!r}"/>'}
-        <inertial pos="0 0 {-p.l8z!r}" mass="{p.m8!r}" diaginertia="{_f(I8)}"/>
+        <inertial pos="0 0 {-p.l8z!r}" mass="{m8!r}" diaginertia="{_f(I8)}"/>
         <body name="link9">
           {"" if "J9" in lock else f'<joint name="J9" axis="0 1 0" damping="{fv[2]!r}" frictionloss="{fs[2]!r}" armature="{float(armature["J9"])!r}"/>'}
-          <inertial pos="0 0 {-p.l9z!r}" mass="{p.m9!r}" diaginertia="{_f(I9)}"/>
+          <inertial pos="0 0 {-p.l9z!r}" mass="{m9!r}" diaginertia="{_f(I9)}"/>
           <body name="link10" pos="0 0 {-p.L!r}">
             {slide}
             {"" if "J10" in lock else f'<joint name="J10" axis="0 0 1" stiffness="{p.kp10!r}" damping="{p.kd10!r}"/>'}
