@@ -63,3 +63,66 @@ def test_estimator_node_publishes_swing_and_survives_nan(ros_context):
     ex.shutdown()
     node.destroy_node()
     peer.destroy_node()
+
+
+def test_sim_node_to_estimator_node_chain(ros_context):
+    import rclpy
+    from rclpy.executors import SingleThreadedExecutor
+    from sensor_msgs.msg import JointState
+    from geometry_msgs.msg import PoseStamped
+    from trajectory_msgs.msg import JointTrajectory
+
+    from cablelab.plants.suspended.nodes import make_node
+    from cablelab.plants.suspended.params import parameter_set
+    from cablelab.ros import convert
+    from cablelab.ros.qos import catch_up_qos, publisher_qos
+
+    # LiCAS virtual-joint model (defaults), started displaced via a parameter override
+    sim = make_node_with(make_node, "sim", {"start_swing_x": 0.1})
+    est = make_node("estimator")
+    peer = rclpy.create_node("peer2")
+    poses, truth, estim = [], [], []
+    peer.create_subscription(PoseStamped, "/suspended/platform_pose", poses.append, catch_up_qos())
+    peer.create_subscription(JointState, "/suspended/ground_truth/swing", truth.append, catch_up_qos())
+    peer.create_subscription(JointState, "/suspended/swing_estimate", estim.append, catch_up_qos())
+    ref = peer.create_publisher(JointTrajectory, "/suspended/reference", publisher_qos())
+    ex = SingleThreadedExecutor()
+    for n in (sim, est, peer):
+        ex.add_node(n)
+    deadline = time.monotonic() + 3.0
+    while time.monotonic() < deadline:
+        ex.spin_once(timeout_sec=0.01)
+    ref.publish(convert.joint_trajectory_msg(0.0, ["bogus"], [0.0]))
+    for _ in range(20):
+        ex.spin_once(timeout_sec=0.01)
+    assert len(poses) > 50 and len(truth) > 50 and len(estim) > 30
+    p = parameter_set("licas")
+    d = np.array([[m.pose.position.x, m.pose.position.y, m.pose.position.z] for m in poses]) - p.S
+    assert np.allclose(np.linalg.norm(d, axis=1), p.L, atol=1e-9)          # on the cable sphere
+    sx_truth = {round(convert.from_stamp(m.header.stamp), 6): m.position[0] for m in truth}
+    pairs = [(m.position[0], sx_truth[round(convert.from_stamp(m.header.stamp), 6)]) for m in estim
+             if round(convert.from_stamp(m.header.stamp), 6) in sx_truth]
+    assert len(pairs) > 30 and max(abs(a - b) for a, b in pairs) < 1e-9
+    assert max(abs(b) for _, b in pairs) == pytest.approx(0.1, abs=0.01)
+    assert sim.inputs.status(time.monotonic())[0] >= 1                      # bad reference reported
+    ex.shutdown()
+    for n in (sim, est, peer):
+        n.destroy_node()
+
+
+def make_node_with(make_node, role, overrides):
+    """A node with ROS parameter overrides (as --ros-args -p would give)."""
+    import rclpy.node as rn
+    from rclpy.parameter import Parameter
+
+    orig = rn.Node.__init__
+
+    def init(self, name, *a, **kw):
+        kw.setdefault("parameter_overrides", [Parameter(k, value=v) for k, v in overrides.items()])
+        orig(self, name, *a, **kw)
+
+    rn.Node.__init__ = init
+    try:
+        return make_node(role)
+    finally:
+        rn.Node.__init__ = orig

@@ -1,13 +1,20 @@
 """ROS 2 node adapters of the suspended plant (thin shells over the library).
 
-Only the ``estimator`` role exists so far (``payload_estimator --plant suspended``):
-``/suspended/platform_pose`` -> :class:`~.swing.SwingEstimator` -> ``/suspended/swing_estimate``
-(names swing_x, swing_y, yaw, r_x, r_y; position and velocity), stamped like the pose. NaN,
-wrong-length and frozen-stamp poses are held and counted on /diagnostics. The ``sim`` and
-``controller`` roles are not written yet (their laws: :mod:`.sim`, :mod:`.controller`).
-
-ROS parameters: ``suspension_point`` [x, y, z] m (default: the LiCAS repo set),
-``rest_window`` s, ``velocity_tau`` s, ``pose_timeout`` s wall.
+* ``estimator`` (``payload_estimator --plant suspended``): ``/suspended/platform_pose`` ->
+  :class:`~.swing.SwingEstimator` -> ``/suspended/swing_estimate`` (names swing_x, swing_y, yaw,
+  r_x, r_y; position and velocity), stamped like the pose. NaN, wrong-length and frozen-stamp
+  poses are held and counted on /diagnostics. ROS parameters: ``suspension_point`` [x, y, z] m
+  (default: the LiCAS repo set), ``rest_window`` s, ``velocity_tau`` s, ``pose_timeout`` s wall.
+* ``sim`` (``cable_sim_node --plant suspended``): the virtual-joint model (``model:=virtual``)
+  or the truth plant (``model:=truth``) of ``variant`` in real time; arm position servos follow
+  ``/suspended/reference`` (JointTrajectory, arm joint names; unknown names / wrong lengths are
+  rejected and counted). Publishes ``/suspended/joint_states`` (effort = servo torque),
+  ``/suspended/platform_pose`` (``pose_noise`` m), ``/suspended/ground_truth/swing``,
+  ``/suspended/ground_truth/virtual_joints`` (virtual model), ``/clock``,
+  ``/plant_description``. ROS parameters: ``variant``, ``model``, ``rate`` Hz,
+  ``start_swing_x``, ``start_swing_y``, ``start_yaw`` rad, ``pose_noise`` m.
+  ``/suspended/effort_commands`` (torque control) is not implemented in the node yet.
+* ``controller``: not written yet (its laws: :mod:`.controller`).
 """
 from __future__ import annotations
 
@@ -19,7 +26,7 @@ from .swing import CHANNELS, SwingEstimator
 
 __all__ = ["make_node", "add_arguments", "ROLES"]
 
-ROLES = ("estimator",)
+ROLES = ("estimator", "sim")
 
 
 def _estimator_class():
@@ -70,6 +77,106 @@ def _estimator_class():
     return SuspendedSwingEstimator
 
 
+def _sim_class():
+    import mujoco
+    import numpy as np
+    from geometry_msgs.msg import PoseStamped
+    from rclpy.node import Node
+    from sensor_msgs.msg import JointState
+    from std_msgs.msg import String
+    from trajectory_msgs.msg import JointTrajectory
+
+    from ...description import load_description
+    from ...ros import convert
+    from ...ros.clock import ClockPublisher
+    from ...ros.diagnostics import Diagnostics
+    from ...ros.inputs import InputMonitor
+    from ...ros.qos import DESCRIPTION_QOS, publisher_qos, stream_qos
+    from ...rotations import wxyz_to_xyzw
+    from .bag import description_yaml
+    from .mjcf import VJ, arm_joint_names, build_truth, build_virtual
+    from .sim import STATE_SPEC, initial_state, truth_start
+    from .swing import swing_from_pose
+
+    class SuspendedSimNode(Node):
+        def __init__(self):
+            super().__init__("cable_sim_node")
+            p = self.declare_parameter
+            variant = str(p("variant", "licas").value)
+            self.kind = str(p("model", "virtual").value)
+            self.description = load_description(description_yaml(variant, name=f"simulated {variant}"))
+            self.params = parameter_set(variant)
+            sx, sy, yw = (float(p(k, 0.0).value) for k in ("start_swing_x", "start_swing_y", "start_yaw"))
+            if self.kind == "truth":
+                self.model = build_truth(self.params)
+                x0 = truth_start(self.model, self.params, sx, sy, yw)
+            elif self.kind == "virtual":
+                self.model = build_virtual(self.params)
+                q0 = {"J8": sx, "J9": sy, "J7": yw}
+                if self.params.level_to_swing:
+                    q0.update({"J11": -sx, "J12": -sy})
+                x0 = initial_state(self.model, q0)
+            else:
+                raise CablelabError(f"cable_sim_node suspended: parameter model={self.kind!r} "
+                                    "(expected virtual or truth)")
+            self.data = mujoco.MjData(self.model)
+            mujoco.mj_setState(self.model, self.data, x0, STATE_SPEC)
+            mujoco.mj_forward(self.model, self.data)
+            self.names = list(arm_joint_names(self.params))
+            self.jq = [self.model.joint(n).qposadr[0] for n in self.names]
+            self.jv = [self.model.joint(n).dofadr[0] for n in self.names]
+            self.vq = ([self.model.joint(j).qposadr[0] for j in VJ] if self.kind == "virtual" else [])
+            self.rest = np.array(self.params.S) - [0, 0, self.params.L]
+            self.noise = float(p("pose_noise", 0.0).value)
+            self.rng = np.random.default_rng(0)
+            self.rate = float(p("rate", 100.0).value)
+            self.steps = max(1, int(round(1.0 / (self.rate * self.model.opt.timestep))))
+            self.inputs = InputMonitor()
+            self.inputs.add("reference", timeout=1e9, length=len(self.names))
+            self.pub_js = self.create_publisher(JointState, "/suspended/joint_states", publisher_qos())
+            self.pub_pose = self.create_publisher(PoseStamped, "/suspended/platform_pose", publisher_qos())
+            self.pub_sw = self.create_publisher(JointState, "/suspended/ground_truth/swing", publisher_qos())
+            self.pub_vj = self.create_publisher(JointState, "/suspended/ground_truth/virtual_joints", publisher_qos())
+            self.clock = ClockPublisher(self)
+            self.pub_desc = self.create_publisher(String, "/plant_description", DESCRIPTION_QOS)
+            self.pub_desc.publish(convert.string_msg(self.description.to_yaml()))
+            self.create_subscription(JointTrajectory, "/suspended/reference", self.on_reference, stream_qos())
+            self.diag = Diagnostics(self, update=self.status)
+            self.timer = self.create_timer(1.0 / self.rate, self.tick)
+
+        def status(self):
+            level, msg, values = self.inputs.status(time.monotonic())
+            values["sim time s"] = f"{self.data.time:.3f}"
+            return level, msg, values
+
+        def on_reference(self, msg) -> None:
+            _, names, q, _, _ = convert.joint_trajectory_point(msg)
+            if q is None or names != self.names or len(q) != len(self.names) or not np.all(np.isfinite(q)):
+                self.inputs.accept("reference", None, time.monotonic())
+                return
+            if self.inputs.accept("reference", q, time.monotonic()):
+                self.data.ctrl[:len(q)] = q
+
+        def tick(self) -> None:
+            for _ in range(self.steps):
+                mujoco.mj_step(self.model, self.data)
+            mujoco.mj_forward(self.model, self.data)
+            t = float(self.data.time)
+            pos, quat = self.data.sensordata[:3].copy(), self.data.sensordata[3:7].copy()
+            q, qd = self.data.qpos[self.jq], self.data.qvel[self.jv]
+            eff = self.data.qfrc_actuator[self.jv]
+            self.pub_js.publish(convert.joint_state_msg(t, self.names, q, qd, eff))
+            meas = pos + (self.rng.normal(0, self.noise, 3) if self.noise > 0 else 0.0)
+            self.pub_pose.publish(convert.pose_msg(t, meas, wxyz_to_xyzw(quat[None])[0]))
+            sw = swing_from_pose(pos[None], quat[None], self.params.S, rest_pos=self.rest, rest_yaw=0.0)
+            self.pub_sw.publish(convert.joint_state_msg(t, list(CHANNELS), [float(sw[k][0]) for k in CHANNELS]))
+            if self.vq:
+                self.pub_vj.publish(convert.joint_state_msg(t, list(VJ), self.data.qpos[self.vq]))
+            self.clock.publish(t)
+
+    return SuspendedSimNode
+
+
 def add_arguments(role: str, parser) -> None:
     """No command-line options beyond the ROS parameters."""
 
@@ -78,4 +185,6 @@ def make_node(role: str, args=None):
     """The node of ``role`` (``estimator``)."""
     if role == "estimator":
         return _estimator_class()()
+    if role == "sim":
+        return _sim_class()()
     raise CablelabError(f"suspended: node role {role!r} is not implemented (available: {', '.join(ROLES)})")
