@@ -126,3 +126,66 @@ def make_node_with(make_node, role, overrides):
         return make_node(role)
     finally:
         rn.Node.__init__ = orig
+
+
+def test_controller_node_law_sway_offset_and_bad_input(ros_context):
+    """The controller node answers each joint state with the library law (PD + gravity under the
+    platform attitude + sway offset from the swing estimate), and ignores NaN / wrong-length
+    states. (A closed loop through the in-process executor is not tested: the LiCAS joint 3 has
+    k_d / I ~ 1000 1/s, so the executor's multi-millisecond answer delay destabilises it; the
+    delay-free loop is A10.)"""
+    import rclpy
+    from rclpy.executors import SingleThreadedExecutor
+    from geometry_msgs.msg import PoseStamped
+    from sensor_msgs.msg import JointState
+    from std_msgs.msg import Float64MultiArray
+
+    from cablelab.plants.suspended.controller import ArmGravity, gains, pd_gravity, sway_offset
+    from cablelab.plants.suspended.nodes import make_node
+    from cablelab.plants.suspended.params import parameter_set
+    from cablelab.ros import convert
+    from cablelab.ros.qos import catch_up_qos, publisher_qos
+
+    ctl = make_node_with(make_node, "controller", {"sway_damping": 0.3})
+    peer = rclpy.create_node("peer3")
+    cmds = []
+    peer.create_subscription(Float64MultiArray, "/suspended/effort_commands", cmds.append, catch_up_qos())
+    pj = peer.create_publisher(JointState, "/suspended/joint_states", publisher_qos())
+    pp = peer.create_publisher(PoseStamped, "/suspended/platform_pose", publisher_qos())
+    ps = peer.create_publisher(JointState, "/suspended/swing_estimate", publisher_qos())
+    ex = SingleThreadedExecutor()
+    ex.add_node(ctl)
+    ex.add_node(peer)
+    deadline = time.monotonic() + 10
+    while pj.get_subscription_count() == 0 or ps.get_subscription_count() == 0 or pp.get_subscription_count() == 0:
+        ex.spin_once(timeout_sec=0.05)
+        assert time.monotonic() < deadline
+    p = parameter_set("licas")
+    names = [f"left_{i}" for i in range(1, 5)] + [f"right_{i}" for i in range(1, 5)]
+    c, s_ = np.cos(0.1), np.sin(0.1)                  # platform rolled 0.1 rad about x
+    pp.publish(convert.pose_msg(1.0, [0, 0.1, 0.85], [np.sin(0.05), 0, 0, np.cos(0.05)]))
+    ps.publish(convert.joint_state_msg(1.0, ["swing_x", "swing_y", "yaw", "r_x", "r_y"],
+                                       [0.1, 0, 0, 0, 0.1], [0, 0, 0, 0, 0.2]))
+    for _ in range(20):
+        ex.spin_once(timeout_sec=0.01)
+    q = np.array([0.1, 0.2, -0.1, 0.0, 0.05, -0.2, 0.1, 0.3])
+    qd = np.full(8, 0.1)
+    pj.publish(convert.joint_state_msg(1.01, names, [np.nan] * 8, qd))     # rejected
+    pj.publish(convert.joint_state_msg(1.01, names[:3], q[:3], qd[:3]))     # rejected
+    pj.publish(convert.joint_state_msg(1.01, names, q, qd))
+    deadline = time.monotonic() + 5
+    while not cmds and time.monotonic() < deadline:
+        ex.spin_once(timeout_sec=0.02)
+    for _ in range(10):
+        ex.spin_once(timeout_sec=0.01)
+    assert len(cmds) == 1
+    R = np.array([[1, 0, 0], [0, c, -s_], [0, s_, c]])
+    kp, kd, lim = gains(p)
+    ref = np.zeros(8)
+    ref[1] = ref[5] = sway_offset(0.2, 0.3, 0.01)                            # -0.06 rad
+    want = pd_gravity(q, qd, ref, 0, kp, kd, ArmGravity(p).torque(q, R), lim)
+    assert np.allclose(np.array(cmds[0].data), want, atol=1e-9)
+    assert ctl.inputs.status(time.monotonic())[0] >= 1                      # bad states reported
+    ex.shutdown()
+    ctl.destroy_node()
+    peer.destroy_node()

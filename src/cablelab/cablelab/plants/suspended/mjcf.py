@@ -125,7 +125,7 @@ def _option(timestep: float, integrator: str) -> str:
 
 def virtual_xml(p: VirtualParams, *, levelling: str = "tendon", cable_elasticity=None,
                 timestep: float = 1e-3, integrator: str = "implicitfast", lock=(),
-                freeze_arms: bool = False) -> str:
+                freeze_arms: bool = False, arm_motors: bool = False) -> str:
     """MJCF of the virtual-joint chain (module docstring).
 
     Args:
@@ -134,6 +134,7 @@ def virtual_xml(p: VirtualParams, *, levelling: str = "tendon", cable_elasticity
         timestep: s. integrator: MuJoCo integrator name.
         lock: virtual joints left out (held at 0), e.g. ``("J7", "J9", "J10", "J12")`` for the
             planar reduction of spec 4.5. freeze_arms: arms rigid at q = 0 (no joints, no servos).
+        arm_motors: arm torque motors (ctrl = N m) instead of the repo position servos.
     """
     lock = set(lock)
     if levelling not in ("tendon", "paper"):
@@ -199,7 +200,7 @@ def virtual_xml(p: VirtualParams, *, levelling: str = "tendon", cable_elasticity
   </worldbody>
   {tendon}
   <actuator>
-    {_actuators(p, freeze_arms)}
+    {_actuators(p, freeze_arms, arm_motors)}
     {lvl_act}
   </actuator>
   <sensor>

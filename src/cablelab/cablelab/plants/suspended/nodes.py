@@ -13,8 +13,14 @@
   ``/suspended/ground_truth/virtual_joints`` (virtual model), ``/clock``,
   ``/plant_description``. ROS parameters: ``variant``, ``model``, ``rate`` Hz,
   ``start_swing_x``, ``start_swing_y``, ``start_yaw`` rad, ``pose_noise`` m.
-  ``/suspended/effort_commands`` (torque control) is not implemented in the node yet.
-* ``controller``: not written yet (its laws: :mod:`.controller`).
+  ``arm_input:=effort``: torque motors driven by ``/suspended/effort_commands`` instead (a
+  stale command, older than ``command_timeout`` s wall, means zero torque and WARN).
+* ``controller`` (``pd_feedforward --plant suspended``): on each ``/suspended/joint_states``
+  publishes ``/suspended/effort_commands`` = :func:`~.controller.pd_gravity` with the gravity
+  under the attitude of ``/suspended/platform_pose``; reference from ``/suspended/reference``
+  plus the built-in ``excitation`` (none | x | y | z, ``excitation_level`` 0..2, 000 Fig. 7) and
+  ``sway_damping`` k_s (r_y rate of ``/suspended/swing_estimate``; older than
+  ``estimate_stale`` s = off). Parameters: ``variant``.
 """
 from __future__ import annotations
 
@@ -26,7 +32,7 @@ from .swing import CHANNELS, SwingEstimator
 
 __all__ = ["make_node", "add_arguments", "ROLES"]
 
-ROLES = ("estimator", "sim")
+ROLES = ("estimator", "sim", "controller")
 
 
 def _estimator_class():
@@ -83,7 +89,7 @@ def _sim_class():
     from geometry_msgs.msg import PoseStamped
     from rclpy.node import Node
     from sensor_msgs.msg import JointState
-    from std_msgs.msg import String
+    from std_msgs.msg import Float64MultiArray, String
     from trajectory_msgs.msg import JointTrajectory
 
     from ...description import load_description
@@ -107,11 +113,16 @@ def _sim_class():
             self.description = load_description(description_yaml(variant, name=f"simulated {variant}"))
             self.params = parameter_set(variant)
             sx, sy, yw = (float(p(k, 0.0).value) for k in ("start_swing_x", "start_swing_y", "start_yaw"))
+            self.arm_input = str(p("arm_input", "reference").value)
+            if self.arm_input not in ("reference", "effort"):
+                raise CablelabError(f"cable_sim_node suspended: parameter arm_input={self.arm_input!r} "
+                                    "(expected reference or effort)")
+            motors = self.arm_input == "effort"
             if self.kind == "truth":
-                self.model = build_truth(self.params)
+                self.model = build_truth(self.params, arm_motors=motors)
                 x0 = truth_start(self.model, self.params, sx, sy, yw)
             elif self.kind == "virtual":
-                self.model = build_virtual(self.params)
+                self.model = build_virtual(self.params, arm_motors=motors)
                 q0 = {"J8": sx, "J9": sy, "J7": yw}
                 if self.params.level_to_swing:
                     q0.update({"J11": -sx, "J12": -sy})
@@ -133,6 +144,8 @@ def _sim_class():
             self.steps = max(1, int(round(1.0 / (self.rate * self.model.opt.timestep))))
             self.inputs = InputMonitor()
             self.inputs.add("reference", timeout=1e9, length=len(self.names))
+            self.inputs.add("effort_commands", timeout=float(p("command_timeout", 0.5).value),
+                            length=len(self.names))
             self.pub_js = self.create_publisher(JointState, "/suspended/joint_states", publisher_qos())
             self.pub_pose = self.create_publisher(PoseStamped, "/suspended/platform_pose", publisher_qos())
             self.pub_sw = self.create_publisher(JointState, "/suspended/ground_truth/swing", publisher_qos())
@@ -140,7 +153,10 @@ def _sim_class():
             self.clock = ClockPublisher(self)
             self.pub_desc = self.create_publisher(String, "/plant_description", DESCRIPTION_QOS)
             self.pub_desc.publish(convert.string_msg(self.description.to_yaml()))
-            self.create_subscription(JointTrajectory, "/suspended/reference", self.on_reference, stream_qos())
+            if motors:
+                self.create_subscription(Float64MultiArray, "/suspended/effort_commands", self.on_effort, stream_qos())
+            else:
+                self.create_subscription(JointTrajectory, "/suspended/reference", self.on_reference, stream_qos())
             self.diag = Diagnostics(self, update=self.status)
             self.timer = self.create_timer(1.0 / self.rate, self.tick)
 
@@ -157,7 +173,14 @@ def _sim_class():
             if self.inputs.accept("reference", q, time.monotonic()):
                 self.data.ctrl[:len(q)] = q
 
+        def on_effort(self, msg) -> None:
+            u = convert.float_array(msg)
+            if self.inputs.accept("effort_commands", u, time.monotonic()):
+                self.data.ctrl[:len(self.names)] = u
+
         def tick(self) -> None:
+            if self.arm_input == "effort" and not self.inputs.fresh("effort_commands", time.monotonic()):
+                self.data.ctrl[:len(self.names)] = 0.0      # stale command: no torque (reported)
             for _ in range(self.steps):
                 mujoco.mj_step(self.model, self.data)
             mujoco.mj_forward(self.model, self.data)
@@ -177,6 +200,90 @@ def _sim_class():
     return SuspendedSimNode
 
 
+def _controller_class():
+    import numpy as np
+    from geometry_msgs.msg import PoseStamped
+    from rclpy.node import Node
+    from sensor_msgs.msg import JointState
+    from std_msgs.msg import Float64MultiArray
+    from trajectory_msgs.msg import JointTrajectory
+
+    from ...ros import convert
+    from ...ros.diagnostics import Diagnostics
+    from ...ros.inputs import InputMonitor
+    from ...ros.qos import catch_up_qos, publisher_qos, stream_qos
+    from .controller import ArmGravity, fig7_excitation, gains, pd_gravity, sway_offset
+    from .mjcf import arm_joint_names
+
+    class SuspendedController(Node):
+        def __init__(self):
+            super().__init__("pd_feedforward")
+            p = self.declare_parameter
+            self.params = parameter_set(str(p("variant", "licas").value))
+            self.names = list(arm_joint_names(self.params))
+            n = len(self.names)
+            self.kp, self.kd, self.lim = gains(self.params)
+            self.gravity = ArmGravity(self.params)
+            self.excitation = str(p("excitation", "none").value)
+            self.level = int(p("excitation_level", 1).value)
+            self.k_s = float(p("sway_damping", 0.0).value)
+            self.stale = float(p("estimate_stale", 0.2).value)
+            self.q_ref, self.qd_ref = np.zeros(n), np.zeros(n)
+            self.R = np.eye(3)
+            self.v_swing, self.t_swing = np.nan, -np.inf
+            self.inputs = InputMonitor()
+            self.inputs.add("joint_states", timeout=0.5, length=n)
+            self.inputs.add("platform_pose", timeout=0.5, length=3)
+            self.inputs.add("reference", timeout=1e9, length=n)
+            self.pub = self.create_publisher(Float64MultiArray, "/suspended/effort_commands", publisher_qos())
+            self.create_subscription(JointState, "/suspended/joint_states", self.on_joints, catch_up_qos())
+            self.create_subscription(PoseStamped, "/suspended/platform_pose", self.on_pose, catch_up_qos())
+            self.create_subscription(JointState, "/suspended/swing_estimate", self.on_swing, catch_up_qos())
+            self.create_subscription(JointTrajectory, "/suspended/reference", self.on_reference, stream_qos())
+            self.diag = Diagnostics(self, update=lambda: self.inputs.status(time.monotonic()))
+
+        def on_pose(self, msg) -> None:
+            _, pos, qx = convert.pose_arrays(msg)
+            if self.inputs.accept("platform_pose", pos, time.monotonic()) and np.all(np.isfinite(qx)):
+                x, y, z, w = qx / np.linalg.norm(qx)
+                self.R = np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                                   [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                                   [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+
+        def on_swing(self, msg) -> None:
+            t, names, _, qd, _ = convert.joint_state_arrays(msg)
+            if qd is not None and "r_y" in names and len(qd) == len(names) and np.isfinite(qd[names.index("r_y")]):
+                self.v_swing, self.t_swing = float(qd[names.index("r_y")]), t
+
+        def on_reference(self, msg) -> None:
+            _, names, q, qd, _ = convert.joint_trajectory_point(msg)
+            if q is None or names != self.names or len(q) != len(self.names) or not np.all(np.isfinite(q)):
+                self.inputs.accept("reference", None, time.monotonic())
+                return
+            if self.inputs.accept("reference", q, time.monotonic()):
+                self.q_ref = q
+                self.qd_ref = qd if qd is not None and len(qd) == len(q) else np.zeros_like(q)
+
+        def on_joints(self, msg) -> None:
+            t, names, q, qd, _ = convert.joint_state_arrays(msg)
+            ok = q is not None and qd is not None and names == self.names and len(q) == len(names)
+            if not self.inputs.accept("joint_states", q if ok else None, time.monotonic()) or not ok \
+                    or not np.all(np.isfinite(qd)):
+                return
+            q_ref, qd_ref = self.q_ref.copy(), self.qd_ref.copy()
+            if self.excitation in ("x", "y", "z"):
+                qe, qde = fig7_excitation(np.array([t]), self.params, self.excitation, self.level)
+                q_ref, qd_ref = q_ref + qe[0], qd_ref + qde[0]
+            off = sway_offset(self.v_swing, self.k_s, t - self.t_swing, stale=self.stale)
+            n = self.params.n_arm
+            q_ref[1] += off
+            q_ref[n + 1] += off
+            tau = pd_gravity(q, qd, q_ref, qd_ref, self.kp, self.kd, self.gravity.torque(q, self.R), self.lim)
+            self.pub.publish(convert.command_msg(tau, t))
+
+    return SuspendedController
+
+
 def add_arguments(role: str, parser) -> None:
     """No command-line options beyond the ROS parameters."""
 
@@ -187,4 +294,6 @@ def make_node(role: str, args=None):
         return _estimator_class()()
     if role == "sim":
         return _sim_class()()
+    if role == "controller":
+        return _controller_class()()
     raise CablelabError(f"suspended: node role {role!r} is not implemented (available: {', '.join(ROLES)})")
