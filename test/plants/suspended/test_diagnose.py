@@ -53,3 +53,16 @@ def test_a9_cranebot_yaw_return_ranked_first(tmp_path):
     out = _diagnose(_bag(tmp_path, "yaw", p, {"J7": 0.2}, 15.0, "cranebot"))
     first = out["ranking"][0]
     assert first["effect"] == "virtual_yaw_stiffness" and first["significant"]
+
+
+def test_cli_diagnose_greedy_json_on_a_suspended_bag(tmp_path, capsys):
+    import json
+
+    from cablelab.cli import main as cli
+
+    p = parameter_set("licas")
+    bag = _bag(tmp_path, "hidden_cli", p.replace(fs=(0.0, 0.5, 0.5)), Y_SWING, 10.0)
+    assert cli(["diagnose", "--greedy", "--json", str(bag)]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["plant"] == "suspended" and out["ranking"][0]["effect"] == "cable_joint_coulomb_friction"
+    assert out["final"]["params"]["fs8"] == pytest.approx(0.5, rel=0.2)

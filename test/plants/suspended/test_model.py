@@ -178,3 +178,17 @@ def test_description_defaults_and_params():
     assert d.params().kp10 == 551.3 and d.cable_length == pytest.approx(3.483)
     d = parse_section({"variant": "licas", "cable_length": 1.2, "parameter_set": "table5"})
     assert d.params().L == 1.2 and d.params().inertia_fix == "none"
+
+
+@pytest.mark.parametrize("name, variant", [("licas", "licas"), ("cranebot", "cranebot")])
+def test_shipped_descriptions_load_and_match_the_repo_sets(name, variant):
+    from pathlib import Path
+
+    from cablelab.description import load_description
+    import cablelab.plants.suspended as pkg
+
+    desc = load_description(Path(pkg.__file__).parent / "data" / f"{name}.yaml")
+    sec = parse_section(desc.extra["suspended"])
+    p, ref = sec.params(), parameter_set(variant)
+    assert sec.variant == variant
+    assert p.L == pytest.approx(ref.L) and np.allclose(p.S, ref.S) and np.allclose(p.arm_mount, ref.arm_mount)
