@@ -15,7 +15,8 @@ meaningless (documented deviation from 000, which averages all three).
 
 :func:`identify` also reports the parameters the data cannot determine: those whose standard
 error (Gauss-Newton, inflated for coloured residuals) exceeds ``undetermined_rel`` of their
-Table 5 range, or which end on a bound.
+Table 5 range. This sees local non-identifiability only: the compound pendulum's conjugate
+branch (l9z and k^2 / l9z give the same period) is a discrete ambiguity it cannot flag.
 """
 from __future__ import annotations
 
@@ -25,12 +26,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...errors import CablelabError
-from ...fit.simulation import SimulationFit, fit_simulation
+from ...fit.simulation import SimulationFit, fit_simulation, objective_residual
 from ...model import Param
-from .mjcf import build_virtual
+from .mjcf import build_truth, build_virtual
 from .params import IDENTIFIED, VirtualParams
 from .sim import initial_state, simulate, truth_start
-from .mjcf import build_truth
 from .swing import swing_from_pose
 
 __all__ = ["Experiment", "apply_values", "identified_params", "licas_experiments",
@@ -220,8 +220,7 @@ def identify(exps: list[Experiment], p_start: VirtualParams, names=None, *, obje
         return np.stack([_stack(exps, o) for o in outs])
 
     fit = fit_simulation(sim, params, y_meas, objective=objective, max_iter=max_iter, progress=progress)
-    pearson_fit = 1.0 - float(np.sum(__import__("cablelab.fit.simulation", fromlist=["x"])
-                                     .objective_residual(y_meas, fit.y_sim, "pearson") ** 2))
+    pearson_fit = 1.0 - float(np.sum(objective_residual(y_meas, fit.y_sim, "pearson") ** 2))
     und = []
     for q in params:
         v, se = fit.params[q.name], fit.stderr[q.name]
