@@ -20,8 +20,8 @@ from cablelab.plants.suspended.reference import planar_reference  # noqa: E402
 from cablelab.plants.suspended.sim import (initial_state, simulate, simulate_paper_levelling,  # noqa: E402
                                            truth_start)
 from cablelab.plants.suspended.swing import yaw_from_quat  # noqa: E402
-from test_model import _licas_y_swing, period  # noqa: E402
-from test_swing_control import _decay  # noqa: E402
+from test_suspended_model import _licas_y_swing, period  # noqa: E402
+from test_suspended_swing_control import _decay  # noqa: E402
 
 
 def main() -> None:
