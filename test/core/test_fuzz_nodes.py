@@ -46,8 +46,11 @@ NAME_LIST = st.lists(st.sampled_from(NAMES), max_size=10)
 def _descriptions():
     from cablelab.bags import open_bag
 
+    plants = REPO / "src" / "cablelab" / "cablelab" / "plants"
     return {"axis": open_bag(EMPS).description_yaml, "cdpr": open_bag(CDPR).description_yaml,
-            "crane": open_bag(REPO / "bags" / "crane_control").description_yaml}
+            "crane": open_bag(REPO / "bags" / "crane_control").description_yaml,
+            "leg": (plants / "leg" / "data" / "leg.yaml").read_text(),
+            "suspended": (plants / "suspended" / "data" / "licas.yaml").read_text()}
 
 
 @st.composite

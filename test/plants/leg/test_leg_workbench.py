@@ -41,7 +41,7 @@ def bag(traj, tmp_path_factory):
 def test_greedy_adds_impact_then_preload(bag):
     plant, desc, ds = load(bag)
     assert plant.name == "leg" and ds.n > 19000
-    out = diagnose(ds, build_model(plant, desc), plant.candidates(desc), greedy_mode=True)
+    out = diagnose(ds, build_model(plant, desc), plant.candidates(desc), greedy_mode=True).to_json()
     steps = out["greedy"]
     assert [s["added"] for s in steps[1:3]] == ["impact_restitution", "spring_preload"]
     errs = [s["error"] for s in steps]

@@ -70,7 +70,15 @@ def check_dataset(ds) -> None:
     """
     src = ds.source or ds.plant
     ok = ds.valid & np.isfinite(ds.y).all(axis=1)
+    # a plant may mark channels its record does not excite (``signals["excited"]``, one bool per
+    # channel): those are set aside on purpose, not a stuck sensor
+    excited = np.asarray(ds.signals.get("excited", np.ones(ds.n_channels, bool)), bool).reshape(-1)
+    if excited.size == ds.n_channels and not excited.any():
+        raise CablelabError(f"{src}: no output channel is excited ({', '.join(ds.channels)}): record "
+                            "a run with motion")
     for c, ch in enumerate(ds.channels):
+        if excited.size == ds.n_channels and not excited[c]:
+            continue
         y = ds.y[np.isfinite(ds.y[:, c]), c]
         spread = float(np.ptp(y)) if y.size else 0.0
         if spread <= CONSTANT_REL * max(float(np.max(np.abs(y))) if y.size else 0.0, 1e-300):

@@ -73,9 +73,14 @@ def confounding(ident, own: list[str], threshold: float = CONFOUNDED) -> dict:
         se = float(ident.stderr.get(p, 0.0))
         return se > 0 and abs(float(ident.params.get(p, 0.0))) < MIN_T * se
 
+    # a per-actuator effect is identified through any of its parameters the data determine
+    # (one excited winch or cable joint): it is unidentifiable only when confounded parameters
+    # are all it has
+    bad = {r["param"] for r in out if abs(r["correlation"]) >= UNIDENTIFIABLE and vague(r["param"])}
+    determined = [p for p in own if p in names and p not in bad and not vague(p)
+                  and abs(float(ident.params.get(p, 0.0))) > 0]
     return {"condition": float(ident.linear.cond), "confounded": out,
-            "identifiable": not any(abs(r["correlation"]) >= UNIDENTIFIABLE and vague(r["param"])
-                                    for r in out)}
+            "identifiable": not bad or bool(determined)}
 
 
 def describe(info: dict) -> str:

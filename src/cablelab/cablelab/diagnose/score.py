@@ -31,13 +31,16 @@ def channel_nrmse(y: np.ndarray, y_hat: np.ndarray, valid: np.ndarray | None = N
         ok &= np.asarray(valid, bool)
     e = y[ok] - y_hat[ok]
     rms_y = np.sqrt(np.mean(y[ok] ** 2, axis=0))
-    return np.sqrt(np.mean(e**2, axis=0)) / np.where(rms_y > 0, rms_y, 1.0)
+    # a channel that is identically zero (set aside by its plant as not excited) has no NRMSE
+    return np.where(rms_y > 0, np.sqrt(np.mean(e**2, axis=0)) / np.where(rms_y > 0, rms_y, 1.0),
+                    np.nan)
 
 
 def heldout_error(y: np.ndarray, y_hat: np.ndarray, valid: np.ndarray | None = None) -> float:
-    """Geometric mean over channels of the per-channel NRMSE (see module doc)."""
+    """Geometric mean over the channels with a signal of the per-channel NRMSE (see module doc)."""
     c = channel_nrmse(y, y_hat, valid)
-    return float(np.exp(np.mean(np.log(np.maximum(c, 1e-300)))))
+    c = c[np.isfinite(c)]
+    return float(np.exp(np.mean(np.log(np.maximum(c, 1e-300))))) if c.size else 0.0
 
 
 def _n_free(ident) -> int:

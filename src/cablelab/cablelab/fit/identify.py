@@ -214,15 +214,28 @@ def identify(model: Model, ds: Dataset, *, on_deficient: str = "raise",
                           extra={"stderr_white": white, "lag1": r1, "stderr_inflation": inflation})
 
 
+#: a channel residual below this fraction of the largest one is round-off (a channel the plant
+#: sets aside, fitted exactly), not a noise level
+ROUND_OFF = 1e-9
+
+
 def noise_weights(residual: np.ndarray) -> np.ndarray:
     """(C,) channel weights 1 / sigma_c, sigma_c = robust (MAD) standard deviation of each
-    channel's residual (NaN rows dropped), normalised to a geometric mean of 1."""
+    channel's residual (NaN rows dropped), normalised to a geometric mean of 1; a channel without
+    any residual gets the geometric-mean sigma of the others (neutral weight)."""
     r = np.asarray(residual, dtype=float)
     r = r[np.isfinite(r).all(axis=1)]
     if r.shape[0] < 3:
         return np.ones(r.shape[1])
     sig = 1.4826 * np.median(np.abs(r - np.median(r, axis=0)), axis=0)
-    sig = np.where(sig > 0, sig, np.maximum(r.std(axis=0), 1e-300))
+    sig = np.where(sig > 0, sig, r.std(axis=0))
+    sig = np.where(sig > ROUND_OFF * sig.max(), sig, 0.0)    # round-off residual: none at all
+    pos = sig[sig > 0]
+    if pos.size == 0:
+        return np.ones(r.shape[1])
+    # a channel fitted exactly (no residual at all, e.g. one a plant sets aside as not excited)
+    # carries no noise estimate: it keeps a neutral weight instead of an infinite one
+    sig = np.where(sig > 0, sig, np.exp(np.mean(np.log(pos))))
     w = 1.0 / sig
     return w / np.exp(np.mean(np.log(w)))
 

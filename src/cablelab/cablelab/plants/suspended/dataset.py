@@ -1,0 +1,120 @@
+"""Bag -> :class:`cablelab.model.Dataset` for the workbench on ``suspended`` runs.
+
+The workbench model is linear in its parameters (:mod:`cablelab.model`), so the platform
+motion is written as the swing equations of 000 eq. 1 reduced to one generalised coordinate per
+mode (cable angles q8 = swing_x, q9 = swing_y about S, and platform yaw phi^z):
+
+``J_x qdd8 = -[mgl_x sin q8 + f_v8 qd8 + f_s8 sign(qd8) + ...]`` (channel ``swing_x``, N m),
+the same for ``swing_y`` (q9) and ``J_z phidd = -[k_yaw phi + f_v7 phid + ...]`` (``yaw``).
+
+Output y = nominal inertia x measured angular acceleration, with the nominal modal inertias of
+the description's parameter set (:func:`modal_inertias`: the links turning with each joint plus
+the platform and arms translating at distance L, spec 4.5). The swing angles come from the
+platform pose (:mod:`.swing`), conditioned by :func:`cablelab.conditioning.condition_motion`
+(uniform grid, zero-phase Butterworth, central differences). The effects of
+:mod:`.effects` supply the bracketed terms as regressor columns.
+"""
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from ...conditioning import Conditioning, condition_motion
+from ...errors import CablelabError
+from ...model import Dataset
+from .description import parse_section
+from .params import VirtualParams
+from .reference import planar_bodies
+from .swing import swing_from_pose
+
+__all__ = ["dataset", "dataset_from_arrays", "modal_inertias", "CHANNELS", "POSE_TOPIC",
+           "JOINT_STATES", "CUTOFF_HZ"]
+
+CHANNELS = ("swing_x", "swing_y", "yaw")
+POSE_TOPIC = "/suspended/platform_pose"
+JOINT_STATES = "/suspended/joint_states"
+POSE = "geometry_msgs/msg/PoseStamped"
+#: position low-pass cut-off, Hz: the swing is at 0.5 Hz (LiCAS) / 0.24 Hz (CRANEbot), yaw below
+#: 0.6 Hz; 1 mm of mocap noise differentiated twice needs a low cut-off (cf. crane: 3 Hz)
+CUTOFF_HZ = 2.0
+#: amplitude (rad) below which a channel counts as not excited: swing_x, swing_y, yaw
+MIN_AMPLITUDE = (0.01, 0.01, 0.02)
+
+
+def modal_inertias(p: VirtualParams) -> np.ndarray:
+    """(3,) nominal inertias of the modes q8, q9, phi^z, kg m^2.
+
+    q8: links 8, 9, 10 about S plus the lower body (platform + arms, mass M_B) translating at L
+    (the levelled platform does not rotate). q9: link 9, 10 and the lower body. Yaw: the lower
+    body's inertia about the vertical through the attachment point (arms at q = 0).
+    """
+    b = planar_bodies(p)
+    from .mjcf import effective_cable_inertias
+    (_, I8, I9), _ = effective_cable_inertias(p)
+    Jx = b["J_A"] + b["M_B"] * p.L ** 2
+    Jy = I9[1] + p.m9 * p.l9z ** 2 + p.I_plat[1] + p.m_plat * p.L ** 2 + b["M_B"] * p.L ** 2
+    # yaw: platform links + arm links about z through the attachment point
+    Jz = 2 * p.I_plat[2]
+    for s in (1.0, -1.0):
+        o = np.array(p.arm_mount) * [1, s, 1]
+        for i, a in enumerate(p.arm):
+            if i > 0:
+                o = o + np.array(a.pos) * [1, s, 1]
+            c = o + np.array(a.com) * [1, s, 1]
+            Jz += a.inertia[2] + a.mass * (c[0] ** 2 + c[1] ** 2)
+    return np.array([Jx, Jy, Jz])
+
+
+def dataset_from_arrays(t, pos, quat_wxyz, desc_section, description=None, options: dict | None = None,
+                        *, source: str = "data") -> Dataset:
+    """Dataset from platform poses ``pos`` (N, 3) m and ``quat_wxyz`` (N, 4) at stamps ``t`` (N,)."""
+    options = options or {}
+    opts = options.get("conditioning") or Conditioning()
+    if opts.cutoff_hz is None:
+        opts = dataclasses.replace(opts, cutoff_hz=CUTOFF_HZ)
+    p = desc_section.params()
+    s = swing_from_pose(pos, quat_wxyz, p.S, rest_pos=np.array(p.S) - [0, 0, p.L], rest_yaw=0.0)
+    q = np.column_stack([s["swing_x"], s["swing_y"], s["yaw"]])
+    c = condition_motion(np.asarray(t, float), q, np.zeros((len(q), 1)), opts, revolute=False,
+                         source=source)
+    q, qd, qdd = c["q"], c["qd"], c["qdd"]
+    J = modal_inertias(p)
+    g = description.gravity if description is not None else 9.81
+    amp = np.abs(q[:, :2]).max(axis=1)
+    edges = np.quantile(amp, [1 / 3, 2 / 3])
+    labels = np.array(["small swing", "medium swing", "large swing"])
+    y = qdd * J
+    # a channel the record does not excite carries only differentiated noise: its output is
+    # zeroed (the columns keep the measured motion, so every parameter stays fitted, to ~0)
+    excited = np.abs(q - q.mean(axis=0)).max(axis=0) > np.asarray(options.get("min_amplitude", MIN_AMPLITUDE))
+    y[:, ~excited] = 0.0
+    return Dataset(
+        plant="suspended", t=c["t"], y=y, channels=CHANNELS, units=("N m", "N m", "N m"),
+        signals={"q": q, "qd": qd, "qdd": qdd, "J": J, "g": g, "L": p.L, "excited": excited,
+                 "cutoff_hz": c.get("cutoff_hz", opts.cutoff_hz)},
+        actuators=CHANNELS, act_vel=qd, act_units=(("N m", "rad"),) * 3,
+        inputs={"swing_x rate": qd[:, 0], "swing_y rate": qd[:, 1], "yaw rate": qd[:, 2]},
+        regimes={"swing amplitude": labels[np.searchsorted(edges, amp)]},
+        description=description, source=source)
+
+
+def section_of(description):
+    """The parsed ``suspended:`` section of a description (from ``extra`` until the restructure
+    gives Description a field)."""
+    sec = getattr(description, "suspended", None)
+    if sec is not None and not isinstance(sec, dict):
+        return sec
+    raw = (getattr(description, "extra", {}) or {}).get("suspended")
+    if raw is None:
+        raise CablelabError("description: plant suspended needs a 'suspended:' section")
+    return parse_section(raw)
+
+
+def dataset(bag, description, options: dict | None = None) -> Dataset:
+    """Workbench dataset of a ``suspended`` bag (``/suspended/platform_pose``)."""
+    bag.require(POSE_TOPIC, POSE)
+    ps = bag.pose(POSE_TOPIC)
+    quat = ps.quaternion[:, [3, 0, 1, 2]]                 # x y z w -> w x y z
+    return dataset_from_arrays(ps.t, ps.position, quat, section_of(description), description,
+                               options, source=str(bag.path))

@@ -1,0 +1,236 @@
+"""Identification of the virtual-joint parameters (000 sec. 4, eq. 3-7; spec sec. 6).
+
+Cost, 000 eq. 3/6/7: ``p̂ = argmax (1/N_e) sum_i R(x_m^i, x_s^i(p))``, ``0 <= p <= p̄`` (Table 5),
+``R`` = mean Pearson rho over the output channels ``r_x, r_y, phi^z`` (000 eq. 4). The forward
+model (000 eq. 5) is :func:`~cablelab.plants.suspended.mjcf.build_virtual` (``levelling="tendon"``)
+integrated at 1 ms by :func:`mujoco.rollout.rollout` from the measured initial state; the
+optimiser is :func:`cablelab.fit.simulation.fit_simulation` (``mujoco.minimize.least_squares``)
+with objective ``pearson`` (residual with ``||r||^2 = 1 - R``) or the amplitude-aware ``nmse``
+(003 eq. 28). The paper used fmincon active-set.
+
+Each (experiment, channel) pair is one column of the fit, so the Pearson standardisation is per
+experiment and channel exactly as in 000 eq. 7. Channels an experiment does not excite (standard
+deviation below ``excite_factor`` x the pose noise) are left out: a Pearson value on noise is
+meaningless (documented deviation from 000, which averages all three).
+
+:func:`identify` also reports the parameters the data cannot determine: those whose standard
+error (Gauss-Newton, inflated for coloured residuals) exceeds ``undetermined_rel`` of their
+Table 5 range. This sees local non-identifiability only: the compound pendulum's conjugate
+branch (l9z and k^2 / l9z give the same period) is a discrete ambiguity it cannot flag.
+"""
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ...errors import CablelabError
+from ...fit.simulation import SimulationFit, fit_simulation, objective_residual
+from ...model import Param
+from .mjcf import build_truth, build_virtual
+from .params import IDENTIFIED, VirtualParams
+from .sim import initial_state, simulate, truth_start
+from .swing import swing_from_pose
+
+__all__ = ["Experiment", "apply_values", "identified_params", "licas_experiments",
+           "simulate_experiments", "identify", "validate", "Identification", "metrics",
+           "CHANNELS"]
+
+CHANNELS = ("r_x", "r_y", "yaw")
+
+
+@dataclass
+class Experiment:
+    """One recorded experiment (000 sec. 5.3).
+
+    Args:
+        name: label. t: (N,) s at the output rate. y: (N, 3) measured [r_x m, r_y m, yaw rad].
+        q0: start virtual joint positions by name (from the first measured pose).
+        duration: s. every: simulation steps per output sample.
+        arm_ctrl: (nstep, nu) arm servo references or None (arms held at 0).
+        use: (3,) bool, channels excited in this experiment.
+    """
+
+    name: str
+    t: np.ndarray
+    y: np.ndarray
+    q0: dict
+    duration: float
+    every: int = 10
+    arm_ctrl: np.ndarray | None = None
+    use: np.ndarray = field(default_factory=lambda: np.ones(3, bool))
+
+
+def identified_params(variant: str = "licas", names=None) -> list[Param]:
+    """Table 5 (★) parameters as :class:`Param` (nominal = p_0, bounds [0, p̄])."""
+    out = []
+    col = 1 if variant == "licas" else 2
+    for row in IDENTIFIED:
+        p0, hi = row[col]
+        if names is None or row[0] in names:
+            out.append(Param(row[0], "", p0, 0.0, hi, "000 Table 5"))
+    if names is not None:
+        missing = set(names) - {p.name for p in out}
+        if missing:
+            raise CablelabError(f"unknown suspended parameter(s) {sorted(missing)} (Table 5 rows: "
+                                f"{', '.join(r[0] for r in IDENTIFIED)})")
+    return out
+
+
+def apply_values(p: VirtualParams, values: dict) -> VirtualParams:
+    """Parameter set with Table 5 values (names of :data:`~.params.IDENTIFIED`) written in."""
+    kw = {}
+    I = [list(p.I7), list(p.I8), list(p.I9)]
+    fv, fs = list(p.fv), list(p.fs)
+    for k, v in values.items():
+        v = float(v)
+        if k in ("ixx", "iyy", "izz"):
+            for row in I:
+                row["xyz".index(k[1])] = v
+        elif k.startswith("fv"):
+            fv[int(k[2]) - 7] = v
+        elif k.startswith("fs"):
+            fs[int(k[2]) - 7] = v
+        else:
+            kw[k] = v
+    return dataclasses.replace(p, I7=tuple(I[0]), I8=tuple(I[1]), I9=tuple(I[2]), fv=tuple(fv),
+                               fs=tuple(fs), **kw)
+
+
+def _rest(p: VirtualParams) -> np.ndarray:
+    return np.array(p.S, float) - [0.0, 0.0, p.L]
+
+
+def simulate_experiments(p: VirtualParams, exps: list[Experiment], *, nthread: int = 2,
+                         value_sets: list[dict] | None = None) -> list[list[np.ndarray]]:
+    """Simulated outputs ``[set][experiment] -> (N, 3)`` of the virtual model for each value set
+    (all sets and experiments in one rollout batch per distinct duration)."""
+    sets = value_sets or [{}]
+    params = [apply_values(p, v) for v in sets]
+    out = [[None] * len(exps) for _ in sets]
+    for d in sorted({e.duration for e in exps}):
+        idx = [i for i, e in enumerate(exps) if e.duration == d]
+        models, x0s, ctrls = [], [], []
+        for pp in params:
+            m = build_virtual(pp)
+            for i in idx:
+                models.append(m)
+                x0s.append(initial_state(m, exps[i].q0))
+                c = exps[i].arm_ctrl
+                ctrls.append(np.zeros((int(round(d / m.opt.timestep)), m.nu)) if c is None else c)
+        runs = simulate(models, np.array(x0s), d, np.array(ctrls), nthread=nthread)
+        k = 0
+        for s, pp in enumerate(params):
+            rest = _rest(pp)
+            for i in idx:
+                r = runs[k]
+                k += 1
+                e = exps[i].every
+                sw = swing_from_pose(r.pos[e - 1::e], r.quat[e - 1::e], pp.S, rest_pos=rest, rest_yaw=0.0)
+                out[s][i] = np.stack([sw["r_x"], sw["r_y"], sw["yaw"]], axis=1)[:len(exps[i].t)]
+    return out
+
+
+def licas_experiments(p_gen: VirtualParams, *, plant: str = "virtual", duration: float = 10.0,
+                      amp: float = 0.15, yaw0: float = 0.5, every: int = 10, pos_noise: float = 1e-3,
+                      yaw_noise: float = np.deg2rad(0.5), seed: int = 0):
+    """The 7 unforced LiCAS experiments of 000 sec. 5.3: identification (x, y, yaw displacement)
+    and validation (x, y, yaw, xy), generated by the virtual model ``p_gen`` (``plant="virtual"``)
+    or the 4-tendon truth plant (``"truth"``), with Gaussian pose noise.
+
+    Returns:
+        ``(identification, validation)`` lists of :class:`Experiment`.
+    """
+    rng = np.random.default_rng(seed)
+    starts = [("id_x", 0, amp, 0), ("id_y", amp, 0, 0), ("id_yaw", 0, 0, yaw0),
+              ("val_x", 0, 0.8 * amp, 0), ("val_y", 0.8 * amp, 0, 0), ("val_yaw", 0, 0, 0.8 * yaw0),
+              ("val_xy", 0.7 * amp, 0.7 * amp, 0)]
+    exps = []
+    for name, sx, sy, yw in starts:
+        if plant == "virtual":
+            m = build_virtual(p_gen)
+            q0 = {"J8": sx, "J11": -sx, "J9": sy, "J12": -sy, "J7": yw}
+            run = simulate(m, initial_state(m, q0), duration)[0]
+        elif plant == "truth":
+            m = build_truth(p_gen)
+            run = simulate(m, truth_start(m, p_gen, swing_x=sx, swing_y=sy, yaw=yw), duration)[0]
+        else:
+            raise CablelabError(f"licas_experiments plant {plant!r}: expected virtual or truth")
+        pos = run.pos[every - 1::every]
+        quat = run.quat[every - 1::every]
+        sw = swing_from_pose(pos, quat, p_gen.S, rest_pos=_rest(p_gen), rest_yaw=0.0)
+        y = np.stack([sw["r_x"], sw["r_y"], sw["yaw"]], axis=1)
+        y = y + rng.normal(0, 1, y.shape) * [pos_noise, pos_noise, yaw_noise]
+        noise = np.array([pos_noise, pos_noise, yaw_noise])
+        use = y.std(axis=0) > 5 * np.maximum(noise, 1e-12)
+        q0 = {"J8": sx, "J11": -sx, "J9": sy, "J12": -sy, "J7": yw}   # from the first pose
+        exps.append(Experiment(name, run.t[every - 1::every], y, q0, duration, every, None, use))
+    return exps[:3], exps[3:]
+
+
+def metrics(y_meas: np.ndarray, y_sim: np.ndarray) -> dict:
+    """Per channel: Pearson rho, NRMSE (RMS error / RMS of the measurement about its mean), MRE
+    (mean |error| / mean |measurement|, the relative error of 000 Tables 1-2) and max |error|."""
+    e = y_sim - y_meas
+    ym = y_meas - y_meas.mean(0)
+    ys = y_sim - y_sim.mean(0)
+    rho = (ym * ys).sum(0) / np.sqrt((ym ** 2).sum(0) * (ys ** 2).sum(0) + 1e-300)
+    return {"rho": rho, "nrmse": np.sqrt((e ** 2).mean(0)) / np.sqrt((ym ** 2).mean(0) + 1e-300),
+            "mre": np.abs(e).mean(0) / (np.abs(y_meas).mean(0) + 1e-300),
+            "max_abs": np.abs(e).max(0)}
+
+
+@dataclass
+class Identification:
+    """Result of :func:`identify`: the fit, the full parameter set, mean R over the experiments
+    (000 eq. 7), and the parameters the data do not determine."""
+
+    fit: SimulationFit
+    params: VirtualParams
+    mean_R: float
+    undetermined: list
+    values: dict
+
+
+def _stack(exps, ys):
+    cols = [y[:, c] for e, y in zip(exps, ys) for c in range(3) if e.use[c]]
+    n = min(len(c) for c in cols)
+    return np.stack([c[:n] for c in cols], axis=1)
+
+
+def identify(exps: list[Experiment], p_start: VirtualParams, names=None, *, objective: str = "pearson",
+             start: dict | None = None, max_iter: int = 30, undetermined_rel: float = 0.25,
+             progress: bool = False, nthread: int = 2) -> Identification:
+    """Fit the Table 5 parameters ``names`` (default all (★) rows) to the experiments.
+
+    Args:
+        exps: identification experiments. p_start: parameter set for everything not fitted.
+        objective: ``pearson`` (000 eq. 3-7) or ``nmse`` (amplitude-aware).
+        start: start values by name (default Table 5 p_0).
+    """
+    params = identified_params(p_start.variant, names)
+    if start:
+        params = [dataclasses.replace(q, nominal=float(np.clip(start.get(q.name, q.nominal), q.lower, q.upper)))
+                  for q in params]
+    y_meas = _stack(exps, [e.y for e in exps])
+
+    def sim(value_sets):
+        outs = simulate_experiments(p_start, exps, value_sets=value_sets, nthread=nthread)
+        return np.stack([_stack(exps, o) for o in outs])
+
+    fit = fit_simulation(sim, params, y_meas, objective=objective, max_iter=max_iter, progress=progress)
+    pearson_fit = 1.0 - float(np.sum(objective_residual(y_meas, fit.y_sim, "pearson") ** 2))
+    und = []
+    for q in params:
+        v, se = fit.params[q.name], fit.stderr[q.name]
+        span = q.upper - q.lower
+        if not np.isfinite(se) or se > undetermined_rel * span:
+            und.append(q.name)
+    return Identification(fit, apply_values(p_start, fit.params), pearson_fit, und, dict(fit.params))
+
+
+def validate(p: VirtualParams, exps: list[Experiment], nthread: int = 2) -> list[dict]:
+    """Per experiment: :func:`metrics` of the model ``p`` against the data, plus the channel mask."""
+    ys = simulate_experiments(p, exps, nthread=nthread)[0]
+    return [{"name": e.name, "use": e.use, **metrics(e.y[:len(y)], y)} for e, y in zip(exps, ys)]

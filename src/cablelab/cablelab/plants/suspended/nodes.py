@@ -1,0 +1,287 @@
+"""ROS 2 node adapters of the suspended plant (thin shells over the library).
+
+* ``estimator`` (``payload_estimator --plant suspended``): ``/suspended/platform_pose`` ->
+  :class:`~.swing.SwingEstimator` -> ``/suspended/swing_estimate`` (names swing_x, swing_y, yaw,
+  r_x, r_y; position and velocity), stamped like the pose. NaN, wrong-length and frozen-stamp
+  poses are held and counted on /diagnostics. ROS parameters: ``suspension_point`` [x, y, z] m
+  (default: the LiCAS repo set), ``rest_window`` s, ``velocity_tau`` s, ``pose_timeout`` s wall.
+* ``sim`` (``cable_sim_node --plant suspended``): the virtual-joint model (``model:=virtual``)
+  or the truth plant (``model:=truth``) of ``variant`` in real time; arm position servos follow
+  ``/suspended/reference`` (JointTrajectory, arm joint names; unknown names / wrong lengths are
+  rejected and counted). Publishes ``/suspended/joint_states`` (effort = servo torque),
+  ``/suspended/platform_pose`` (``pose_noise`` m), ``/suspended/ground_truth/swing``,
+  ``/suspended/ground_truth/virtual_joints`` (virtual model), ``/clock``,
+  ``/plant_description``. ROS parameters: ``variant``, ``model``, ``rate`` Hz,
+  ``start_swing_x``, ``start_swing_y``, ``start_yaw`` rad, ``pose_noise`` m.
+  ``arm_input:=effort``: torque motors driven by ``/suspended/effort_commands`` instead (a
+  stale command, older than ``command_timeout`` s wall, means zero torque and WARN).
+* ``controller`` (``pd_feedforward --plant suspended``): on each ``/suspended/joint_states``
+  publishes ``/suspended/effort_commands`` = :func:`~.controller.pd_gravity` with the gravity
+  under the attitude of ``/suspended/platform_pose``; reference from ``/suspended/reference``
+  plus the built-in ``excitation`` (none | x | y | z, ``excitation_level`` 0..2, 000 Fig. 7) and
+  ``sway_damping`` k_s (r_y rate of ``/suspended/swing_estimate``; older than
+  ``estimate_stale`` s = off). Parameters: ``variant``.
+"""
+from __future__ import annotations
+
+import time
+
+from ...errors import CablelabError
+from .params import parameter_set
+from .swing import CHANNELS, SwingEstimator
+
+__all__ = ["make_node", "add_arguments", "ROLES"]
+
+ROLES = ("estimator", "sim", "controller")
+
+
+def _estimator_class():
+    from geometry_msgs.msg import PoseStamped
+    from ...ros.plant_node import PlantNode
+    from sensor_msgs.msg import JointState
+
+    from ...ros import convert
+    from ...ros.inputs import WARN
+    from ...ros.qos import catch_up_qos, publisher_qos
+
+    class SuspendedSwingEstimator(PlantNode):
+        def __init__(self):
+            super().__init__("payload_estimator")
+            p = self.declare_parameter
+            S = [float(v) for v in p("suspension_point", list(parameter_set("licas").S)).value]
+            self.est = SwingEstimator(S, rest_window=float(p("rest_window", 2.0).value),
+                                      velocity_tau=float(p("velocity_tau", 0.05).value))
+            self.inputs.add("platform_pose", timeout=float(p("pose_timeout", 0.5).value), length=3)
+            self.rejected = 0
+            self.last_problem = ""
+            self.pub = self.create_publisher(JointState, "/suspended/swing_estimate", publisher_qos())
+            self.create_subscription(PoseStamped, "/suspended/platform_pose", self.on_pose, catch_up_qos())
+            self.start_diagnostics()
+
+        def extend_status(self, level, msg, values):
+            values["held samples"] = str(self.rejected)
+            if self.rejected:
+                level = max(level, WARN)
+                extra = f"{self.rejected} pose samples held ({self.last_problem})"
+                msg = extra if msg == "ok" else f"{msg}; {extra}"
+            return level, msg, values
+
+        def on_pose(self, msg) -> None:
+            t, pos, quat_xyzw = convert.pose_arrays(msg)
+            self.inputs.accept("platform_pose", pos, time.monotonic())
+            q = quat_xyzw[[3, 0, 1, 2]] if quat_xyzw is not None and len(quat_xyzw) == 4 else quat_xyzw
+            s = self.est.step(t, pos, q)
+            if not s.ok:
+                self.rejected += 1
+                self.last_problem = s.message
+                return
+            self.pub.publish(convert.joint_state_msg(t, list(CHANNELS), s.position, s.velocity))
+
+    return SuspendedSwingEstimator
+
+
+def _sim_class():
+    import mujoco
+    import numpy as np
+    from geometry_msgs.msg import PoseStamped
+    from ...ros.plant_node import PlantNode
+    from sensor_msgs.msg import JointState
+    from std_msgs.msg import Float64MultiArray
+    from trajectory_msgs.msg import JointTrajectory
+
+    from ...description import load_description
+    from ...ros import convert
+    from ...ros.clock import ClockPublisher
+    from ...ros.qos import publisher_qos, stream_qos
+    from ...rotations import wxyz_to_xyzw
+    from .bag import description_yaml
+    from .mjcf import VJ, arm_joint_names, build_truth, build_virtual
+    from .sim import STATE_SPEC, initial_state, truth_start
+    from .swing import swing_from_pose
+
+    class SuspendedSimNode(PlantNode):
+        def __init__(self):
+            super().__init__("cable_sim_node")
+            p = self.declare_parameter
+            variant = str(p("variant", "licas").value)
+            self.kind = str(p("model", "virtual").value)
+            self.description = load_description(description_yaml(variant, name=f"simulated {variant}"))
+            self.params = parameter_set(variant)
+            sx, sy, yw = (float(p(k, 0.0).value) for k in ("start_swing_x", "start_swing_y", "start_yaw"))
+            self.arm_input = str(p("arm_input", "reference").value)
+            if self.arm_input not in ("reference", "effort"):
+                raise CablelabError(f"cable_sim_node suspended: parameter arm_input={self.arm_input!r} "
+                                    "(expected reference or effort)")
+            motors = self.arm_input == "effort"
+            if self.kind == "truth":
+                self.model = build_truth(self.params, arm_motors=motors)
+                x0 = truth_start(self.model, self.params, sx, sy, yw)
+            elif self.kind == "virtual":
+                self.model = build_virtual(self.params, arm_motors=motors)
+                q0 = {"J8": sx, "J9": sy, "J7": yw}
+                if self.params.level_to_swing:
+                    q0.update({"J11": -sx, "J12": -sy})
+                x0 = initial_state(self.model, q0)
+            else:
+                raise CablelabError(f"cable_sim_node suspended: parameter model={self.kind!r} "
+                                    "(expected virtual or truth)")
+            self.data = mujoco.MjData(self.model)
+            mujoco.mj_setState(self.model, self.data, x0, STATE_SPEC)
+            mujoco.mj_forward(self.model, self.data)
+            self.names = list(arm_joint_names(self.params))
+            self.jq = [self.model.joint(n).qposadr[0] for n in self.names]
+            self.jv = [self.model.joint(n).dofadr[0] for n in self.names]
+            self.vq = ([self.model.joint(j).qposadr[0] for j in VJ] if self.kind == "virtual" else [])
+            self.rest = np.array(self.params.S) - [0, 0, self.params.L]
+            self.noise = float(p("pose_noise", 0.0).value)
+            self.rng = np.random.default_rng(0)
+            self.rate = float(p("rate", 100.0).value)
+            self.steps = max(1, int(round(1.0 / (self.rate * self.model.opt.timestep))))
+            self.inputs.add("reference", timeout=1e9, length=len(self.names))
+            self.inputs.add("effort_commands", timeout=float(p("command_timeout", 0.5).value),
+                            length=len(self.names))
+            self.pub_js = self.create_publisher(JointState, "/suspended/joint_states", publisher_qos())
+            self.pub_pose = self.create_publisher(PoseStamped, "/suspended/platform_pose", publisher_qos())
+            self.pub_sw = self.create_publisher(JointState, "/suspended/ground_truth/swing", publisher_qos())
+            self.pub_vj = self.create_publisher(JointState, "/suspended/ground_truth/virtual_joints", publisher_qos())
+            self.clock = ClockPublisher(self)
+            self.publish_description(self.description)
+            if motors:
+                self.create_subscription(Float64MultiArray, "/suspended/effort_commands", self.on_effort, stream_qos())
+            else:
+                self.create_subscription(JointTrajectory, "/suspended/reference", self.on_reference, stream_qos())
+            self.start_diagnostics()
+            self.timer = self.create_timer(1.0 / self.rate, self.tick)
+
+        def extend_status(self, level, msg, values):
+            values["sim time s"] = f"{self.data.time:.3f}"
+            return level, msg, values
+
+        def on_reference(self, msg) -> None:
+            _, names, q, _, _ = convert.joint_trajectory_point(msg)
+            if q is None or names != self.names or len(q) != len(self.names) or not np.all(np.isfinite(q)):
+                self.inputs.accept("reference", None, time.monotonic())
+                return
+            if self.inputs.accept("reference", q, time.monotonic()):
+                self.data.ctrl[:len(q)] = q
+
+        def on_effort(self, msg) -> None:
+            u = convert.float_array(msg)
+            if self.inputs.accept("effort_commands", u, time.monotonic()):
+                self.data.ctrl[:len(self.names)] = u
+
+        def tick(self) -> None:
+            if self.arm_input == "effort" and not self.inputs.fresh("effort_commands", time.monotonic()):
+                self.data.ctrl[:len(self.names)] = 0.0      # stale command: no torque (reported)
+            for _ in range(self.steps):
+                mujoco.mj_step(self.model, self.data)
+            mujoco.mj_forward(self.model, self.data)
+            t = float(self.data.time)
+            pos, quat = self.data.sensordata[:3].copy(), self.data.sensordata[3:7].copy()
+            q, qd = self.data.qpos[self.jq], self.data.qvel[self.jv]
+            eff = self.data.qfrc_actuator[self.jv]
+            self.pub_js.publish(convert.joint_state_msg(t, self.names, q, qd, eff))
+            meas = pos + (self.rng.normal(0, self.noise, 3) if self.noise > 0 else 0.0)
+            self.pub_pose.publish(convert.pose_msg(t, meas, wxyz_to_xyzw(quat[None])[0]))
+            sw = swing_from_pose(pos[None], quat[None], self.params.S, rest_pos=self.rest, rest_yaw=0.0)
+            self.pub_sw.publish(convert.joint_state_msg(t, list(CHANNELS), [float(sw[k][0]) for k in CHANNELS]))
+            if self.vq:
+                self.pub_vj.publish(convert.joint_state_msg(t, list(VJ), self.data.qpos[self.vq]))
+            self.clock.publish(t)
+
+    return SuspendedSimNode
+
+
+def _controller_class():
+    import numpy as np
+    from geometry_msgs.msg import PoseStamped
+    from ...ros.plant_node import PlantNode
+    from sensor_msgs.msg import JointState
+    from std_msgs.msg import Float64MultiArray
+    from trajectory_msgs.msg import JointTrajectory
+
+    from ...ros import convert
+    from ...ros.qos import catch_up_qos, publisher_qos, stream_qos
+    from .controller import ArmGravity, fig7_excitation, gains, pd_gravity, sway_offset
+    from .mjcf import arm_joint_names
+
+    class SuspendedController(PlantNode):
+        def __init__(self):
+            super().__init__("pd_feedforward")
+            p = self.declare_parameter
+            self.params = parameter_set(str(p("variant", "licas").value))
+            self.names = list(arm_joint_names(self.params))
+            n = len(self.names)
+            self.kp, self.kd, self.lim = gains(self.params)
+            self.gravity = ArmGravity(self.params)
+            self.excitation = str(p("excitation", "none").value)
+            self.level = int(p("excitation_level", 1).value)
+            self.k_s = float(p("sway_damping", 0.0).value)
+            self.stale = float(p("estimate_stale", 0.2).value)
+            self.q_ref, self.qd_ref = np.zeros(n), np.zeros(n)
+            self.R = np.eye(3)
+            self.v_swing, self.t_swing = np.nan, -np.inf
+            self.inputs.add("joint_states", timeout=0.5, length=n)
+            self.inputs.add("platform_pose", timeout=0.5, length=3)
+            self.inputs.add("reference", timeout=1e9, length=n)
+            self.pub = self.create_publisher(Float64MultiArray, "/suspended/effort_commands", publisher_qos())
+            self.create_subscription(JointState, "/suspended/joint_states", self.on_joints, catch_up_qos())
+            self.create_subscription(PoseStamped, "/suspended/platform_pose", self.on_pose, catch_up_qos())
+            self.create_subscription(JointState, "/suspended/swing_estimate", self.on_swing, catch_up_qos())
+            self.create_subscription(JointTrajectory, "/suspended/reference", self.on_reference, stream_qos())
+            self.start_diagnostics()
+
+        def on_pose(self, msg) -> None:
+            _, pos, qx = convert.pose_arrays(msg)
+            if self.inputs.accept("platform_pose", pos, time.monotonic()) and np.all(np.isfinite(qx)):
+                from ...rotations import quat_to_matrix, xyzw_to_wxyz
+
+                self.R = quat_to_matrix(xyzw_to_wxyz(qx / np.linalg.norm(qx)))
+
+        def on_swing(self, msg) -> None:
+            t, names, _, qd, _ = convert.joint_state_arrays(msg)
+            if qd is not None and "r_y" in names and len(qd) == len(names) and np.isfinite(qd[names.index("r_y")]):
+                self.v_swing, self.t_swing = float(qd[names.index("r_y")]), t
+
+        def on_reference(self, msg) -> None:
+            _, names, q, qd, _ = convert.joint_trajectory_point(msg)
+            if q is None or names != self.names or len(q) != len(self.names) or not np.all(np.isfinite(q)):
+                self.inputs.accept("reference", None, time.monotonic())
+                return
+            if self.inputs.accept("reference", q, time.monotonic()):
+                self.q_ref = q
+                self.qd_ref = qd if qd is not None and len(qd) == len(q) else np.zeros_like(q)
+
+        def on_joints(self, msg) -> None:
+            t, names, q, qd, _ = convert.joint_state_arrays(msg)
+            ok = q is not None and qd is not None and names == self.names and len(q) == len(names)
+            if not self.inputs.accept("joint_states", q if ok else None, time.monotonic()) or not ok \
+                    or not np.all(np.isfinite(qd)):
+                return
+            q_ref, qd_ref = self.q_ref.copy(), self.qd_ref.copy()
+            if self.excitation in ("x", "y", "z"):
+                qe, qde = fig7_excitation(np.array([t]), self.params, self.excitation, self.level)
+                q_ref, qd_ref = q_ref + qe[0], qd_ref + qde[0]
+            off = sway_offset(self.v_swing, self.k_s, t - self.t_swing, stale=self.stale)
+            n = self.params.n_arm
+            q_ref[1] += off
+            q_ref[n + 1] += off
+            tau = pd_gravity(q, qd, q_ref, qd_ref, self.kp, self.kd, self.gravity.torque(q, self.R), self.lim)
+            self.pub.publish(convert.command_msg(tau, t))
+
+    return SuspendedController
+
+
+def add_arguments(role: str, parser) -> None:
+    """No command-line options beyond the ROS parameters."""
+
+
+def make_node(role: str, args=None):
+    """The node of ``role`` (``estimator``)."""
+    if role == "estimator":
+        return _estimator_class()()
+    if role == "sim":
+        return _sim_class()()
+    if role == "controller":
+        return _controller_class()()
+    raise CablelabError(f"suspended: node role {role!r} is not implemented (available: {', '.join(ROLES)})")
