@@ -171,7 +171,8 @@ def load_description(src: str | os.PathLike) -> Description:
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f" line {mark.line + 1}" if mark is not None else ""
-        raise CablelabError(f"{origin}:{where} bad YAML ({getattr(exc, 'problem', exc)})") from None
+        problem = " ".join(str(getattr(exc, "problem", exc)).split())    # one line
+        raise CablelabError(f"{origin}:{where} bad YAML ({problem})") from None
     if data is None:
         raise CablelabError(f"{origin}: empty description")
     try:

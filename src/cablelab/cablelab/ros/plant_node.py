@@ -85,7 +85,7 @@ class PlantNode(Node):
         try:
             desc = load_description(msg.data)
         except CablelabError as exc:
-            self.description_problem = f"bad /plant_description: {exc}"
+            self.description_problem = " ".join(f"bad /plant_description: {exc}".split())
             self.get_logger().error(f"/plant_description: {exc}")
             return
         self.set_description(desc)

@@ -66,7 +66,7 @@ def _estimator_class():
                 msg = extra if msg == "ok" else f"{msg}; {extra}"
             return level, msg, values
 
-        def on_pose(self, msg) -> None:
+        def on_pose(self, msg: PoseStamped) -> None:
             t, pos, quat_xyzw = convert.pose_arrays(msg)
             self.inputs.accept("platform_pose", pos, time.monotonic())
             q = quat_xyzw[[3, 0, 1, 2]] if quat_xyzw is not None and len(quat_xyzw) == 4 else quat_xyzw
@@ -157,7 +157,7 @@ def _sim_class():
             values["sim time s"] = f"{self.data.time:.3f}"
             return level, msg, values
 
-        def on_reference(self, msg) -> None:
+        def on_reference(self, msg: JointTrajectory) -> None:
             _, names, q, _, _ = convert.joint_trajectory_point(msg)
             if q is None or names != self.names or len(q) != len(self.names) or not np.all(np.isfinite(q)):
                 self.inputs.accept("reference", None, time.monotonic())
@@ -165,7 +165,7 @@ def _sim_class():
             if self.inputs.accept("reference", q, time.monotonic()):
                 self.data.ctrl[:len(q)] = q
 
-        def on_effort(self, msg) -> None:
+        def on_effort(self, msg: Float64MultiArray) -> None:
             u = convert.float_array(msg)
             if self.inputs.accept("effort_commands", u, time.monotonic()):
                 self.data.ctrl[:len(self.names)] = u
@@ -231,19 +231,19 @@ def _controller_class():
             self.create_subscription(JointTrajectory, "/suspended/reference", self.on_reference, stream_qos())
             self.start_diagnostics()
 
-        def on_pose(self, msg) -> None:
+        def on_pose(self, msg: PoseStamped) -> None:
             _, pos, qx = convert.pose_arrays(msg)
             if self.inputs.accept("platform_pose", pos, time.monotonic()) and np.all(np.isfinite(qx)):
                 from ...rotations import quat_to_matrix, xyzw_to_wxyz
 
                 self.R = quat_to_matrix(xyzw_to_wxyz(qx / np.linalg.norm(qx)))
 
-        def on_swing(self, msg) -> None:
+        def on_swing(self, msg: JointState) -> None:
             t, names, _, qd, _ = convert.joint_state_arrays(msg)
             if qd is not None and "r_y" in names and len(qd) == len(names) and np.isfinite(qd[names.index("r_y")]):
                 self.v_swing, self.t_swing = float(qd[names.index("r_y")]), t
 
-        def on_reference(self, msg) -> None:
+        def on_reference(self, msg: JointTrajectory) -> None:
             _, names, q, qd, _ = convert.joint_trajectory_point(msg)
             if q is None or names != self.names or len(q) != len(self.names) or not np.all(np.isfinite(q)):
                 self.inputs.accept("reference", None, time.monotonic())
@@ -252,7 +252,7 @@ def _controller_class():
                 self.q_ref = q
                 self.qd_ref = qd if qd is not None and len(qd) == len(q) else np.zeros_like(q)
 
-        def on_joints(self, msg) -> None:
+        def on_joints(self, msg: JointState) -> None:
             t, names, q, qd, _ = convert.joint_state_arrays(msg)
             ok = q is not None and qd is not None and names == self.names and len(q) == len(names)
             if not self.inputs.accept("joint_states", q if ok else None, time.monotonic()) or not ok \
