@@ -40,7 +40,7 @@ def main() -> int:
 
     from cablelab.fleet.engine import default_workers, run_batch, run_loop, start_client
     from cablelab.fleet.scan import content_hash, find_bags
-    from cablelab.fleet.synthetic import write_fleet
+    from cablelab.plants.axis.fleet import write_fleet
 
     tmp = Path(tempfile.mkdtemp(prefix="bench-batch-"))
     try:

@@ -1,4 +1,4 @@
-"""Write a synthetic fleet of winch bags with planted drifts (cablelab.fleet.synthetic): N
+"""Write a synthetic fleet of winch bags with planted drifts (cablelab.plants.axis.fleet): N
 machines x D days, an independent solve_ivp simulation (tanh Coulomb + viscous friction), friction
 rising on one machine and a force-sensor offset appearing on another.
 
@@ -10,7 +10,7 @@ from __future__ import annotations
 import argparse
 import json
 
-from cablelab.fleet.synthetic import Drift, default_drifts, machine_names, write_fleet
+from cablelab.plants.axis.fleet import Drift, default_drifts, machine_names, write_fleet
 
 
 def main(argv=None) -> int:

@@ -1,5 +1,5 @@
 """`cablelab batch` end to end on a synthetic fleet (6 machines x 10 days of winch bags from an
-independent solve_ivp simulation, cablelab.fleet.synthetic) with planted drifts: every drift is
+independent solve_ivp simulation, cablelab.plants.axis.fleet) with planted drifts: every drift is
 found (machine, parameter, day within +-1), clean machines report none, a corrupt bag becomes one
 failed row, and a re-run with the same OUT diagnoses nothing again and keeps every row once.
 """
@@ -16,7 +16,7 @@ import pyarrow.parquet as pq
 import pytest
 
 from cablelab.fleet.scan import compile_group_by, content_hash, find_bags, match_group_by
-from cablelab.fleet.synthetic import day_time, machine_names, write_fleet
+from cablelab.plants.axis.fleet import day_time, machine_names, write_fleet
 from cablelab.fleet.task import run_bag
 
 MACHINES, DAYS = 6, 10

@@ -135,7 +135,7 @@ def test_checker_catches_broken_pages(tmp_path):
 
 
 def test_fleet_and_bag_reports_render_in_chromium(tmp_path):
-    from cablelab.fleet.synthetic import write_fleet
+    from cablelab.plants.axis.fleet import write_fleet
 
     root, out = tmp_path / "fleet", tmp_path / "out"
     write_fleet(root, 2, 6, duration=4.0)

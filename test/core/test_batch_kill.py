@@ -14,7 +14,7 @@ import psutil
 import pyarrow.parquet as pq
 import pytest
 
-from cablelab.fleet.synthetic import write_fleet
+from cablelab.plants.axis.fleet import write_fleet
 
 MACHINES, DAYS = 6, 10
 N_EFFECTS = 5  # axis: inertia, viscous, coulomb, offset, delay

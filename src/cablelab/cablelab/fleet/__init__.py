@@ -3,7 +3,8 @@
 ``scan`` finds bags, machine/time and content hashes; ``task`` turns one bag into result rows
 (never raises); ``engine`` runs the tasks on a Dask LocalCluster or an existing scheduler with
 progress, retries and resume; ``table`` is the parquet schema; ``drift`` the change-point test;
-``report`` the fleet index.html; ``synthetic`` a fleet of simulated winch bags with planted drifts.
+``report`` the fleet index.html. (A synthetic fleet of winch bags with planted drifts for tests and
+benchmarks: :mod:`cablelab.plants.axis.fleet`.)
 """
 from __future__ import annotations
 

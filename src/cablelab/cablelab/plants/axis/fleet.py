@@ -144,7 +144,7 @@ def write_fleet(root, machines: int = 6, days: int = 10, drifts=None, *, duratio
                 fs: float = 200.0, noise_effort: float = 0.05, progress: bool = False) -> list[Drift]:
     """Write ``root/<machine>/day-<DD>/`` rosbag2 bags (``/axis/joint_states`` + description with
     ``name`` = machine, stamps from :data:`EPOCH` + day) and return the planted drifts."""
-    from ..bags import BagWriter
+    from ...bags import BagWriter
 
     root = Path(root)
     names = machine_names(machines)
