@@ -123,6 +123,15 @@ def _option(timestep: float, integrator: str) -> str:
             f'  <option timestep="{timestep!r}" integrator="{integrator}" gravity="0 0 -9.81"/>')
 
 
+#: the measured platform pose of every model (MJCF tail shared by the virtual and truth models)
+_PLATFORM_SENSORS = """  <sensor>
+    <framepos objtype="site" objname="platform"/>
+    <framequat objtype="site" objname="platform"/>
+  </sensor>
+</mujoco>
+"""
+
+
 def virtual_xml(p: VirtualParams, *, levelling: str = "tendon", cable_elasticity=None,
                 timestep: float = 1e-3, integrator: str = "implicitfast", lock=(),
                 freeze_arms: bool = False, arm_motors: bool = False) -> str:
@@ -203,12 +212,7 @@ def virtual_xml(p: VirtualParams, *, levelling: str = "tendon", cable_elasticity
     {_actuators(p, freeze_arms, arm_motors)}
     {lvl_act}
   </actuator>
-  <sensor>
-    <framepos objtype="site" objname="platform"/>
-    <framequat objtype="site" objname="platform"/>
-  </sensor>
-</mujoco>
-"""
+{_PLATFORM_SENSORS}"""
 
 
 def build_virtual(p: VirtualParams, **kw) -> mujoco.MjModel:
@@ -275,12 +279,7 @@ def truth_xml(p: VirtualParams, *, platform_mass: float = 0.7, cable_separation:
   <actuator>
     {_actuators(p, motors=arm_motors)}
   </actuator>
-  <sensor>
-    <framepos objtype="site" objname="platform"/>
-    <framequat objtype="site" objname="platform"/>
-  </sensor>
-</mujoco>
-"""
+{_PLATFORM_SENSORS}"""
 
 
 def build_truth(p: VirtualParams, **kw) -> mujoco.MjModel:
