@@ -52,6 +52,7 @@ class DemoPart:
         analyse: ``fn(out_dir, args, runs) -> PartResult`` (may run in a worker thread).
         quick: ``fn(args)`` shortening the options for ``--quick``.
         subdir: the part's directory under ``--out`` ("" = ``--out`` itself).
+        how: how its data are made (shown in its table's heading).
     """
 
     plant: str
@@ -62,6 +63,7 @@ class DemoPart:
     analyse: Callable
     quick: Callable = lambda args: None
     subdir: str = ""
+    how: str = "sim + estimator + controller + recorder over DDS"
 
 
 def demo_parts() -> list[DemoPart]:
@@ -156,13 +158,13 @@ def main(argv: list[str] | None = None) -> int:
         for part, fut in futures:
             res = fut.result()
             if res is not None:
-                results[part.title] = res
-    index = index_page(out, results) if results else None
-    for title, res in results.items():
-        print_table(f"{title}: sim + estimator + controller + recorder over DDS "
-                    f"(analysis {res.seconds:.0f} s)", res.rows)
+                results[part.title] = (part, res)
+    index = index_page(out, {t: r for t, (_, r) in results.items()}) if results else None
+    for title, (part, res) in results.items():
+        took = f" (analysis {res.seconds:.0f} s)" if res.seconds else ""
+        print_table(f"{title}: {part.how}{took}", res.rows)
     print()
-    for title, res in results.items():
+    for title, (_, res) in results.items():
         print(f"{title.split(' (')[0]}: bags {', '.join(str(b) for b in res.bags)}")
         print(f"    report {os.path.abspath(res.report)}")
         print(f"    page   {os.path.abspath(res.page)}")

@@ -149,4 +149,4 @@ def _analyse(out_dir: Path, args, res: dict) -> PartResult:
 DEMO = DemoPart(plant="leg", title="Hopping leg (003), impact map and preload hidden", order=40,
                 add_arguments=lambda group: None,
                 record=lambda out, args: run(out, quick=args.quick), analyse=_analyse,
-                subdir="leg")
+                subdir="leg", how="MuJoCo hybrid-plant data (offline), then the workbench")

@@ -157,7 +157,8 @@ def _make_demo():
     return DemoPart(plant="suspended", title="LiCAS cable-suspended platform (000)", order=30,
                     add_arguments=lambda group: None,
                     record=lambda out, args: run(out, quick=args.quick), analyse=_analyse,
-                    subdir="suspended")
+                    subdir="suspended",
+                    how="four-tendon truth-plant data (offline), identification, the workbench")
 
 
 DEMO = _make_demo()
