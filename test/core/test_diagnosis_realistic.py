@@ -155,6 +155,10 @@ def test_stribeck_effect_recovers_breakaway_level_and_speed(tmp_path):
     assert r.params["Fc"] + r.params["dFs"] == pytest.approx(6.0, rel=0.10)
     assert r.params["Fc"] == pytest.approx(3.0, rel=0.10)
     assert r.params["vs_rel"] * np.percentile(np.abs(ds.act_vel[:, 0]), 99) == pytest.approx(0.08, rel=0.25)
+    # the contract's parameters F_s, v_s reported beside the fitted dFs, vs_rel
+    own = r.effect_params("joint_stribeck_friction", ds)
+    assert own["F_s"] == pytest.approx(r.params["Fc"] + r.params["dFs"], rel=1e-12)
+    assert own["F_s"] == pytest.approx(6.0, rel=0.10) and own["v_s"] == pytest.approx(0.08, rel=0.25)
     # and without it the Coulomb-only model leaves a clearly larger error
     r0 = identify(workbench.build_model(plant, desc, ["joint_coulomb_friction"]), ds)
     assert r.linear.rss < 0.7 * r0.linear.rss

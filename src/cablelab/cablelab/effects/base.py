@@ -63,6 +63,8 @@ class Effect:
         nonlinear: parameters searched outside the linear LS (bounded, separable LS).
         transform: ``fn(ds, values) -> ds`` applying the nonlinear parameters to the data
             (must set ``valid`` False where the result is undefined).
+        derived: optional ``fn(effect, own, all_params, ds) -> {name: value}``: values reported
+            beside the fitted parameters (e.g. the contract's F_s, v_s of a Stribeck effect).
         requires: a capability the plant must declare (:attr:`cablelab.registry.Plant.
             capabilities`, e.g. ``"joint_actuators"``); ``None`` = no requirement.
     """
@@ -78,6 +80,7 @@ class Effect:
     nonlinear: tuple[Param, ...] = ()
     transform: TransformFn | None = None
     requires: str | None = None
+    derived: Callable | None = None
 
     def applies_to(self, plant: str, capabilities=frozenset()) -> bool:
         """Whether the effect applies to ``plant`` with these capabilities."""

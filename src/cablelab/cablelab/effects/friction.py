@@ -95,6 +95,21 @@ def stribeck_regressor(effect_id: str) -> RegressorFn:
     return fn
 
 
+def stribeck_contract_params(effect: Effect, own: dict, all_params: dict, ds) -> dict:
+    """The contract's Stribeck parameters beside the fitted ones: F_s = Fc + dFs (the model's
+    Coulomb level, 0 without it) and v_s = vs_rel x p99(|v|), per actuator."""
+    v = ds.require_actuators(effect.id)
+    p99 = np.percentile(np.abs(v), 99, axis=0)
+    vs_rel = float(own.get("vs_rel", 0.1))
+    out = {}
+    for j, col in enumerate(effect.columns(ds)):
+        suffix = col.name[len("dFs"):]
+        if col.name in own:
+            out["F_s" + suffix] = float(all_params.get("Fc" + suffix, 0.0)) + float(own[col.name])
+            out["v_s" + suffix] = vs_rel * float(p99[min(j, len(p99) - 1)])
+    return out
+
+
 def stribeck_effect(effect_id: str, plants: tuple, reference: str,
                     requires: str | None = None) -> Effect:
     """A Stribeck friction effect (generic: joint effects; the CDPR registers its winch one)."""
@@ -114,6 +129,7 @@ def stribeck_effect(effect_id: str, plants: tuple, reference: str,
         reference=reference,
         regressor=stribeck_regressor(effect_id),
         per_actuator=True,
+        derived=stribeck_contract_params,
     )
 
 

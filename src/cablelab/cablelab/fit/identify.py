@@ -66,7 +66,10 @@ class Identification:
 
         eff = get_effect(effect_id)
         names = [p.name for p in eff.columns(ds)] + [p.name for p in eff.nonlinear]
-        return {k: self.params[k] for k in names if k in self.params}
+        own = {k: self.params[k] for k in names if k in self.params}
+        if eff.derived is not None:
+            own.update(eff.derived(eff, own, self.params, ds))
+        return own
 
 
 def _linear_system(model: Model, ds: Dataset):
