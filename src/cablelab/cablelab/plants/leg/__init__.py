@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from ...registry import Plant, register_plant
 from . import effects as _effects  # noqa: F401  (registers the leg effects)
-from .dataset import dataset
+from .dataset import check_bag, dataset
 from .description import parse_section
 
 JOINT_STATE = "sensor_msgs/msg/JointState"
@@ -42,6 +42,7 @@ LEG = register_plant(Plant(
     joint_topic="/leg/joint_states",
     joints=("body", "motor"),
     checked_topics=("/leg/contact",),
+    check_bag=check_bag,
 ))
 
 PLANT = LEG

@@ -82,12 +82,19 @@ def dataset_from_arrays(t, z, contact, tau, description, options: dict | None = 
                    inputs={"velocity": zd}, description=description, source=source)
 
 
+def check_bag(bag, description, options, series) -> list[str]:
+    """Input checks before a fit (:func:`cablelab.bagcheck.check_bag`): say when the phase has
+    to come from the height because the bag has no contact switch."""
+    if bag.has("/leg/contact"):
+        return []
+    return [f"{bag.path}: no /leg/contact in the bag; phase detected from the height "
+            "(z < z_td - 0.5 mm, 20 ms dwell)"]
+
+
 def dataset(bag, description, options: dict | None = None) -> Dataset:
     """Leg dataset from a bag's ``/leg/joint_states`` (joint ``body`` height, ``motor`` torque) and
     ``/leg/contact``. Without the contact topic the phase comes from the height (live estimator
-    rule) and a warning says so."""
-    import sys
-
+    rule) and :func:`check_bag` says so."""
     from .estimator import estimate_series
 
     js = bag.joint_state("/leg/joint_states")
@@ -100,9 +107,7 @@ def dataset(bag, description, options: dict | None = None) -> Dataset:
     if bag.has("/leg/contact"):
         c = bag.joint_state("/leg/contact")
         contact = np.interp(js.t, c.t, c.position[:, 0]) > 0.5
-    if contact is None:
-        print(f"{bag.path}: no /leg/contact in the bag; phase detected from the height "
-              "(z < z_td - 0.5 mm, 20 ms dwell)", file=sys.stderr)
+    if contact is None:       # (said as a warning of the input checks: check_bag below)
         leg = leg_of(description)
         contact = estimate_series(js.t, z, None, tau, leg.params(description.gravity))["phase"]
     return dataset_from_arrays(js.t, z, contact, tau, description, options, source=str(bag.path))
