@@ -58,13 +58,10 @@ def parse_section(obj) -> LegDescription:
 
 
 def leg_of(description) -> LegDescription:
-    """The :class:`LegDescription` of a loaded description (parsed section or raw ``extra``)."""
+    """The :class:`LegDescription` of a loaded description (one-line error without it)."""
     from ...errors import CablelabError
 
     leg = getattr(description, "leg", None)
     if leg is None:
-        raw = getattr(description, "extra", {}).get("leg")
-        if raw is None:
-            raise CablelabError("leg: missing required key (the section of the plant named by 'plant')")
-        leg = parse_section(raw)
+        raise CablelabError("leg: missing required key (the section of the plant named by 'plant')")
     return leg

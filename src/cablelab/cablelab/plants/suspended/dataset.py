@@ -23,7 +23,6 @@ import numpy as np
 from ...conditioning import Conditioning, condition_motion
 from ...errors import CablelabError
 from ...model import Dataset
-from .description import parse_section
 from .params import VirtualParams
 from .reference import planar_bodies
 from .swing import swing_from_pose
@@ -100,15 +99,11 @@ def dataset_from_arrays(t, pos, quat_wxyz, desc_section, description=None, optio
 
 
 def section_of(description):
-    """The parsed ``suspended:`` section of a description (from ``extra`` until the restructure
-    gives Description a field)."""
+    """The parsed ``suspended:`` section of a description (one-line error without it)."""
     sec = getattr(description, "suspended", None)
-    if sec is not None and not isinstance(sec, dict):
-        return sec
-    raw = (getattr(description, "extra", {}) or {}).get("suspended")
-    if raw is None:
+    if sec is None:
         raise CablelabError("description: plant suspended needs a 'suspended:' section")
-    return parse_section(raw)
+    return sec
 
 
 def dataset(bag, description, options: dict | None = None) -> Dataset:
