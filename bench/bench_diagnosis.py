@@ -8,6 +8,13 @@ library path of `cablelab diagnose --greedy`.
 
     nice -n 10 ./run python bench/bench_diagnosis.py --cases 300        # full benchmark
     nice -n 10 ./run python bench/bench_diagnosis.py --quick            # 30 cases, no 1M timing
+    nice -n 10 ./run python bench/bench_diagnosis.py --plants crane,cdpr,leg,suspended --no-scaling
+
+``--plants`` chooses the plants (default: axis only): axis cases come from bench/diagnosis_cases.py,
+the others from bench/cases_<plant>.py (each a separate simulator: MuJoCo crane with smooth
+friction, an own CDPR wrench computation, the leg's and the suspended platform's solve_ivp
+references), ``--plant-cases crane=60,cdpr=60,leg=20,suspended=20`` their numbers. Every table is
+printed over all cases and per plant.
 
 Targets: top-1 hidden effect >= 95 %; false significant on controls <= 2 %; parameter of the true
 effect median |error| <= 3 %, p95 <= 10 %; greedy recovers exactly the hidden set in >= 90 % of
@@ -26,6 +33,11 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from diagnosis_cases import TRUE_PARAM, draw_case, simulate, write_bag  # noqa: E402
 from harness import Bench  # noqa: E402
+from cases_common import rel_param_error  # noqa: E402
+
+#: plant -> (generator module, default number of cases, first seed)
+PLANT_CASES = {"crane": ("cases_crane", 60, 2000), "cdpr": ("cases_cdpr", 60, 3000),
+               "leg": ("cases_leg", 20, 4000), "suspended": ("cases_suspended", 20, 5000)}
 
 
 def run_case(case, workdir: str) -> dict:
@@ -40,7 +52,7 @@ def run_case(case, workdir: str) -> dict:
         model = workbench.build_model(plant, desc)
         out = workbench.diagnose(ds, model, plant.candidates(desc), greedy_mode=True).to_json()
     except CablelabError as exc:
-        return {"case": case, "error": str(exc), "seconds": time.perf_counter() - t0}
+        return {"case": case, "error": str(exc), "seconds": time.perf_counter() - t0, **_axis_fields(case)}
     secs = time.perf_counter() - t0
     first = out["ranking"][0] if out["ranking"] else None
     top_sig = first["effect"] if first and first.get("significant") else "none"
@@ -55,7 +67,48 @@ def run_case(case, workdir: str) -> dict:
         else:
             perr[h] = np.inf
     return {"case": case, "top": first["effect"] if first else "none", "top_sig": top_sig,
-            "added": added, "perr": perr, "seconds": secs, "n": ds.n}
+            "added": added, "perr": perr, "seconds": secs, "n": ds.n, **_axis_fields(case)}
+
+
+def _axis_fields(case) -> dict:
+    return {"plant": "axis", "hidden": tuple(case.hidden), "label": case.label(),
+            "family": (case.flavour, int(case.fs), "velocity" if case.velocity_recorded else "encoder only"),
+            "miss": f"seed {case.seed} {case.flavour} {case.fs:g} Hz {case.profile} "
+                    f"{'vel' if case.velocity_recorded else 'enc'}"}
+
+
+def run_plant_case(case, gen, workdir: str) -> dict:
+    """One case of another plant (a :class:`cases_common.PlantCase` of module ``gen``): write its
+    bag, load it with the case's options, nominal model + the case's known effects and fixed
+    parameters, ``diagnose --greedy``; the parameter error of each hidden effect (norm over its
+    parameter vector) where the case states its true parameters."""
+    from cablelab import workbench
+    from cablelab.errors import CablelabError
+
+    path = os.path.join(workdir, f"{case.plant}_{case.seed}")
+    gen.write_bag(case, path)
+    fields = {"case": case, "plant": case.plant, "hidden": tuple(case.hidden),
+              "label": case.label(),
+              "family": (f"{case.plant} {case.family}".strip(), int(case.fs),
+                         "velocity" if case.velocity_recorded else "encoder only"),
+              "miss": f"seed {case.seed} {case.plant} {case.family}"}
+    t0 = time.perf_counter()
+    try:
+        plant, desc, ds = workbench.load(path, None, dict(case.options))
+        model = workbench.build_model(plant, desc, case.effects, fixed=case.fixed)
+        out = workbench.diagnose(ds, model, plant.candidates(desc), greedy_mode=True).to_json()
+    except CablelabError as exc:
+        return {**fields, "error": str(exc), "seconds": time.perf_counter() - t0}
+    secs = time.perf_counter() - t0
+    first = out["ranking"][0] if out["ranking"] else None
+    added = [g["added"] for g in out["greedy"][1:]]
+    final = out["final"]["params"]
+    perr = {h: (rel_param_error(final, case.true_params[h]) if h in added else np.inf)
+            for h in case.hidden if h in case.true_params}
+    return {**fields, "top": first["effect"] if first else "none",
+            "top_sig": first["effect"] if first and first.get("significant") else "none",
+            "added": added, "perr": perr, "seconds": secs, "n": ds.n,
+            "candidates": tuple(plant.candidates(desc))}
 
 
 def scaling(bench, sizes) -> None:
@@ -90,89 +143,136 @@ def main() -> None:
     bench.parser.add_argument("--quick", action="store_true", help="30 cases, scaling up to 100k")
     bench.parser.add_argument("--seed", type=int, default=1000)
     bench.parser.add_argument("--no-scaling", action="store_true")
+    bench.parser.add_argument("--plants", default="axis",
+                              help="comma-separated: axis," + ",".join(PLANT_CASES) + " (default axis)")
+    bench.parser.add_argument("--plant-cases", default="", metavar="P=N,...",
+                              help="cases per non-axis plant (default " +
+                              ",".join(f"{p}={v[1]}" for p, v in PLANT_CASES.items()) + ")")
     args = bench.parse()
     n_cases = 30 if args.quick else args.cases
+    plants = [p.strip() for p in args.plants.split(",") if p.strip()]
+    unknown = [p for p in plants if p != "axis" and p not in PLANT_CASES]
+    if unknown:
+        bench.parser.error(f"--plants: unknown {unknown}; expected axis or {', '.join(PLANT_CASES)}")
+    counts = {p: v[1] for p, v in PLANT_CASES.items()}
+    for item in filter(None, args.plant_cases.split(",")):
+        name, _, num = item.partition("=")
+        counts[name.strip()] = int(num)
     from tqdm import tqdm
+    import importlib
 
+    jobs = [("axis", k) for k in range(n_cases)] if "axis" in plants else []
+    jobs += [(p, k) for p in plants if p != "axis" for k in range(counts[p])]
     results = []
     with tempfile.TemporaryDirectory() as d:
-        for k in tqdm(range(n_cases), desc="diagnosis cases", file=sys.stderr):
-            results.append(run_case(draw_case(args.seed + k), d))
+        for p, k in tqdm(jobs, desc="diagnosis cases", file=sys.stderr):
+            if p == "axis":
+                results.append(run_case(draw_case(args.seed + k), d))
+            else:
+                gen = importlib.import_module(PLANT_CASES[p][0])
+                results.append(run_plant_case(gen.draw_case(PLANT_CASES[p][2] + k), gen, d))
     summarise(bench, results)
-    if not args.no_scaling:
+    if not args.no_scaling and "axis" in plants:
         scaling(bench, [10_000, 60_000, 100_000] + ([] if args.quick else [1_000_000]))
     bench.done()
 
 
-def summarise(bench, results) -> None:
-    ok = [r for r in results if "error" not in r]
-    hidden = [r for r in ok if r["case"].hidden]
-    controls = [r for r in ok if not r["case"].hidden]
-    two = [r for r in ok if len(r["case"].hidden) == 2]
-    top1 = np.mean([r["top"] in r["case"].hidden for r in hidden]) if hidden else np.nan
-    false_sig = np.mean([r["top_sig"] != "none" for r in controls]) if controls else np.nan
-    exact2 = np.mean([set(r["added"]) == set(r["case"].hidden) for r in two]) if two else np.nan
-    exact_all = np.mean([set(r["added"]) == set(r["case"].hidden) for r in ok]) if ok else np.nan
+def _rates(rs) -> dict:
+    """The target metrics over results ``rs`` (NaN where a metric has no cases)."""
+    ok = [r for r in rs if "error" not in r]
+    hidden = [r for r in ok if r["hidden"]]
+    controls = [r for r in ok if not r["hidden"]]
+    two = [r for r in ok if len(r["hidden"]) == 2]
     errs = np.array([e for r in hidden for e in r["perr"].values()])
+    mean = lambda xs: float(np.mean(xs)) if len(xs) else np.nan  # noqa: E731
+    return {"ok": ok, "hidden": hidden, "controls": controls, "two": two, "errs": errs,
+            "top1": mean([r["top"] in r["hidden"] for r in hidden]),
+            "false_sig": mean([r["top_sig"] != "none" for r in controls]),
+            "exact2": mean([set(r["added"]) == set(r["hidden"]) for r in two]),
+            "exact_all": mean([set(r["added"]) == set(r["hidden"]) for r in ok])}
+
+
+def _pct(x) -> str:
+    return "nan" if not np.isfinite(x) else f"{100 * x:.1f} %"
+
+
+def _short(effect: str) -> str:
+    for a, b in (("joint_", ""), ("winch_", "w_"), ("torque_sensor_", ""), ("tension_sensor_", "t_"),
+                 ("_friction", ""), ("cable_", "c_")):
+        effect = effect.replace(a, b)
+    return effect
+
+
+def summarise(bench, results) -> None:
+    m = _rates(results)
+    ok, controls, two, errs = m["ok"], m["controls"], m["two"], m["errs"]
     fin = errs[np.isfinite(errs)]
     secs = np.array([r["seconds"] for r in ok])
     bench.row(metric="cases (errors)", value=f"{len(results)} ({len(results) - len(ok)})", target="")
-    bench.row(metric="top-1 hidden effect", value=f"{100 * top1:.1f} %", target=">= 95 %")
-    bench.row(metric="false significant on controls", value=f"{100 * false_sig:.1f} % of {len(controls)}",
+    bench.row(metric="top-1 hidden effect", value=_pct(m["top1"]), target=">= 95 %")
+    bench.row(metric="false significant on controls", value=f"{_pct(m['false_sig'])} of {len(controls)}",
               target="<= 2 %")
-    bench.row(metric="greedy = hidden set (two-effect)", value=f"{100 * exact2:.1f} % of {len(two)}",
+    bench.row(metric="greedy = hidden set (two-effect)", value=f"{_pct(m['exact2'])} of {len(two)}",
               target=">= 90 %")
-    bench.row(metric="greedy = hidden set (all cases)", value=f"{100 * exact_all:.1f} %", target="")
+    bench.row(metric="greedy = hidden set (all cases)", value=_pct(m["exact_all"]), target="")
     bench.row(metric="true-effect parameter |rel. error| median",
               value=f"{100 * np.median(errs):.2f} %" if errs.size else "nan", target="<= 3 %")
     bench.row(metric="true-effect parameter |rel. error| p95",
               value=f"{100 * np.percentile(errs, 95):.2f} %" if errs.size else "nan", target="<= 10 %")
     bench.row(metric="parameters not recovered (effect not added)", value=f"{errs.size - fin.size} of {errs.size}",
               target="")
-    bench.row(metric="diagnose --greedy seconds median / max", value=f"{np.median(secs):.2f} / {np.max(secs):.2f}",
-              target="")
+    bench.row(metric="diagnose --greedy seconds median / max",
+              value=f"{np.median(secs):.2f} / {np.max(secs):.2f}" if secs.size else "nan", target="")
+    plants = list(dict.fromkeys(r["plant"] for r in results))
+    if len(plants) > 1 or plants != ["axis"]:
+        bench.section("per plant (targets in the column names)")
+        for p in plants:
+            q = _rates([r for r in results if r["plant"] == p])
+            e = q["errs"]
+            bench.row(plant=p, cases=len([r for r in results if r["plant"] == p]),
+                      errors=sum("error" in r for r in results if r["plant"] == p),
+                      **{"top1 >=95%": _pct(q["top1"]),
+                         "false sig <=2%": f"{_pct(q['false_sig'])} of {len(q['controls'])}",
+                         "greedy=hidden two >=90%": f"{_pct(q['exact2'])} of {len(q['two'])}",
+                         "greedy=hidden all": _pct(q["exact_all"]),
+                         "param median <=3%": f"{100 * np.median(e):.2f} %" if e.size else "-",
+                         "param p95 <=10%": f"{100 * np.percentile(e, 95):.2f} %" if e.size else "-",
+                         "not recovered": f"{int(np.sum(~np.isfinite(e)))} of {e.size}"})
     # per-parameter error
-    bench.section("parameter error by hidden effect (cases where it was added)")
-    for h in TRUE_PARAM:
-        e = np.array([r["perr"][h] for r in hidden if h in r["perr"]])
+    bench.section("parameter error by hidden effect (cases where it was added; norm over the effect's parameters)")
+    keys = list(dict.fromkeys((r["plant"], h) for r in ok for h in r["perr"]))
+    for p, h in keys:
+        e = np.array([r["perr"][h] for r in ok if r["plant"] == p and h in r["perr"]])
         e = e[np.isfinite(e)]
         if e.size:
-            bench.row(effect=h, cases=e.size, median=f"{100 * np.median(e):.2f} %",
+            bench.row(plant=p, effect=h, cases=e.size, median=f"{100 * np.median(e):.2f} %",
                       p95=f"{100 * np.percentile(e, 95):.2f} %", max=f"{100 * np.max(e):.1f} %")
-    # by flavour / rate / velocity source
+    # by case family
     bench.section("top-1 / exact greedy set by case family")
-    fam = Counter()
-    for r in ok:
-        c = r["case"]
-        key = (c.flavour, int(c.fs), "velocity" if c.velocity_recorded else "encoder only")
-        fam[key] += 1
-    for key in sorted(fam):
-        rs = [r for r in ok if (r["case"].flavour, int(r["case"].fs),
-                                "velocity" if r["case"].velocity_recorded else "encoder only") == key]
-        hs = [r for r in rs if r["case"].hidden]
+    fam = Counter(r["family"] for r in ok)
+    for key in sorted(fam, key=str):
+        rs = [r for r in ok if r["family"] == key]
+        hs = [r for r in rs if r["hidden"]]
         bench.row(plant=key[0], rate_hz=key[1], velocity=key[2], cases=len(rs),
-                  top1=f"{100 * np.mean([r['top'] in r['case'].hidden for r in hs]):.0f} %" if hs else "-",
-                  exact_set=f"{100 * np.mean([set(r['added']) == set(r['case'].hidden) for r in rs]):.0f} %")
-    # confusion matrix: true hidden set (label) vs greedy's added set
-    bench.section("confusion matrix: rows = hidden set, columns = first significant effect (step 0)")
-    labels = ["joint_coulomb_friction", "torque_sensor_offset", "time_delay", "none"]
-    short = {"joint_coulomb_friction": "coulomb", "torque_sensor_offset": "offset", "time_delay": "delay",
-             "none": "none"}
-    rows = sorted({r["case"].label() for r in ok})
-    for lab in rows:
-        rs = [r for r in ok if r["case"].label() == lab]
-        cnt = Counter(r["top_sig"] for r in rs)
-        bench.row(hidden=lab, cases=len(rs), **{short[k]: cnt.get(k, 0) for k in labels},
-                  other=sum(v for k, v in cnt.items() if k not in labels))
-    failures = [r for r in ok if set(r["added"]) != set(r["case"].hidden)]
-    for r in failures[:15]:
-        c = r["case"]
-        print(f"[miss] seed {c.seed} {c.flavour} {c.fs:g} Hz {c.profile} "
-              f"{'vel' if c.velocity_recorded else 'enc'} hidden={c.label()} added={r['added']}",
-              file=sys.stderr)
+                  top1=f"{100 * np.mean([r['top'] in r['hidden'] for r in hs]):.0f} %" if hs else "-",
+                  exact_set=f"{100 * np.mean([set(r['added']) == set(r['hidden']) for r in rs]):.0f} %")
+    # confusion matrix per plant: true hidden set vs the first significant effect of the ranking
+    for p in plants:
+        rs_p = [r for r in ok if r["plant"] == p]
+        labels = list(dict.fromkeys([h for r in rs_p for h in r["hidden"]] + sorted(
+            {r["top_sig"] for r in rs_p} - {"none"})))
+        bench.section(f"confusion matrix {p}: rows = hidden set, columns = first significant effect (step 0)")
+        for lab in sorted({r["label"] for r in rs_p}):
+            rs = [r for r in rs_p if r["label"] == lab]
+            cnt = Counter(r["top_sig"] for r in rs)
+            bench.row(hidden=lab, cases=len(rs), **{_short(k): cnt.get(k, 0) for k in labels},
+                      none=cnt.get("none", 0))
+    failures = [r for r in ok if set(r["added"]) != set(r["hidden"])]
+    for r in failures[:40]:
+        print(f"[miss] {r['miss']} hidden={r['label']} added={r['added']}", file=sys.stderr)
     for r in results:
         if "error" in r:
-            print(f"[error] seed {r['case'].seed}: {r['error']}", file=sys.stderr)
+            print(f"[error] {r['miss']}: {r['error']}", file=sys.stderr)
 
 
 if __name__ == "__main__":

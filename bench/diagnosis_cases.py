@@ -25,7 +25,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.integrate
-import scipy.signal
+
+from cases_common import coloured_noise, min_jerk, quantize
 
 G = 9.81
 #: hidden-effect menu of the axis cases: effect id -> the true parameter checked
@@ -110,9 +111,7 @@ def draw_case(seed: int, kind: str | None = None) -> Case:
 
 # ----------------------------------------------------------------------------- reference motion
 
-def _min_jerk(s):
-    s = np.clip(s, 0.0, 1.0)
-    return 10 * s**3 - 15 * s**4 + 6 * s**5, (30 * s**2 - 60 * s**3 + 30 * s**4), (60 * s - 180 * s**2 + 120 * s**3)
+_min_jerk = min_jerk
 
 
 def reference(case: Case, rng) -> callable:
@@ -234,12 +233,9 @@ def simulate(case: Case) -> dict:
     u_true = control(t, x[0], x[1])
     rms = float(np.sqrt(np.mean(u_true**2)))
     sigma = case.noise_rel * rms
-    e = rng.standard_normal(n) * sigma * np.sqrt(1 - case.ar**2)
-    noise = scipy.signal.lfilter([1.0], [1.0, -case.ar], e)
-    spikes = rng.random(n) < case.outlier_rate
-    noise[spikes] += rng.choice([-1, 1], spikes.sum()) * 10 * sigma
+    noise = coloured_noise(rng, n, sigma, case.ar, case.outlier_rate)
     effort = u_meas + tr["OF"] + noise
-    q = np.round(x[0] / case.quantum) * case.quantum if case.quantum > 0 else x[0]
+    q = quantize(x[0], case.quantum)
     qd = x[1] + rng.standard_normal(n) * 0.002 * case.vmax if case.velocity_recorded else np.full(n, np.nan)
     return {"t": t, "q": q, "qd": qd, "effort": effort, "q_true": x[0], "qd_true": x[1], "u_true": u_true}
 

@@ -93,7 +93,7 @@ def dataset_from_arrays(t, q_joints, effort, t_mocap, tip, payload, description,
     g = description.gravity if description is not None else STANDARD_GRAVITY
     q, qd, qdd = c["q"], c["qd"], c["qdd"]
     Y = regressor(q, qd, qdd, g)
-    return Dataset(
+    ds = Dataset(
         plant="crane", t=c["t"], y=c["effort"], channels=JOINTS, units=("N m", "N m", "N"),
         signals={"q": q, "qd": qd, "qdd": qdd, "Y": Y,
                  "boom_length": description.crane.boom_length if description is not None else 1.0},
@@ -104,6 +104,14 @@ def dataset_from_arrays(t, q_joints, effort, t_mocap, tip, payload, description,
         regimes={"payload swing": _swing_regimes(q[:, 3], q[:, 4])},
         description=description, source=source,
     )
+    # drives that stop (issue 10): samples in the zero-speed zone of slew, luff or hoist are not
+    # fitted, as for the axis (cablelab.velocity): there the smooth friction band holds any
+    # effort and the sign of a filtered, quantized encoder velocity is noise
+    from ...velocity import exclude_zero_speed, position_quantum, speed_resolution
+
+    ok_q = q_joints[ok]
+    floor = np.array([speed_resolution(position_quantum(ok_q[:, j]), c["cutoff_hz"]) for j in range(3)])
+    return exclude_zero_speed(ds, floor=floor)
 
 
 def swing_from_bag(bag, *, cutoff_hz: float | None = None) -> tuple[SwingAngles, SwingReport]:

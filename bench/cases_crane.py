@@ -1,0 +1,216 @@
+"""Randomized boom-crane diagnosis cases (issue 10 benchmark), generated WITHOUT the fitting code.
+
+* truth: the MuJoCo crane of :mod:`cablelab.plants.crane.sim` (``build_model``: slew, luff, gimbal
+  swing joints and the hoist, built from the plant description; 002 ch. 3). The crane's fitting
+  code never runs MuJoCo for the diagnosis: its regressor is the sympy-generated Lagrangian of 002
+  eq. 4.1-4.2, so the two are separate implementations of the same mechanics. Added to it here:
+  SMOOTH Coulomb friction ``-Fc tanh(qd / eps)`` on slew and luff (``qfrc_applied``, never the
+  ``sign`` the fit uses), viscous joint damping, a tilted base (gravity rotated, 002 sec. 6.5), a
+  torque-sensor offset, and the counterbalance either described or not (002 sec. 6.4).
+* control: PD + MuJoCo's own bias forces (gravity, Coriolis) + diagonal inertia x reference
+  acceleration at every 1 ms step (zero-order hold), tracking minimum-jerk point-to-point moves or
+  chirp bursts of all three drives with the whole crane at rest 20-50 % of the time (the payload
+  keeps swinging after a move, as on a real crane).
+* sensors: efforts = motor commands + offset + AR(1) noise with outliers (unequal SNR per drive);
+  encoder-quantized joint positions; joint velocity recorded or absent; motion-capture boom-tip
+  and payload positions with 0.2-1 mm noise; 100 Hz or 200 Hz.
+
+Hidden effects are drawn from the crane's candidates (``cablelab.plants.crane.plant.candidates``):
+``joint_coulomb_friction``, ``torque_sensor_offset``, ``base_tilt``, ``counterbalance``,
+``joint_viscous_friction`` (one, or two of them), plus control cases with nothing hidden. The
+nominal model is the plant's (``crane_rigid_body`` + ``counterbalance`` when described) plus
+``joint_viscous_friction`` (``--effects``) except in the viscous cases. The description's boom
+mass and counterbalance are known parameters (``--fix m_b=.. --fix m_c=.. --fix l_c=..``): with
+m_b free, (m_b, m_c, l_c) keep one unidentifiable direction (plants/crane/README.md), and a free
+counterbalance moment absorbs a luff torque offset (cos(beta) over the luff range vs a constant).
+When the counterbalance is the hidden effect only m_b is fixed, so its m_c and l_c are fitted.
+``time_delay`` is not among the crane's candidates, so no crane case hides it.
+"""
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+
+from cases_common import PlantCase, coloured_noise, moves_and_rests, quantize
+
+JOINT_NAMES = ("slew", "luff", "hoist")
+ONE = [("joint_coulomb_friction",), ("torque_sensor_offset",), ("base_tilt",), ("counterbalance",),
+       ("joint_viscous_friction",)]
+TWO = [("joint_coulomb_friction", "torque_sensor_offset"), ("joint_coulomb_friction", "base_tilt"),
+       ("counterbalance", "joint_coulomb_friction"), ("base_tilt", "torque_sensor_offset")]
+#: joint ranges of the reference moves: slew rad, luff rad, rope length m
+LIMITS = ((-1.2, 1.2), (0.15, 1.1), (0.4, 0.9))
+KP, KD = np.array([30.0, 40.0, 400.0]), np.array([10.0, 12.0, 40.0])
+
+
+def draw_case(seed: int, kind: str | None = None) -> PlantCase:
+    """A random crane case. ``kind``: "control", "one", "two" (default drawn 20/50/30 %)."""
+    rng = np.random.default_rng(seed)
+    if kind is None:
+        kind = str(rng.choice(["control", "one", "two"], p=[0.2, 0.5, 0.3]))
+    hidden = () if kind == "control" else (ONE[rng.integers(len(ONE))] if kind == "one"
+                                           else TWO[rng.integers(len(TWO))])
+    lb, m, mb = rng.uniform(0.8, 1.2), rng.uniform(0.3, 1.0), rng.uniform(0.5, 1.5)
+    mc, lc = rng.uniform(1.0, 3.0), rng.uniform(0.2, 0.4)
+    truth = {"boom_length": lb, "payload_mass": m, "boom_mass": mb, "counterbalance_mass": mc,
+             "counterbalance_distance": lc, "slew_inertia": rng.uniform(0.03, 0.1),
+             "luff_inertia": rng.uniform(0.01, 0.04),
+             "viscous": [rng.uniform(0.05, 0.3), rng.uniform(0.05, 0.3), rng.uniform(0.5, 2.0)],
+             "coulomb": [0.0, 0.0, 0.0], "offset": [0.0, 0.0, 0.0], "tilt": [0.0, 0.0],
+             # smooth Coulomb band: 0.2-1 % of each drive's typical peak speed (rad/s, rad/s, m/s)
+             "eps": list(rng.uniform(0.002, 0.01) * np.array([0.5, 0.2, 0.1]))}
+    # typical efforts: slew ~ J alpha_dd, luff ~ boom-side moment x g, hoist ~ m g
+    J = lb * lb * (m + mb / 4) + lc * lc * mc + truth["slew_inertia"]
+    K = abs(lb * m + lb * mb / 2 - lc * mc)
+    f_typ = np.array([0.3 * J + 0.3 * truth["viscous"][0], K * 9.81 * 0.5 + 0.5, m * 9.81])
+    if "joint_coulomb_friction" in hidden:
+        truth["coulomb"] = [rng.uniform(0.15, 0.4) * f_typ[0], rng.uniform(0.1, 0.3) * f_typ[1], 0.0]
+    if "torque_sensor_offset" in hidden:
+        truth["offset"] = list(rng.choice([-1, 1], 3) * rng.uniform(0.05, 0.2, 3) * f_typ)
+    if "base_tilt" in hidden:
+        truth["tilt"] = list(rng.choice([-1, 1], 2) * np.radians(rng.uniform(1.0, 3.0, 2)))
+    effects = () if "joint_viscous_friction" in hidden else ("joint_viscous_friction",)
+    fs = float(rng.choice([100.0, 200.0]))
+    profile = str(rng.choice(["ptp", "chirp"]))
+    # the description's boom mass and (when described) counterbalance are known parameters
+    fixed = {"m_b": mb} if "counterbalance" in hidden else {"m_b": mb, "m_c": mc, "l_c": lc}
+    case = PlantCase(plant="crane", seed=seed, family=profile, fs=fs, hidden=tuple(hidden),
+                     description=_description(truth, with_cb="counterbalance" not in hidden),
+                     effects=effects, fixed=fixed, truth=truth,
+                     velocity_recorded=bool(rng.random() < 0.4))
+    case.truth.update(duration=float(rng.uniform(40, 60)), profile=case.family,
+                      rest_fraction=float(rng.uniform(0.2, 0.5)),
+                      noise_rel=list(10 ** rng.uniform(-2, np.log10(0.05), 3)), ar=float(rng.uniform(0, 0.8)),
+                      outlier_rate=float(rng.choice([0.0, 0.002])), mocap_noise=float(rng.uniform(2e-4, 1e-3)),
+                      quantum=[2 * np.pi / 2 ** int(rng.integers(16, 19)), 2 * np.pi / 2 ** int(rng.integers(16, 19)),
+                               10.0 ** rng.uniform(-6, -5)])
+    case.true_params = _true_params(case)
+    return case
+
+
+def _description(tr: dict, with_cb: bool) -> str:
+    y = (f"plant: crane\ngravity: 9.81\ncrane:\n  boom_length: {tr['boom_length']:.6g}\n"
+         f"  payload_mass: {tr['payload_mass']:.6g}\n  boom_mass: {tr['boom_mass']:.6g}\n")
+    if with_cb:
+        y += (f"  counterbalance: {{mass: {tr['counterbalance_mass']:.6g}, "
+              f"distance: {tr['counterbalance_distance']:.6g}}}\n")
+    return y
+
+
+def _gravity_in_base(tilt, g=9.81) -> np.ndarray:
+    """Gravity in the tilted base frame: base rotated by tilt[0] about world x, then tilt[1]
+    about y; g_base = (Ry Rx)^T [0, 0, -g]."""
+    cx, sx, cy, sy = np.cos(tilt[0]), np.sin(tilt[0]), np.cos(tilt[1]), np.sin(tilt[1])
+    rx = np.array([[1, 0, 0], [0, cx, -sx], [0, sx, cx]])
+    ry = np.array([[cy, 0, sy], [0, 1, 0], [-sy, 0, cy]])
+    return (ry @ rx).T @ np.array([0.0, 0.0, -g])
+
+
+def _true_params(case: PlantCase) -> dict:
+    tr = case.truth
+    out = {}
+    if "joint_coulomb_friction" in case.hidden:
+        out["joint_coulomb_friction"] = {f"Fc[{j}]": v for j, v in zip(JOINT_NAMES, tr["coulomb"])}
+    if "torque_sensor_offset" in case.hidden:
+        out["torque_sensor_offset"] = {f"OF[{j}]": v for j, v in zip(JOINT_NAMES, tr["offset"])}
+    if "joint_viscous_friction" in case.hidden:
+        out["joint_viscous_friction"] = {f"Fv[{j}]": v for j, v in zip(JOINT_NAMES, tr["viscous"])}
+    if "counterbalance" in case.hidden:
+        out["counterbalance"] = {"m_c": tr["counterbalance_mass"], "l_c": tr["counterbalance_distance"]}
+    if "base_tilt" in case.hidden:
+        # horizontal gravity (g_x, g_y) in the base frame, weighted by the boom-side moment K and
+        # the payload mass (the parameters of the base_tilt effect, 002 sec. 6.5); the potential
+        # is -(g_x, g_y) . r, so the parameters carry the sign of -g_base
+        gb = _gravity_in_base(tr["tilt"])
+        K = (tr["boom_length"] * tr["payload_mass"] + tr["boom_length"] * tr["boom_mass"] / 2
+             - tr["counterbalance_distance"] * tr["counterbalance_mass"])
+        out["base_tilt"] = {"tilt_a": K * gb[0], "tilt_b": K * gb[1],
+                            "tilt_pa": tr["payload_mass"] * gb[0], "tilt_pb": tr["payload_mass"] * gb[1]}
+    return out
+
+
+# ----------------------------------------------------------------------------- reference motion
+
+def reference(case: PlantCase, rng):
+    """Joint reference of the three drives, ``fn(t) -> (q, qd, qdd)`` (N, 3) each: moves of all
+    drives together (minimum-jerk point to point, or chirp bursts below the payload's pendulum
+    frequency) separated by rests (:func:`cases_common.moves_and_rests`)."""
+    tr = case.truth
+    r, end = moves_and_rests(rng, [0.0, 0.5, 0.6], LIMITS, tr["duration"], tr["rest_fraction"], tr["profile"],
+                             move_time=3.5 if tr["profile"] == "ptp" else 5.0, chirp_amp=[0.4, 0.12, 0.06])
+    case.truth["end"] = end
+    return r
+
+
+# ----------------------------------------------------------------------------- truth simulation
+
+def simulate(case: PlantCase) -> dict:
+    """Closed-loop MuJoCo run of the crane (1 ms steps) sampled at ``case.fs``; returns the recorded
+    signals: ``t``, ``q`` (N, 3) encoder readings, ``qd`` (N, 3) or NaN, ``effort`` (N, 3), ``tip``,
+    ``payload`` (N, 3) motion capture and their quaternions x, y, z, w, plus the true motor efforts."""
+    from cablelab.plants.crane.model import CraneParams
+    from cablelab.plants.crane.sim import CraneTruth, build_model, set_state
+
+    rng = np.random.default_rng(case.seed + 7919)
+    tr = case.truth
+    ref = reference(case, rng)
+    params = CraneParams(**{k: tr[k] for k in ("boom_length", "payload_mass", "boom_mass", "counterbalance_mass",
+                                               "counterbalance_distance", "slew_inertia", "luff_inertia")})
+    model = build_model(CraneTruth(params=params, base_tilt=tuple(tr["tilt"]), viscous=tuple(tr["viscous"]),
+                                   effort_limit=(1e3, 1e3, 1e3)))
+    data = mujoco.MjData(model)
+    dt = model.opt.timestep
+    dec = int(round(1.0 / (case.fs * dt)))
+    n = int(round(tr["duration"] / dt))
+    tgrid = np.arange(n) * dt
+    qr, vr, ar = ref(tgrid)
+    set_state(model, data, [qr[0, 0], qr[0, 1], qr[0, 2], 0.0, 0.0])
+    idx = np.array([0, 1, 4])                       # slew, luff, hoist dofs
+    fc, eps = np.asarray(tr["coulomb"], float), np.asarray(tr["eps"], float)
+    m = (n + dec - 1) // dec
+    qpos, qvel, sens, ctrl = np.empty((m, 5)), np.empty((m, 5)), np.empty((m, model.nsensordata)), np.empty((m, 3))
+    madr = (model.M_rowadr + model.M_rownnz - 1)[idx]   # diagonal of the sparse mass matrix (data.M)
+    j = 0
+    for k in range(n):  # the 1 kHz control loop (feedback every step, zero-order hold)
+        v = data.qvel[idx]
+        mujoco.mj_fwdPosition(model, data)          # mass matrix and bias of this state
+        mujoco.mj_fwdVelocity(model, data)
+        u = KP * (qr[k] - data.qpos[idx]) + KD * (vr[k] - v) + data.qfrc_bias[idx] + data.M[madr] * ar[k]
+        data.ctrl[:] = u
+        data.qfrc_applied[idx] = -fc * np.tanh(v / eps)   # smooth Coulomb friction (truth)
+        if k % dec == 0:
+            qpos[j], qvel[j], ctrl[j] = data.qpos, data.qvel, u
+        mujoco.mj_step(model, data)
+        if k % dec == 0:
+            sens[j] = data.sensordata                # computed at the state before the step
+            j += 1
+    t = tgrid[::dec]
+    motor = ctrl
+    eff = np.empty_like(motor)
+    for i in range(3):
+        sigma = tr["noise_rel"][i] * float(np.sqrt(np.mean(motor[:, i] ** 2)))
+        eff[:, i] = motor[:, i] + tr["offset"][i] + coloured_noise(rng, m, sigma, tr["ar"], tr["outlier_rate"])
+    q = np.column_stack([quantize(qpos[:, [0, 1, 4][i]], tr["quantum"][i]) for i in range(3)])
+    qd = (qvel[:, idx] + rng.standard_normal((m, 3)) * [0.002, 0.002, 0.001] if case.velocity_recorded
+          else np.full((m, 3), np.nan))
+    tip = sens[:, 13:16] + rng.normal(scale=tr["mocap_noise"], size=(m, 3))
+    pay = sens[:, 20:23] + rng.normal(scale=tr["mocap_noise"], size=(m, 3))
+    return {"t": t, "q": q, "qd": qd, "effort": eff, "motor": motor, "tip": tip, "payload": pay,
+            "tip_quat": sens[:, [17, 18, 19, 16]], "payload_quat": sens[:, [24, 25, 26, 23]],
+            "q_true": qpos, "qd_true": qvel}
+
+
+def write_bag(case: PlantCase, path, rec: dict | None = None) -> dict:
+    """Simulate (unless ``rec`` is given) and write the case as a crane bag: ``/crane/joint_states``
+    (slew, luff, hoist), ``/crane/boom_tip_pose``, ``/crane/payload_pose``, ``/plant_description``."""
+    from cablelab.bags import BagWriter
+
+    rec = rec if rec is not None else simulate(case)
+    t = rec["t"] + 1.0
+    with BagWriter(path, overwrite=True) as w:
+        w.write_description(case.description)
+        w.write_joint_states("/crane/joint_states", t, JOINT_NAMES, position=rec["q"], velocity=rec["qd"],
+                             effort=rec["effort"])
+        w.write_poses("/crane/boom_tip_pose", t, rec["tip"], rec["tip_quat"])
+        w.write_poses("/crane/payload_pose", t, rec["payload"], rec["payload_quat"])
+    return rec
