@@ -267,6 +267,9 @@ def summarise(bench, results) -> None:
             cnt = Counter(r["top_sig"] for r in rs)
             bench.row(hidden=lab, cases=len(rs), **{_short(k): cnt.get(k, 0) for k in labels},
                       none=cnt.get("none", 0))
+    worst = sorted(((e, r["miss"], h) for r in ok for h, e in r["perr"].items() if np.isfinite(e)), reverse=True)
+    for e, miss, h in worst[:15]:
+        print(f"[param] {miss} {h}: {100 * e:.1f} %", file=sys.stderr)
     failures = [r for r in ok if set(r["added"]) != set(r["hidden"])]
     for r in failures[:40]:
         print(f"[miss] {r['miss']} hidden={r['label']} added={r['added']}", file=sys.stderr)

@@ -1,0 +1,207 @@
+"""Randomized CDPR diagnosis cases (issue 10 benchmark), generated WITHOUT the fitting code.
+
+* geometry: the CAROCA-like description (plants/cdpr/data/caroca.yaml: 8 cables, exit points
+  A_i, platform anchor points b_i); the structure matrix is computed here from those points
+  (001 eq. 4: columns [u_i; b_i x u_i], u_i the unit vector from the anchor to the cable's exit
+  point), with or without the swivel pulleys: with pulleys (001 eq. 6-9) the cable leaves the
+  sheave of radius r_p (centre r_p from A_i, towards the anchor, in the vertical plane of the
+  swivel) at its tangent point, found here from the right-angle condition.
+* platform: level, centre of mass at the platform origin, total mass m; its reference is
+  minimum-jerk point-to-point moves or chirp bursts in the workspace with 20-50 % rest; the
+  cables supply the wrench of the rigid body ``[m (a - g); 0]`` (Newton-Euler, no rotation); the
+  tensions are the minimum-norm solution about a pretension level, t = t0 + W^+ (w - W t0),
+  positive by construction of the workspace (checked).
+* winches: motor angle = (gear / drum) x cable length (encoder-quantized), motor torque =
+  (drum / gear) t + SMOOTH winch friction ``Fc tanh(w / eps) + Fv w`` (motor side).
+* sensors: dynamometers read t + b_i (offset) + AR(1) noise with outliers, a different SNR per
+  cable; the reference topic carries the platform pose, twist and acceleration (the platform is
+  assumed to track it); 100 Hz (CAROCA) or 200 Hz.
+
+Hidden effects (from ``cablelab.plants.cdpr.plant.candidates``): ``pulley_geometry`` (sheaves in
+the truth, not in the description), ``tension_sensor_offset``, ``winch_coulomb_friction`` and
+``winch_viscous_friction`` (these two are read from the motor torques, ``--tensions motor``, where
+friction is visible; dynamometers do not see it), ``platform_inertia`` (not in the nominal model);
+one, or two, or none (control). The nominal model is the plant's (``cdpr_gravity`` [+
+``pulley_geometry`` when the description gives a sheave radius]) + ``platform_inertia``
+(``--effects``), except when the inertia is the hidden effect. The described sheave radius is
+known (``--fix r_p``).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from cases_common import PlantCase, coloured_noise, moves_and_rests, quantize
+
+G = 9.81
+#: exit points A_i (world) and anchor points b_i (platform frame) of the CAROCA-like description, m
+EXITS = np.array([[3.5, 1.8, 3.0], [3.3, 2.0, 3.0], [-3.5, 1.8, 3.0], [-3.3, 2.0, 3.0],
+                  [-3.5, -1.8, 3.0], [-3.3, -2.0, 3.0], [3.5, -1.8, 3.0], [3.3, -2.0, 3.0]])
+ANCHORS = np.array([[0.75, -0.75, 0.5], [-0.75, 0.75, 0.5], [-0.75, -0.75, 0.5], [0.75, 0.75, 0.5],
+                    [-0.75, 0.75, 0.5], [0.75, -0.75, 0.5], [0.75, 0.75, 0.5], [-0.75, -0.75, 0.5]])
+DRUM, GEAR = 0.06, 40.0
+#: workspace of the reference moves (platform origin), m (001 Fig. 2 pick-and-place region)
+LIMITS = ((-1.0, 1.0), (-0.3, 0.3), (0.6, 1.1))
+NAMES = tuple(f"cable_{i}" for i in range(1, 9))
+WINCHES = tuple(f"winch_{i}" for i in range(1, 9))
+ONE = [("pulley_geometry",), ("tension_sensor_offset",), ("winch_coulomb_friction",),
+       ("winch_viscous_friction",), ("platform_inertia",)]
+TWO = [("pulley_geometry", "tension_sensor_offset"), ("pulley_geometry", "platform_inertia"),
+       ("winch_coulomb_friction", "winch_viscous_friction"), ("platform_inertia", "tension_sensor_offset")]
+MOTOR = ("winch_coulomb_friction", "winch_viscous_friction")
+
+
+def draw_case(seed: int, kind: str | None = None) -> PlantCase:
+    """A random CDPR case. ``kind``: "control", "one", "two" (default drawn 20/50/30 %)."""
+    rng = np.random.default_rng(seed)
+    if kind is None:
+        kind = str(rng.choice(["control", "one", "two"], p=[0.2, 0.5, 0.3]))
+    hidden = () if kind == "control" else (ONE[rng.integers(len(ONE))] if kind == "one"
+                                           else TWO[rng.integers(len(TWO))])
+    source = "motor" if (any(h in MOTOR for h in hidden) or (kind == "control" and rng.random() < 0.4)) \
+        else "dynamometer"
+    m = rng.uniform(400.0, 900.0)
+    r_p = rng.uniform(0.08, 0.22)
+    t_mean = m * G / 8 / 0.6                     # mean cable tension, N (cables ~37 deg from vertical)
+    tau_mean = t_mean * DRUM / GEAR              # mean motor torque, N m
+    truth = {"m": m, "r_p": r_p, "described_r_p": "pulley_geometry" not in hidden,
+             "b": np.zeros(8), "Fc": np.zeros(8), "Fv": np.zeros(8),
+             "eps": rng.uniform(0.002, 0.01) * 200.0,      # tanh band, rad/s (motor speeds ~200 rad/s)
+             "source": source}
+    if "tension_sensor_offset" in hidden:
+        truth["b"] = rng.choice([-1, 1], 8) * rng.uniform(0.03, 0.1, 8) * t_mean
+    if "winch_coulomb_friction" in hidden:
+        truth["Fc"] = rng.uniform(0.05, 0.15, 8) * tau_mean
+    if "winch_viscous_friction" in hidden:
+        truth["Fv"] = rng.uniform(0.05, 0.15, 8) * tau_mean / 200.0
+    fs = float(rng.choice([100.0, 200.0]))
+    profile = str(rng.choice(["ptp", "chirp"]))
+    effects = () if "platform_inertia" in hidden else ("platform_inertia",)
+    fixed = {"r_p": r_p} if truth["described_r_p"] else {}
+    case = PlantCase(plant="cdpr", seed=seed, family=f"{profile} {source}", fs=fs, hidden=tuple(hidden),
+                     description=_description(m, r_p if truth["described_r_p"] else 0.0), effects=effects,
+                     fixed=fixed, options={"tensions": source}, truth=truth,
+                     velocity_recorded=bool(rng.random() < 0.4))
+    truth.update(duration=float(rng.uniform(40, 60)), profile=profile, rest_fraction=float(rng.uniform(0.2, 0.5)),
+                 noise_rel=10 ** rng.uniform(-2.5, -1.5, 8), ar=float(rng.uniform(0, 0.8)),
+                 outlier_rate=float(rng.choice([0.0, 0.002])), quantum=2 * np.pi / 2 ** int(rng.integers(12, 16)))
+    case.true_params = _true_params(case)
+    return case
+
+
+def _description(m: float, r_p: float) -> str:
+    y = "plant: cdpr\ngravity: 9.81\ncdpr:\n  platform_mass: 366.0\n"
+    y += f"  drum_radius: {DRUM}\n  gear_ratio: {GEAR}\n"
+    if r_p > 0:
+        y += f"  pulley_radius: {r_p:.6g}\n"
+    y += "  cables:\n"
+    for a, b in zip(EXITS, ANCHORS):
+        y += f"    - {{exit_point: [{a[0]}, {a[1]}, {a[2]}], anchor_point: [{b[0]}, {b[1]}, {b[2]}]}}\n"
+    return y
+
+
+def _true_params(case: PlantCase) -> dict:
+    tr = case.truth
+    out = {}
+    if "pulley_geometry" in case.hidden:
+        out["pulley_geometry"] = {"r_p": tr["r_p"]}
+    if "platform_inertia" in case.hidden:
+        out["platform_inertia"] = {"m_a": tr["m"]}
+    if "tension_sensor_offset" in case.hidden:
+        out["tension_sensor_offset"] = {f"b[{n}]": v for n, v in zip(WINCHES, tr["b"])}
+    if "winch_coulomb_friction" in case.hidden:
+        out["winch_coulomb_friction"] = {f"Fc[{n}]": v for n, v in zip(WINCHES, tr["Fc"])}
+    if "winch_viscous_friction" in case.hidden:
+        out["winch_viscous_friction"] = {f"Fv[{n}]": v for n, v in zip(WINCHES, tr["Fv"])}
+    return out
+
+
+# ----------------------------------------------------------------------------- geometry (own)
+
+def cable_directions(p: np.ndarray, r_p: float) -> tuple[np.ndarray, np.ndarray]:
+    """Unit cable directions u (N, 8, 3) from the anchors towards the cable's exit, and cable
+    lengths L (N, 8) from the winch-side rim point of the sheave (r_p = 0: point exits).
+
+    Sheave (swivel axis z): centre O_i = A_i + r_p h_i, h_i the horizontal unit vector from A_i
+    towards the anchor B_i. In the vertical plane (h_i, z) with O_i as origin the anchor is at
+    (x, z); the tangent point T = O + r_p (cos th, sin th) satisfies (B - T) . (T - O) = 0, i.e.
+    x cos th + z sin th = r_p: th = atan2(z, x) + acos(r_p / |(x, z)|) (the cable leaves on the
+    side away from the post and wraps over the top from the rim point at th = pi)."""
+    B = p[:, None, :] + ANCHORS[None]                     # (N, 8, 3)
+    d = B - EXITS[None]
+    if r_p <= 0:
+        L = np.linalg.norm(d, axis=2)
+        return -d / L[..., None], L
+    dh = d.copy()
+    dh[..., 2] = 0.0
+    hn = np.linalg.norm(dh, axis=2)
+    h = dh / hn[..., None]
+    x, z = hn - r_p, d[..., 2]
+    D = np.hypot(x, z)
+    th = np.arctan2(z, x) + np.arccos(r_p / D)
+    T = EXITS[None] + (r_p * (1 + np.cos(th)))[..., None] * h
+    T[..., 2] += r_p * np.sin(th)
+    seg = T - B
+    ls = np.linalg.norm(seg, axis=2)
+    wrap = r_p * np.mod(np.pi - th, 2 * np.pi)            # arc from the rim point (th = pi) to T
+    return seg / ls[..., None], ls + wrap
+
+
+def structure_matrix(u: np.ndarray) -> np.ndarray:
+    """(N, 6, 8) wrench matrix [u_i; b_i x u_i] of a level platform (moments about its origin)."""
+    return np.concatenate([np.transpose(u, (0, 2, 1)),
+                           np.transpose(np.cross(ANCHORS[None], u), (0, 2, 1))], axis=1)
+
+
+# ----------------------------------------------------------------------------- truth + sensors
+
+def simulate(case: PlantCase) -> dict:
+    """Reference motion -> wrench -> tensions -> winch motion and torques -> sensor readings."""
+    rng = np.random.default_rng(case.seed + 7919)
+    tr = case.truth
+    ref, _ = moves_and_rests(rng, [0.0, 0.0, 0.85], LIMITS, tr["duration"], tr["rest_fraction"], tr["profile"],
+                             move_time=4.0, chirp_amp=[0.4, 0.15, 0.12], chirp_f0=(0.1, 0.2), chirp_f1=(0.6, 1.0))
+    n = int(round(tr["duration"] * case.fs))
+    t = np.arange(n) / case.fs
+    p, v, a = ref(t)
+    u, L = cable_directions(p, tr["r_p"])
+    W = structure_matrix(u)
+    w = np.zeros((n, 6))
+    w[:, :3] = tr["m"] * (a + [0.0, 0.0, G])              # m (a - g), g = (0, 0, -G)
+    t0 = np.full(8, tr["m"] * G / 8 / 0.6)
+    Wp = np.linalg.pinv(W)                                 # (N, 8, 6)
+    ten = t0 + np.einsum("nij,nj->ni", Wp, w - np.einsum("nij,j->ni", W, t0))
+    if ten.min() <= 0.05 * t0[0]:
+        raise RuntimeError(f"case {case.seed}: cable tension {ten.min():.1f} N is not positive enough")
+    scale = GEAR / DRUM
+    theta = scale * (L - L[0])                             # motor angle, rad
+    omega = np.gradient(theta, t, axis=0)                  # exact motion is smooth: fine differences
+    motor = ten / scale + tr["Fc"] * np.tanh(omega / tr["eps"]) + tr["Fv"] * omega
+    dyn = ten + tr["b"]
+    for i in range(8):
+        dyn[:, i] += coloured_noise(rng, n, tr["noise_rel"][i] * t0[0], tr["ar"], tr["outlier_rate"])
+        motor[:, i] += coloured_noise(rng, n, tr["noise_rel"][i] * t0[0] / scale, tr["ar"], tr["outlier_rate"])
+    q = quantize(theta, tr["quantum"])
+    qd = omega + rng.standard_normal(omega.shape) * 0.2 if case.velocity_recorded else np.full_like(omega, np.nan)
+    return {"t": t, "p": p, "v": v, "a": a, "tensions": dyn, "motor": motor, "q": q, "qd": qd,
+            "tensions_true": ten, "omega": omega}
+
+
+def write_bag(case: PlantCase, path, rec: dict | None = None) -> dict:
+    """Simulate (unless ``rec`` is given) and write a CDPR bag: ``/cdpr/cable_tensions``,
+    ``/cdpr/joint_states`` (winch angles, rates, motor torques), ``/cdpr/reference`` (pose, twist,
+    acceleration), ``/plant_description``."""
+    from cablelab.bags import BagWriter
+
+    rec = rec if rec is not None else simulate(case)
+    t = rec["t"] + 1.0
+    n = t.size
+    quat = np.tile([0.0, 0.0, 0.0, 1.0], (n, 1))
+    with BagWriter(path, overwrite=True) as w:
+        w.write_description(case.description)
+        w.write_joint_states("/cdpr/cable_tensions", t, NAMES, effort=rec["tensions"])
+        w.write_joint_states("/cdpr/joint_states", t, WINCHES, position=rec["q"], velocity=rec["qd"],
+                             effort=rec["motor"])
+        w.write_multidof_trajectory("/cdpr/reference", t, rec["p"], quat, linear_velocity=rec["v"],
+                                    angular_velocity=np.zeros((n, 3)), linear_acceleration=rec["a"],
+                                    angular_acceleration=np.zeros((n, 3)))
+    return rec

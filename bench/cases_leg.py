@@ -1,0 +1,93 @@
+"""Randomized hopping-leg diagnosis cases (issue 10 benchmark), generated WITHOUT the fitting code.
+
+* truth: the leg's independent reference, :func:`cablelab.plants.leg.reference.sampled_trajectory`
+  (scipy ``solve_ivp`` per phase with terminal events, rtol 1e-10; it shares nothing with the
+  MuJoCo plant or the workbench's linear inverse model but the physical laws of 003 eq. 1, 23,
+  24, 26), under the open-loop stance torque ``T sin(2 pi (t - t_d) / P)`` of eq. 26 with random
+  T and P, started from a drop.
+* sensors (003 sec. 3.1, the reference's measurement model): 0.09 mm encoder with a random zero,
+  backward-difference velocity, contact switch; plus AR(1) noise with outliers on the recorded
+  motor torque (1-3 % of its RMS); 1 kHz.
+
+Every run has the impacts of eq. 24 (beta_td 0.5-0.85, beta_lo 1.02-1.15, as 003 Table 2).
+Hidden effects, one per case, from the leg's candidates (``cablelab.plants.leg``):
+``impact_restitution`` (not in the nominal model), ``spring_preload`` (F_0),
+``guide_coulomb_friction`` (F_c), ``phase_effective_mass`` (m_f != m), plus control cases
+(nothing hidden). The nominal model is the plant's (``leg_inertia``, ``stance_damping``,
+``flight_damping``) + ``impact_restitution`` (``--effects``) except when that is the hidden one.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from cases_common import PlantCase, coloured_noise
+
+ONE = [("impact_restitution",), ("spring_preload",), ("guide_coulomb_friction",), ("phase_effective_mass",)]
+
+DESCRIPTION = """plant: leg
+gravity: 9.81
+leg:
+  mass: 1.55
+  spring_stiffness: 605.0
+  link_length: 0.15
+  free_angle: 0.349066
+  spring_preload: 0.0
+  encoder_resolution: 9.0e-5
+"""
+
+
+def draw_case(seed: int, kind: str | None = None) -> PlantCase:
+    """A random leg case. ``kind``: "control" or "one" (default drawn 25/75 %)."""
+    rng = np.random.default_rng(seed)
+    if kind is None:
+        kind = str(rng.choice(["control", "one"], p=[0.25, 0.75]))
+    hidden = () if kind == "control" else ONE[rng.integers(len(ONE))]
+    m = rng.uniform(1.45, 1.7)
+    truth = {"m": m, "d_s": rng.uniform(4.0, 8.0), "d_f": rng.uniform(0.8, 1.5),
+             "beta_td": rng.uniform(0.5, 0.85), "beta_lo": rng.uniform(1.02, 1.15),
+             "F0": 0.0, "Fc": 0.0, "m_f": m, "T": rng.uniform(1.0, 3.0), "P": rng.uniform(0.26, 0.38),
+             "duration": rng.uniform(12.0, 20.0), "z_drop": rng.uniform(0.02, 0.05),
+             "noise_rel": 10 ** rng.uniform(-2, np.log10(0.03)), "ar": rng.uniform(0, 0.8),
+             "outlier_rate": float(rng.choice([0.0, 0.002]))}
+    if "spring_preload" in hidden:
+        truth["F0"] = rng.uniform(1.5, 4.0)
+    if "guide_coulomb_friction" in hidden:
+        truth["Fc"] = rng.uniform(0.4, 1.2)
+    if "phase_effective_mass" in hidden:
+        truth["m_f"] = m + rng.choice([-1, 1]) * rng.uniform(0.12, 0.3)
+    effects = () if "impact_restitution" in hidden else ("impact_restitution",)
+    case = PlantCase(plant="leg", seed=seed, family="", fs=1000.0, hidden=tuple(hidden), effects=effects,
+                     description=DESCRIPTION, truth=truth, velocity_recorded=True)
+    tp = {"impact_restitution": {"c_td": m * (1 - truth["beta_td"]), "c_lo": m * (1 - truth["beta_lo"])},
+          "spring_preload": {"F0": truth["F0"]}, "guide_coulomb_friction": {"Fc": truth["Fc"]},
+          "phase_effective_mass": {"dm_f": truth["m_f"] - m}}
+    case.true_params = {h: tp[h] for h in hidden}
+    return case
+
+
+def simulate(case: PlantCase):
+    """The reference run, measured (:class:`cablelab.plants.leg.sim.Trajectory`), with noise on
+    the recorded torque."""
+    from cablelab.plants.leg.hybrid import LegParams
+    from cablelab.plants.leg.reference import sampled_trajectory
+
+    tr = case.truth
+    p = LegParams(m=tr["m"], d_s=tr["d_s"], d_f=tr["d_f"], beta_td=tr["beta_td"], beta_lo=tr["beta_lo"],
+                  F0=tr["F0"], Fc=tr["Fc"], m_f=tr["m_f"])
+    traj = sampled_trajectory(p, p.z_td + tr["z_drop"], 0.0, tr["duration"], T=tr["T"], P=tr["P"],
+                              seed=case.seed)
+    rng = np.random.default_rng(case.seed + 7919)
+    sigma = tr["noise_rel"] * float(np.sqrt(np.mean(traj.tau ** 2)))
+    traj.tau = traj.tau + coloured_noise(rng, traj.tau.size, sigma, tr["ar"], tr["outlier_rate"])
+    return traj
+
+
+def write_bag(case: PlantCase, path, rec=None):
+    """Simulate (unless ``rec`` is given) and write the leg bag (``/leg/joint_states`` body height
+    and motor torque, ``/leg/contact``, ``/plant_description``; the bag layout of the leg's own
+    writer, :func:`cablelab.plants.leg.sim.write_bag`)."""
+    from cablelab.plants.leg.sim import write_bag as leg_write_bag
+
+    rec = rec if rec is not None else simulate(case)
+    leg_write_bag(path, rec, case.description, overwrite=True)
+    return rec
