@@ -86,12 +86,15 @@ def run_plant_case(case, gen, workdir: str) -> dict:
     from cablelab.errors import CablelabError
 
     path = os.path.join(workdir, f"{case.plant}_{case.seed}")
-    gen.write_bag(case, path)
     fields = {"case": case, "plant": case.plant, "hidden": tuple(case.hidden),
               "label": case.label(),
               "family": (f"{case.plant} {case.family}".strip(), int(case.fs),
                          "velocity" if case.velocity_recorded else "encoder only"),
               "miss": f"seed {case.seed} {case.plant} {case.family}"}
+    try:
+        gen.write_bag(case, path)
+    except RuntimeError as exc:  # the generator could not make this case (e.g. a slack cable)
+        return {**fields, "error": f"generator: {exc}", "seconds": 0.0}
     t0 = time.perf_counter()
     try:
         plant, desc, ds = workbench.load(path, None, dict(case.options))
@@ -105,7 +108,10 @@ def run_plant_case(case, gen, workdir: str) -> dict:
     final = out["final"]["params"]
     perr = {h: (rel_param_error(final, case.true_params[h]) if h in added else np.inf)
             for h in case.hidden if h in case.true_params}
-    return {**fields, "top": first["effect"] if first else "none",
+    # hidden effects whose parameters the diagnosis itself flags as confounded with another
+    # parameter (step-0 ranking, "identifiability"): their values are not determined by the record
+    conf = {r["effect"] for r in out["ranking"] if (r.get("identifiability") or {}).get("confounded")}
+    return {**fields, "top": first["effect"] if first else "none", "confounded": conf,
             "top_sig": first["effect"] if first and first.get("significant") else "none",
             "added": added, "perr": perr, "seconds": secs, "n": ds.n,
             "candidates": tuple(plant.candidates(desc))}
@@ -245,8 +251,14 @@ def summarise(bench, results) -> None:
         e = np.array([r["perr"][h] for r in ok if r["plant"] == p and h in r["perr"]])
         e = e[np.isfinite(e)]
         if e.size:
+            fl = [r for r in ok if r["plant"] == p and h in r["perr"] and np.isfinite(r["perr"][h])
+                  and h in r.get("confounded", ())]
+            clear = np.array([r["perr"][h] for r in ok if r["plant"] == p and h in r["perr"]
+                              and np.isfinite(r["perr"][h]) and h not in r.get("confounded", ())])
             bench.row(plant=p, effect=h, cases=e.size, median=f"{100 * np.median(e):.2f} %",
-                      p95=f"{100 * np.percentile(e, 95):.2f} %", max=f"{100 * np.max(e):.1f} %")
+                      p95=f"{100 * np.percentile(e, 95):.2f} %", max=f"{100 * np.max(e):.1f} %",
+                      flagged_confounded=len(fl) if p != "axis" else "-",
+                      p95_not_flagged=f"{100 * np.percentile(clear, 95):.2f} %" if clear.size and p != "axis" else "-")
     # by case family
     bench.section("top-1 / exact greedy set by case family")
     fam = Counter(r["family"] for r in ok)

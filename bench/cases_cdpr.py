@@ -159,7 +159,7 @@ def simulate(case: PlantCase) -> dict:
     rng = np.random.default_rng(case.seed + 7919)
     tr = case.truth
     ref, _ = moves_and_rests(rng, [0.0, 0.0, 0.85], LIMITS, tr["duration"], tr["rest_fraction"], tr["profile"],
-                             move_time=4.0, chirp_amp=[0.4, 0.15, 0.12], chirp_f0=(0.1, 0.2), chirp_f1=(0.6, 1.0))
+                             move_time=4.0, chirp_amp=[0.12, 0.06, 0.05], chirp_f0=(0.1, 0.2), chirp_f1=(0.4, 0.7))
     n = int(round(tr["duration"] * case.fs))
     t = np.arange(n) / case.fs
     p, v, a = ref(t)

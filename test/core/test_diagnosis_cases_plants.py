@@ -1,0 +1,118 @@
+"""Diagnosis on realistic recordings of the crane, CDPR, leg and suspended platform (issue 10):
+fixed-seed cases of the benchmark generators bench/cases_<plant>.py through the real path
+(bag -> cablelab.workbench.load -> diagnose --greedy, as `cablelab diagnose --greedy`).
+
+Oracles, none of them the fitting code: the MuJoCo crane with smooth tanh Coulomb friction applied
+as a joint force (the crane fit uses the sympy Lagrangian regressor); the CDPR's own structure
+matrix and sheave tangent geometry with a tension distribution and tanh winch friction; the leg's
+scipy solve_ivp reference; the suspended platform's four-tendon MuJoCo truth plant with smooth
+cable friction and air drag applied as forces. Encoders quantized, rests, coloured noise.
+"""
+import os
+import sys
+
+import numpy as np
+import pytest
+
+from cablelab import workbench
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "bench"))
+import cases_cdpr  # noqa: E402
+import cases_crane  # noqa: E402
+import cases_leg  # noqa: E402
+import cases_suspended  # noqa: E402
+from cases_common import rel_param_error  # noqa: E402
+
+
+def _diagnose(gen, case, tmp_path):
+    path = tmp_path / f"{case.plant}_{case.seed}"
+    gen.write_bag(case, path)
+    plant, desc, ds = workbench.load(path, None, dict(case.options))
+    model = workbench.build_model(plant, desc, case.effects, fixed=case.fixed)
+    return workbench.diagnose(ds, model, plant.candidates(desc), greedy_mode=True).to_json()
+
+
+def _case(gen, seed, kind, **truth):
+    case = gen.draw_case(seed, kind)
+    case.truth.update(truth)
+    return case
+
+
+def _assert_found(out, case, rel):
+    (hidden,) = case.hidden
+    first = out["ranking"][0]
+    assert first["effect"] == hidden and first["significant"], out["ranking"][:2]
+    assert [g["added"] for g in out["greedy"][1:]] == [hidden]
+    assert out["final"]["error"] < out["greedy"][0]["error"]
+    if hidden in case.true_params:
+        assert rel_param_error(out["final"]["params"], case.true_params[hidden]) < rel
+
+
+def _assert_control(out):
+    assert not any(r["significant"] for r in out["ranking"]), out["ranking"][:2]
+    assert len(out["greedy"]) == 1
+
+
+# crane: 30 s at 100 Hz, chirp bursts, smooth Coulomb on slew and luff, encoder only
+def test_crane_hidden_coulomb_friction_first_and_its_levels(tmp_path):
+    case = _case(cases_crane, 11, "one", duration=30.0)
+    assert case.hidden == ("joint_coulomb_friction",) and case.fs == 100.0
+    _assert_found(_diagnose(cases_crane, case, tmp_path), case, rel=0.10)
+
+
+def test_crane_control_nothing_significant(tmp_path):
+    case = _case(cases_crane, 2, "control", duration=30.0)
+    _assert_control(_diagnose(cases_crane, case, tmp_path))
+
+
+# CDPR: dynamometers with the sheaves left out of the description; motor torques with winch friction
+def test_cdpr_hidden_pulleys_found_with_the_sheave_radius(tmp_path):
+    case = _case(cases_cdpr, 11, "one", duration=30.0)
+    assert case.hidden == ("pulley_geometry",) and case.options["tensions"] == "dynamometer"
+    _assert_found(_diagnose(cases_cdpr, case, tmp_path), case, rel=0.10)
+
+
+def test_cdpr_hidden_winch_coulomb_from_motor_torques(tmp_path):
+    case = _case(cases_cdpr, 1, "one", duration=30.0)
+    case.fs = 100.0
+    assert case.hidden == ("winch_coulomb_friction",) and case.options["tensions"] == "motor"
+    _assert_found(_diagnose(cases_cdpr, case, tmp_path), case, rel=0.10)
+
+
+def test_cdpr_control_nothing_significant(tmp_path):
+    case = _case(cases_cdpr, 3, "control", duration=30.0)
+    case.fs = 100.0
+    _assert_control(_diagnose(cases_cdpr, case, tmp_path))
+
+
+# leg: solve_ivp reference, 0.09 mm encoder, contact switch
+def test_leg_hidden_impact_restitution_found(tmp_path):
+    case = _case(cases_leg, 11, "one", duration=10.0)
+    assert case.hidden == ("impact_restitution",)
+    _assert_found(_diagnose(cases_leg, case, tmp_path), case, rel=0.10)
+
+
+def test_leg_control_nothing_significant(tmp_path):
+    case = _case(cases_leg, 1, "control", duration=10.0)
+    _assert_control(_diagnose(cases_leg, case, tmp_path))
+
+
+# suspended: four-tendon truth plant, 100 Hz motion capture
+def test_suspended_hidden_air_drag_found(tmp_path):
+    case = _case(cases_suspended, 1, "one")
+    assert case.hidden == ("air_drag",)
+    _assert_found(_diagnose(cases_suspended, case, tmp_path), case, rel=np.inf)
+
+
+def test_suspended_control_nothing_significant(tmp_path):
+    case = _case(cases_suspended, 1, "control")
+    _assert_control(_diagnose(cases_suspended, case, tmp_path))
+
+
+@pytest.mark.xfail(strict=True, reason="diagnose/score.py lr_significance adds n_eff log(RSS0/RSS1) of the "
+                   "yaw channel the suspended dataset zeroed (not excited): log(1e-300 / 1e-24) makes "
+                   "the LR hugely negative, p = 1, for a candidate with a 90 % held-out gain")
+def test_suspended_hidden_pose_offset_significant(tmp_path):
+    case = _case(cases_suspended, 4, "one")
+    assert case.hidden == ("pose_sensor_offset",)
+    _assert_found(_diagnose(cases_suspended, case, tmp_path), case, rel=np.inf)
