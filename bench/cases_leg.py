@@ -45,7 +45,7 @@ def draw_case(seed: int, kind: str | None = None) -> PlantCase:
     m = rng.uniform(1.45, 1.7)
     truth = {"m": m, "d_s": rng.uniform(4.0, 8.0), "d_f": rng.uniform(0.8, 1.5),
              "beta_td": rng.uniform(0.5, 0.85), "beta_lo": rng.uniform(1.02, 1.15),
-             "F0": 0.0, "Fc": 0.0, "m_f": m, "T": rng.uniform(1.0, 3.0), "P": rng.uniform(0.26, 0.38),
+             "F0": 0.0, "Fc": 0.0, "m_f": m, "T": rng.uniform(1.5, 3.0), "P": rng.uniform(0.26, 0.38),
              "duration": rng.uniform(12.0, 20.0), "z_drop": rng.uniform(0.02, 0.05),
              "noise_rel": 10 ** rng.uniform(-2, np.log10(0.03)), "ar": rng.uniform(0, 0.8),
              "outlier_rate": float(rng.choice([0.0, 0.002]))}
@@ -74,8 +74,15 @@ def simulate(case: PlantCase):
     tr = case.truth
     p = LegParams(m=tr["m"], d_s=tr["d_s"], d_f=tr["d_f"], beta_td=tr["beta_td"], beta_lo=tr["beta_lo"],
                   F0=tr["F0"], Fc=tr["Fc"], m_f=tr["m_f"])
-    traj = sampled_trajectory(p, p.z_td + tr["z_drop"], 0.0, tr["duration"], T=tr["T"], P=tr["P"],
-                              seed=case.seed)
+    redraw = np.random.default_rng(case.seed + 104729)
+    for _ in range(10):  # some (T, P) settle into a bounce without flight: draw another excitation
+        traj = sampled_trajectory(p, p.z_td + tr["z_drop"], 0.0, tr["duration"], T=tr["T"], P=tr["P"],
+                                  seed=case.seed)
+        if np.mean(traj.phase == 0) >= 0.05:
+            break
+        tr["T"], tr["P"] = redraw.uniform(1.5, 3.0), redraw.uniform(0.26, 0.38)
+    else:
+        raise RuntimeError(f"case {case.seed}: the leg does not hop (T {tr['T']:.2f} N m, P {tr['P']:.3f} s)")
     rng = np.random.default_rng(case.seed + 7919)
     sigma = tr["noise_rel"] * float(np.sqrt(np.mean(traj.tau ** 2)))
     traj.tau = traj.tau + coloured_noise(rng, traj.tau.size, sigma, tr["ar"], tr["outlier_rate"])
