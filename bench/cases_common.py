@@ -91,7 +91,8 @@ def moves_and_rests(rng, start, limits, duration: float, rest_fraction: float, p
             sn, cs = np.sin(ph), np.cos(ph)
             Q[inside] = q0 + amp * (w * sn)[:, None]
             V[inside] = amp * (wd * sg * sn + w * om * cs)[:, None]
-            A[inside] = amp * (wdd * sg**2 * sn + 2 * wd * sg * om * cs + w * (2 * np.pi * kk * cs - om**2 * sn))[:, None]
+            A[inside] = amp * (wdd * sg**2 * sn + 2 * wd * sg * om * cs
+                               + w * (2 * np.pi * kk * cs - om**2 * sn))[:, None]
             Q[after] = q0
 
     def r(tt):
