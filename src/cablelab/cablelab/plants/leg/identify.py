@@ -432,6 +432,7 @@ class Identification:
     stride_metrics: dict
     apex: dict
     timings: dict = field(default_factory=dict)
+    cpu_timings: dict = field(default_factory=dict)
 
     def table1(self) -> str:
         """Per-phase validation NMSE / MAE / max error in 003 Table 1's format (markdown)."""
@@ -489,15 +490,16 @@ def identify(records: list[HopRecord], base: LegParams | None = None, *, folds=(
     import time
 
     bar = tqdm(total=4, desc="leg identification", disable=not progress)
-    clock = [time.perf_counter()]
+    clock = [time.perf_counter(), time.process_time()]
 
     def lap(name):
-        now = time.perf_counter()
-        timings[name] = now - clock[0]
-        clock[0] = now
+        now, cpu = time.perf_counter(), time.process_time()
+        timings[name], cpu_timings[name] = now - clock[0], cpu - clock[1]
+        clock[0], clock[1] = now, cpu
         bar.update()
 
     timings: dict = {}
+    cpu_timings: dict = {}
     fl = cross_validate(phase_segments(records, 0, base), simulate_phase_segments, start, ("d_f",),
                         folds[0], "flight", max_iter, warm=True)
     lap("flight")
@@ -519,7 +521,7 @@ def identify(records: list[HopRecord], base: LegParams | None = None, *, folds=(
             "nmse_full": segment_metrics(strides_, sims[0]), "nmse_no_impact": segment_metrics(strides_, sims[1])}
     lap("validation")
     bar.close()
-    return Identification(fl, st, im, final, whole, apex, timings)
+    return Identification(fl, st, im, final, whole, apex, timings, cpu_timings)
 
 
 __all__ = ["HopRecord", "Identification", "Segment", "StageResult", "apex_errors", "cross_validate",
