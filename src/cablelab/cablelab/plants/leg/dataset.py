@@ -74,6 +74,9 @@ class LegRecords:
     _base: list = field(default_factory=list, repr=False)
     _cache: dict = field(default_factory=dict, repr=False)
 
+    def __getstate__(self):          # pickled (e.g. to a fleet worker) without the caches
+        return {**self.__dict__, "_base": [], "_cache": {}}
+
     def _bases(self) -> list[dict]:
         """Per record the parts that do not depend on the phase (computed once)."""
         if not self._base:
