@@ -102,3 +102,20 @@ def test_control_without_delay_does_not_call_it_significant(punctual):
     assert not row["significant"]
     assert row["params"]["tau_c"] < 1e-3
     assert d.best_significant() is None
+
+
+def test_bag_and_contract_json(delayed, tmp_path):
+    """The same data as a contract bag (``/leg/contact`` topic) through the workbench: load,
+    diagnose on the 003 model, contract JSON with tau_c in seconds."""
+    from cablelab.plants.leg.sim import write_bag
+    from cablelab.workbench import build_model, diagnose, load
+
+    tr, _ = delayed
+    path = tmp_path / "late_switch"
+    write_bag(path, tr, (Path(leg_pkg.__file__).parent / "data" / "leg.yaml").read_text())
+    plant, desc, ds = load(path)
+    model = build_model(plant, desc, effects=("impact_restitution",))
+    out = diagnose(ds, model, plant.candidates(desc)).to_json()
+    top = out["ranking"][0]
+    assert top["effect"] == "contact_delay" and top["significant"]
+    assert top["params"]["tau_c"] == pytest.approx(DELAY, abs=1e-3)
