@@ -143,14 +143,18 @@ class LegRecords:
         out = {"y": cat.pop("y")[:, None],
                "regimes": {"phase": cat.pop("phase"), "transition": cat.pop("transition")},
                "signals": cat}
-        if len(self._cache) >= CACHE_BUILDS:
+        per_build = sum(v.nbytes for v in cat.values()) + out["y"].nbytes
+        keep = int(np.clip(CACHE_BYTES // max(per_build, 1), 2, CACHE_BUILDS))
+        while len(self._cache) >= keep:
             self._cache.pop(next(k for k in self._cache if k != 0))
         self._cache[adv] = out
         return out
 
 
-#: whole-sample builds kept by :class:`LegRecords` (0-20 ms at 1 kHz: 21)
+#: whole-sample builds kept by :class:`LegRecords` (0-20 ms at 1 kHz: 21), and at most about
+#: this many bytes of them (a long record keeps fewer; the zero advance is always kept)
 CACHE_BUILDS = 24
+CACHE_BYTES = 200e6
 
 
 def _time_to_edge(s: np.ndarray, fs: float) -> np.ndarray:
