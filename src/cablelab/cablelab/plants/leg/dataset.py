@@ -188,6 +188,10 @@ def dataset_from_records(records, description, options: dict | None = None,
         recs.append(tuple(np.asarray(x, float) for x in (t, z, contact, tau)))
     if not recs:
         raise CablelabError(f"{source}: no leg record")
+    rates = [1.0 / float(np.median(np.diff(r[0]))) for r in recs]
+    if max(rates) - min(rates) > 1e-6 * max(rates):
+        raise CablelabError(f"{source}: leg records at different sample rates "
+                            f"({min(rates):g} and {max(rates):g} Hz); resample them to one rate")
     raw = LegRecords(tuple(recs), description, dict(options), source)
     built = raw.build(0.0)
     times, valid, t_next = [], [], None
