@@ -185,6 +185,10 @@ def test_slow_slew_axis_under_chirps_coulomb_and_inertia_with_parallel_filtering
     fin = out["final"]["params"]
     assert fin["Fc"] == pytest.approx(40.0, rel=0.05)
     assert fin["M"] == pytest.approx(250.0, rel=0.02)
+    # the whiteness test stays valid on parallel-filtered data: the right model is called white
+    plant, desc, _ = workbench.load(tmp_path / f"case_{case.seed}")
+    cmp = workbench.compare(ds, workbench.build_model(plant, desc, ["joint_coulomb_friction"]))
+    assert cmp["whiteness"]["joint"]["decimate"] > 1 and cmp["whiteness"]["joint"]["white"]
     # the same bag with the positions filtered alone: biased (the failure this fixes)
     plant, desc, ds_old = workbench.load(tmp_path / f"case_{case.seed}",
                                          options={"conditioning": Conditioning(parallel=False)})
