@@ -73,7 +73,12 @@ def moving_mask(act_vel: np.ndarray, zone: np.ndarray) -> np.ndarray:
 def exclude_zero_speed(ds, floor: np.ndarray | float = 0.0, fraction: float = ZONE_FRACTION):
     """The dataset with samples in any actuator's zero-speed zone marked invalid (not fitted,
     not scored); the zone and the excluded share are kept in ``ds.signals`` (``zero_speed_zone``,
-    ``rest_share``) for reports. Datasets without actuator velocities are returned unchanged."""
+    ``rest_share``) for reports. Datasets without actuator velocities are returned unchanged.
+    The speeds tested are ``ds.signals["rest_velocity"]`` when the dataset keeps one (the
+    velocity in the band of the effort), else ``ds.act_vel``; on a parallel-filtered dataset the
+    samples next to a rest are left out too (:func:`cablelab.parallel_filter.rest_guard`).
+    Applied by the axis dataset and, for every other plant with joint or winch actuators, by
+    :func:`cablelab.workbench.load_checked`."""
     if ds.act_vel is None or ds.n < 3:
         return ds
     # the velocity in the band of the effort when the dataset keeps one (parallel filtering:
