@@ -6,7 +6,8 @@ excitation and the platform swinging, estimated as the simulator's truth says.
 
 Oracles: the controller law recomputed from the recorded states and poses (lock-step: the torque
 applied over each 1 ms period is the answer to the state that starts it), the Fig. 7 reference
-formula, and the simulator's own ground-truth swing topic (exact pose geometry, no filter)."""
+formula, and the simulator's own ground-truth swing topic (exact pose geometry, no filter; the
+simulator's IMU is on, so the estimator's yaw comes from it)."""
 from __future__ import annotations
 
 import sys
@@ -98,7 +99,11 @@ def test_lockstep_closed_loop_sim_estimator_controller_recorder(launcher, tmp_pa
     est = bag.joint_state("/suspended/swing_estimate", names=truth.names)
     common, i_t, i_e = np.intersect1d(np.round(truth.t, 6), np.round(est.t, 6), return_indices=True)
     assert len(common) > 0.9 * len(t)
-    np.testing.assert_allclose(est.position[i_e], truth.position[i_t], atol=1e-9)
+    # (yaw comes from the IMU, published with the pose: when DDS delivers the pose first, the
+    # previous IMU sample is carried 1 ms forward with its rate, a 1e-7-rad-level difference)
+    tol = np.array([1e-6 if n == "yaw" else 1e-9 for n in truth.names])
+    assert np.all(np.abs(est.position[i_e] - truth.position[i_t]) <= tol), \
+        np.abs(est.position[i_e] - truth.position[i_t]).max(axis=0)
     sx = truth.position[i_t, truth.names.index("swing_x")]
     assert np.ptp(sx) > 1.5 * START_X                      # swinging, not at rest
     ry = truth.position[i_t, truth.names.index("r_y")]

@@ -2,7 +2,10 @@
 
 * ``estimator`` (``payload_estimator --plant suspended``): ``/suspended/platform_pose`` ->
   :class:`~.swing.SwingEstimator` -> ``/suspended/swing_estimate`` (names swing_x, swing_y, yaw,
-  r_x, r_y; position and velocity), stamped like the pose. NaN, wrong-length and frozen-stamp
+  r_x, r_y; position and velocity), stamped like the pose. ``/suspended/imu`` when present
+  (spec 5.2): yaw from its orientation and yaw rate from its gyro for poses within
+  ``imu_max_lag`` s (stamps) of an IMU sample, else from the pose; a stale (``imu_timeout`` s
+  wall) or NaN IMU is reported on /diagnostics once the IMU has been seen. NaN, wrong-length and frozen-stamp
   poses are held and counted on /diagnostics. ROS parameters: ``suspension_point`` [x, y, z] m
   (default: the LiCAS repo set), ``rest_position`` [x, y, z] m and ``rest_yaw`` rad (default NaN:
   the mean over the first ``rest_window`` s), ``velocity_tau`` s, ``pose_timeout`` s wall.
@@ -52,9 +55,10 @@ ROLES = ("estimator", "sim", "controller")
 
 
 def _estimator_class():
+    import numpy as np
     from geometry_msgs.msg import PoseStamped
     from ...ros.plant_node import PlantNode
-    from sensor_msgs.msg import JointState
+    from sensor_msgs.msg import Imu, JointState
 
     from ...ros import convert
     from ...ros.inputs import WARN
@@ -71,18 +75,34 @@ def _estimator_class():
                 raise CablelabError(f"payload_estimator suspended: parameter rest_position={rest!r} "
                                     "(expected [x, y, z] m)")
             self.est = SwingEstimator(S, rest_window=float(p("rest_window", 2.0).value),
+                                      imu_max_lag=float(p("imu_max_lag", 0.05).value),
                                       rest_pos=rest if all(map(math.isfinite, rest)) else None,
                                       rest_yaw=rest_yaw if math.isfinite(rest_yaw) else None,
                                       velocity_tau=float(p("velocity_tau", 0.05).value))
             self.use_fast_executor()
             self.inputs.add("platform_pose", timeout=float(p("pose_timeout", 0.5).value), length=3)
+            self.imu_timeout = float(p("imu_timeout", 0.5).value)
+            self.imu_used = 0            # estimates whose yaw came from the IMU
             self.rejected = 0
             self.last_problem = ""
             self.pub = self.create_publisher(JointState, "/suspended/swing_estimate", publisher_qos())
+            self.create_subscription(Imu, "/suspended/imu", self.on_imu, catch_up_qos())
             self.create_subscription(PoseStamped, "/suspended/platform_pose", self.on_pose, catch_up_qos())
             self.start_diagnostics()
 
+        def on_imu(self, msg) -> None:
+            """Optional input: monitored (stale / NaN on /diagnostics) from its first message on."""
+            if "imu" not in self.inputs.inputs:
+                self.inputs.add("imu", timeout=self.imu_timeout, length=7, required=False)
+            t, qx, gyro, _ = convert.imu_arrays(msg)
+            if qx is None or gyro is None:
+                self.inputs.accept("imu", None, time.monotonic())
+                return
+            if self.inputs.accept("imu", np.r_[qx, gyro], time.monotonic()):
+                self.est.imu(t, qx[[3, 0, 1, 2]], gyro)
+
         def extend_status(self, level, msg, values):
+            values["yaw from IMU"] = str(self.imu_used)
             values["held samples"] = str(self.rejected)
             if self.rejected:
                 level = max(level, WARN)
@@ -95,6 +115,7 @@ def _estimator_class():
             self.inputs.accept("platform_pose", pos, time.monotonic())
             q = quat_xyzw[[3, 0, 1, 2]] if quat_xyzw is not None and len(quat_xyzw) == 4 else quat_xyzw
             s = self.est.step(t, pos, q)
+            self.imu_used += s.source == "imu"
             if not s.ok:
                 self.rejected += 1
                 self.last_problem = s.message
@@ -251,19 +272,19 @@ def _sim_class():
                     pub.wait_for_all_acked(Duration(seconds=5.0))
 
         def publish_state(self) -> None:
-            """Publish the current state: the pose (and IMU) first, so a controller that takes
-            the attitude from the pose has it when the joint state it answers arrives."""
+            """Publish the current state: IMU, pose, then joint states (the estimator then has the
+            IMU sample of a pose's stamp, and a controller the attitude of the state it answers)."""
             mujoco.mj_forward(self.model, self.data)
             t = float(self.data.time)
             pos, quat = self.data.sensordata[:3].copy(), self.data.sensordata[3:7].copy()
             q, qd = self.data.qpos[self.jq], self.data.qvel[self.jv]
             eff = self.data.qfrc_actuator[self.jv]
-            meas = pos + (self.rng.normal(0, self.noise, 3) if self.noise > 0 else 0.0)
-            self.pub_pose.publish(convert.pose_msg(t, meas, wxyz_to_xyzw(quat[None])[0]))
             if self.pub_imu is not None:
                 gyro, acc = platform_imu(self.model, self.data, self.site)
                 self.pub_imu.publish(convert.imu_msg(t, wxyz_to_xyzw(quat[None])[0], gyro, acc,
                                                      frame_id="platform"))
+            meas = pos + (self.rng.normal(0, self.noise, 3) if self.noise > 0 else 0.0)
+            self.pub_pose.publish(convert.pose_msg(t, meas, wxyz_to_xyzw(quat[None])[0]))
             self.pub_js.publish(convert.joint_state_msg(t, self.names, q, qd, eff))
             sw = swing_from_pose(pos[None], quat[None], self.params.S, rest_pos=self.rest, rest_yaw=0.0)
             self.pub_sw.publish(convert.joint_state_msg(t, list(CHANNELS), [float(sw[k][0]) for k in CHANNELS]))
