@@ -90,7 +90,7 @@ def _estimator_class():
             self.create_subscription(PoseStamped, "/suspended/platform_pose", self.on_pose, catch_up_qos())
             self.start_diagnostics()
 
-        def on_imu(self, msg) -> None:
+        def on_imu(self, msg: Imu) -> None:
             """Optional input: monitored (stale / NaN on /diagnostics) from its first message on."""
             if "imu" not in self.inputs.inputs:
                 self.inputs.add("imu", timeout=self.imu_timeout, length=7, required=False)
