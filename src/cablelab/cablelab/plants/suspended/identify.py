@@ -142,6 +142,9 @@ def identifiability(fit: SimulationFit, params: list[Param], *, undetermined_rel
         module docstring for the rules.
     """
     names = [q.name for q in params]
+    if "jacobian" not in fit.extra:            # fit_simulation(covariance=False): nothing to judge by
+        return {"condition": np.nan, "stderr": dict(fit.stderr), "correlation": None, "confounded": [],
+                "weak_directions": [], "undetermined": []}
     J = np.asarray(fit.extra["jacobian"], float)
     r0 = np.asarray(fit.extra["residual"], float)
     p = len(names)
