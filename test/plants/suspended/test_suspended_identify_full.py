@@ -25,13 +25,13 @@ def fits():
     # the 0.7 kg truth platform split over links 10-12 (D3 `total`, as the demo); warm start from
     # the repo values, k_p7 scanned over its Table 5 range (the repo yaw period is 25 % off)
     p = parameter_set("licas").replace(m_plat=0.7 / 3)
-    ide, val = licas_experiments(p, plant="truth", duration=4.0, seed=3)
-    kw = dict(objective="pearson", start=values_of(p), max_iter=10, scan={"kp7": np.linspace(5, 50, 10)})
+    ide, val = licas_experiments(p, plant="truth", duration=3.0, seed=3)
+    kw = dict(objective="pearson", start=values_of(p), max_iter=8, scan={"kp7": np.linspace(5, 50, 10)})
     t0 = time.perf_counter()
     a = identify(ide, p, NAMES, **kw)
     wall = time.perf_counter() - t0
     b = identify(val, p, NAMES, **kw)                 # second fit, on the other experiments
-    print(f"21-parameter Pearson fit: {wall:.1f} s, {a.fit.evaluations} rollouts of 3 x 4 s, "
+    print(f"21-parameter Pearson fit: {wall:.1f} s, {a.fit.evaluations} rollouts of 3 x 3 s, "
           f"R {a.mean_R:.5f}, condition {a.report['condition']:.3g}, undetermined {a.undetermined}")
     return p, ide, val, a, b
 
@@ -41,6 +41,8 @@ def test_full_fit_reproduces_held_out_experiments(fits):
     assert len(a.values) == 21 and a.mean_R >= 0.99
     rows = validate(a.params, val)
     rho = np.concatenate([r["rho"][r["use"]] for r in rows])
+    print(f"held-out validation rho: min {rho.min():.4f}, mean {rho.mean():.4f}; weak directions "
+          f"{[[n for n, _ in d] for d in a.report['weak_directions']]}")
     assert rho.min() >= 0.99 and rho.mean() >= 0.99, rho
     bounds = {q.name: (q.lower, q.upper) for q in identified_params("licas")}
     assert all(bounds[n][0] <= v <= bounds[n][1] for n, v in a.values.items())   # Table 5 bounds
