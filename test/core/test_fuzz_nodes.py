@@ -111,6 +111,12 @@ def message(draw, type_name: str, descriptions: dict):
         m.inertia.m = draw(FLOAT)
         m.inertia.com = vec()
         draw(stamp(m.header))
+    elif type_name == "Imu":
+        from sensor_msgs.msg import Imu
+
+        m = Imu(orientation=quat(), angular_velocity=vec(), linear_acceleration=vec())
+        m.orientation_covariance[0] = draw(st.sampled_from([0.0, -1.0]))
+        draw(stamp(m.header))
     else:
         raise AssertionError(f"no strategy for {type_name}")
     return m

@@ -156,12 +156,16 @@ def fit_simulation(simulate: Callable[[list[dict]], np.ndarray], params: Sequenc
     from .identify import lag1_autocorrelation
 
     r1 = lag1_autocorrelation(r0.reshape(y_meas.shape))
-    se = se * np.sqrt((1.0 + r1) / (1.0 - r1))
+    inflation = float(np.sqrt((1.0 + r1) / (1.0 - r1)))
+    se = se * inflation
     y_sim = np.asarray(simulate([values]))[0].reshape(y_meas.shape)
     nm = float(np.sum(objective_residual(y_meas, y_sim, "nmse") ** 2))
     rho = 1.0 - float(np.sum(objective_residual(y_meas, y_sim, "pearson") ** 2))
+    # (what an identifiability analysis needs: the Jacobian at the optimum, its residual and the
+    # coloured-residual inflation of the standard errors)
     return SimulationFit(values, dict(zip(names, map(float, se))), objective, nm, rho, y_sim,
-                         iterations=len(trace), evaluations=count["n"])
+                         iterations=len(trace), evaluations=count["n"],
+                         extra={"jacobian": jac, "residual": r0, "se_inflation": inflation})
 
 
 # ----------------------------------------------------------------------------- free-run windows
