@@ -250,7 +250,7 @@ def run_closed_loop(launch, seconds: float, params: dict, log=print, on_started=
     ``cpu_ms`` {node: CPU per step}, ``p99_ms`` {sim, estimator, controller}: the largest in-node
     processing p99 any node reported over the steady state (each report is the p99 of its last
     1000 samples, so this is the worst 1 s window), ``load`` (before, after)."""
-    launch.node("estimator", "payload_estimator", "cdpr", params)
+    launch.node("estimator", "payload_estimator", "cdpr", {"poll_period": 0.01} | params)
     launch.node("controller", "pd_feedforward", "cdpr", params)
     cl = _Client(launch.domain_id)       # listens to /diagnostics only (1 Hz): no extra 1 kHz load
     deadline = time.monotonic() + 60
@@ -316,6 +316,11 @@ def run_closed_loop(launch, seconds: float, params: dict, log=print, on_started=
            "p99_ms": worst, "load": (load0, _load()),
            "brakes_total": int(last.get("brake steps after the first command", "-1"))}
     out["missed_cycles"] = delta("missed steps") + out["dropped"]   # each step counted once
+
+    def ages(d):
+        return [int(x) for x in d.get("command age 1/2/3+ periods", "0/0/0").split("/")]
+
+    out["command_age"] = [b - a for a, b in zip(ages(first), ages(last))]   # periods 1, 2, >= 3
     return out
 
 
@@ -332,6 +337,9 @@ def closed_loop_1khz(bench: Bench, launch, seconds: float, params: dict) -> None
               value=f"{r['missed_cycles']} (braked {r['braked']}, late {r['late']}, dropped {r['dropped']}, "
                     f"stale {r['stale']})",
               unit=f"of {r['steps']}", target="0")
+    age = r["command_age"]
+    bench.row(case="applied command answers the state 1 / 2 / >= 3 periods back",
+              value=" / ".join(str(a) for a in age), unit="steps", target="all 1")
     bench.row(case="CPU per step: sim / estimator / controller (all threads)",
               value=" / ".join(f"{v:.3f}" for v in r["cpu_ms"].values()), unit="ms", target="")
     bench.log(f"  load average before/after: {r['load'][0]} / {r['load'][1]}")

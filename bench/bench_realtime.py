@@ -160,7 +160,8 @@ def main(argv=None) -> int:
         r = closed_loop(args.seconds, bench.log, env, args.py_spy)
         out["closed_loop"] = {"rate_hz": r["rate_hz"], "seconds": r["seconds"],
                               "realtime_factor": r["realtime_factor"], "missed_cycles": r["missed_cycles"],
-                              "p99_ms": r["p99_ms"], "rt_priority": r["rt_priority"]}
+                              "p99_ms": r["p99_ms"], "rt_priority": r["rt_priority"],
+                              "command_age_steps": r["command_age"]}
     if args.json:
         print(json.dumps(out))
         return 0
@@ -181,6 +182,8 @@ def main(argv=None) -> int:
                       value=f"{c['missed_cycles']} (braked {r['braked']}, late {r['late']}, "
                             f"dropped {r['dropped']}, stale {r['stale']})",
                       unit=f"of {r['steps']}", target="0")]
+        rows.append(dict(case="applied command answers the state 1 / 2 / >= 3 periods back",
+                         value=" / ".join(str(a) for a in r["command_age"]), unit="steps", target=""))
         rows += [dict(case=f"in-node p99, {k} (worst 1 s window)", value=v, unit="ms", target="< 1")
                  for k, v in c["p99_ms"].items()]
         rows.append(dict(case="CPU per step sim / estimator / controller",

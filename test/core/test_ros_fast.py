@@ -24,6 +24,7 @@ def test_templates_equal_rclpy_serialisation():
     from std_msgs.msg import Float64MultiArray, MultiArrayDimension
     from trajectory_msgs.msg import MultiDOFJointTrajectory
 
+    from cablelab import cdr
     from cablelab.ros import convert
     from cablelab.ros.rawmsg import RawTemplate
 
@@ -35,8 +36,17 @@ def test_templates_equal_rclpy_serialisation():
         q, qd, e = rng.normal(size=(3, 8))
         tpl.stamp(t)
         tpl["position"][:], tpl["velocity"][:], tpl["effort"][:] = q, qd, e
-        # byte for byte what rclpy serialises for the same message object
-        assert tpl.data() == bytes(serialize_message(convert.joint_state_msg(t, names, q, qd, e)))
+        # byte for byte what rclpy serialises for the same message object, except the alignment
+        # padding, which rclpy's serialiser leaves uninitialised (whatever the memory held)
+        want = bytes(serialize_message(convert.joint_state_msg(t, names, q, qd, e)))
+        assert len(tpl.data()) == len(want)
+        free = np.zeros(len(want), dtype=bool)
+        lay = cdr.walk("sensor_msgs/msg/JointState", want)
+        for off, n in lay.padding:
+            free[off:off + n] = True
+        free[lay.end:] = True
+        got_b, want_b = np.frombuffer(tpl.data(), np.uint8), np.frombuffer(want, np.uint8)
+        assert np.array_equal(got_b[~free], want_b[~free]) and lay.padding
         back = deserialize_message(tpl.data(), JointState)
         assert back.header.stamp == convert.to_stamp(t) and list(back.name) == names
         assert np.array_equal(back.position, q) and np.array_equal(back.effort, e)
@@ -118,3 +128,53 @@ def test_fast_executor_delivers_every_message_in_order(ros_context):
         ex.spin_once(0.05)
     assert late and late[0] == -1.0
     node.destroy_node()
+
+
+def test_polled_subscription_wakes_nobody_and_drains_in_step(ros_context):
+    """A polled subscription stays out of the wait set (its samples do not end a wait) and
+    :func:`drain` takes every queued sample, two streams interleaved in publishing order."""
+    from rclpy.node import Node
+    from std_msgs.msg import Float64MultiArray
+
+    from cablelab.ros.fastspin import FastExecutor, drain, poll
+    from cablelab.ros.qos import stream_qos
+
+    node = Node("poll_test", start_parameter_services=False)
+    got = []
+    subs = [node.create_subscription(Float64MultiArray, f"/p/{k}", lambda m, k=k: got.append((k, m.data[0])),
+                                     stream_qos(100)) for k in ("a", "b")]
+    for s in subs:
+        poll(node, s)
+    pubs = {k: node.create_publisher(Float64MultiArray, f"/p/{k}", stream_qos(100)) for k in ("a", "b")}
+    ex = FastExecutor()
+    ex.add_node(node)
+    deadline = time.monotonic() + 30
+    while not all(p.get_subscription_count() for p in pubs.values()):
+        assert time.monotonic() < deadline, "no intra-process match"
+        time.sleep(0.05)
+    for i in range(20):
+        for k in ("a", "b"):
+            pubs[k].publish(Float64MultiArray(data=[float(i)]))
+    time.sleep(0.2)                      # delivered into the queues by now
+    t0 = time.monotonic()
+    ex.spin_once(0.3)                    # nothing in the wait set is ready: the full timeout
+    assert time.monotonic() - t0 > 0.25 and not got
+    assert drain(*subs) == 40
+    assert got == [(k, float(i)) for i in range(20) for k in ("a", "b")]
+    assert drain(*subs) == 0
+    node.destroy_node()
+
+
+def test_stamped_buffer_looks_up_the_newest_sample_not_newer_than_t():
+    from cablelab.stamped import StampedBuffer
+
+    b = StampedBuffer(size=4)
+    assert b.at(1.0) is None and not b
+    for k in range(6):                   # stamps 0.000 .. 0.005, the last four kept
+        b.push(k * 1e-3, k)
+    assert b.newest == pytest.approx(5e-3)
+    assert b.at(3e-3) == (pytest.approx(3e-3), 3)          # exact stamp (float rounding tolerated)
+    assert b.at(3.5e-3)[1] == 3 and b.at(9.0)[1] == 5        # the newest not newer than t
+    assert b.at(0.0)[1] == 2                                 # older than kept: the oldest kept
+    b.push(1e-3, 99)                                         # went back in time: restarted
+    assert b.newest == pytest.approx(1e-3) and b.at(9.0)[1] == 99

@@ -62,6 +62,7 @@ class Layout:
         end: where the message's last field ends (bytes after it are padding, possibly
             uninitialised: rmw_fastrtps sizes a message with 8 bytes of alignment per empty
             float64 sequence that the serialiser does not write)
+        padding: (offset, length) of every alignment gap between fields
     """
 
     spans: dict[str, tuple[int, int, str]] = field(default_factory=dict)
@@ -69,12 +70,16 @@ class Layout:
     seqlen: dict[str, int] = field(default_factory=dict)
     size: int = 0
     end: int = 0
+    padding: list = field(default_factory=list)
 
     def numeric_mask(self) -> np.ndarray:
         """Boolean mask (size,) that is True on bytes that do not determine the layout: numeric
-        leaf values and the trailing padding."""
+        leaf values, alignment padding (rclpy's serialiser leaves it uninitialised) and the
+        trailing padding."""
         mask = np.zeros(self.size, dtype=bool)
         mask[self.end:] = True
+        for off, n in self.padding:
+            mask[off:off + n] = True
         for off, count, dt in self.spans.values():
             mask[off:off + count * int(dt[-1])] = True
         return mask
@@ -93,7 +98,10 @@ class _Walker:
 
     def align(self, n: int) -> None:
         rel = self.pos - 4
-        self.pos = 4 + ((rel + n - 1) & -n)
+        pos = 4 + ((rel + n - 1) & -n)
+        if pos > self.pos:          # alignment padding: serialisers may leave it uninitialised
+            self.out.padding.append((self.pos, pos - self.pos))
+        self.pos = pos
 
     def count(self) -> int:
         self.align(4)

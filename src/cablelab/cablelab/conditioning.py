@@ -30,6 +30,15 @@ class Conditioning:
         unwrap: unwrap revolute angles (2 pi jumps).
         max_jitter: relative spread of sample periods above which times count as irregular and
             the signals are interpolated onto a uniform grid.
+        parallel: when the automatic (quantization-aware) cut-off must go below the default
+            and comes within :data:`~cablelab.velocity.PARALLEL_OVER_EXCITATION` x the motion's
+            excitation bandwidth (``cutoff_hz`` None, ``effort_cutoff_hz`` None), keep the
+            default for the derivatives and use the lowered cut-off as the parallel filter of
+            the effort and of every regressor column (:mod:`cablelab.parallel_filter`, IDIM-LS)
+            instead of filtering only the positions with it (which would attenuate the
+            acceleration and sharpen the Coulomb column where the effort is not filtered).
+            The automatic cut-off never goes below
+            :data:`~cablelab.velocity.CUTOFF_OVER_EXCITATION` x the excitation bandwidth.
     """
 
     cutoff_hz: float | None = None
@@ -39,6 +48,7 @@ class Conditioning:
     decimate: int = 1
     unwrap: bool = True
     max_jitter: float = 0.05
+    parallel: bool = True
 
 
 def unwrap_angle(q: np.ndarray) -> np.ndarray:
@@ -134,7 +144,11 @@ def condition_motion(t: np.ndarray, q: np.ndarray, effort: np.ndarray,
         qd: optional measured velocities (N, k); NaN columns are derived from q instead.
     Returns:
         dict with ``t, q, qd, qdd, effort`` on the conditioned uniform grid (borders dropped,
-        decimated), and ``fs``, ``cutoff_hz``, ``resampled``.
+        decimated), and ``fs``, ``cutoff_hz`` (the band of the conditioned data: the parallel
+        filter's when there is one), ``derivative_cutoff_hz`` (the positions' filter),
+        ``parallel_hz`` (None without a parallel filter), ``qd_smooth``, ``qdd_smooth`` (velocity
+        and acceleration in the band of the effort: low-passed by the parallel filter when there
+        is one, else ``qd``, ``qdd``), ``resampled``.
     Raises:
         CablelabError: too few samples or non-finite data.
     """
@@ -160,10 +174,20 @@ def condition_motion(t: np.ndarray, q: np.ndarray, effort: np.ndarray,
             raise CablelabError(f"{source}: {name} has no finite samples in some column")
     fs = 1.0 / float(np.median(np.diff(t)))
     cutoff = default_cutoff(fs, opts)
+    parallel = None
     if opts.cutoff_hz is None:  # quantized encoder: lower the cut-off until qdd is not noise
-        from .velocity import quantization_aware_cutoff
+        from .velocity import (CUTOFF_OVER_EXCITATION, PARALLEL_OVER_EXCITATION,
+                               excitation_bandwidth, quantization_aware_cutoff)
 
-        cutoff = quantization_aware_cutoff(q, fs, cutoff, opts.order)
+        low = quantization_aware_cutoff(q, fs, cutoff, opts.order)
+        f_exc = excitation_bandwidth(q, fs, cutoff, opts.order)
+        # never far below the motion's own band (the filter would remove the excitation)
+        low = max(low, min(CUTOFF_OVER_EXCITATION * f_exc, cutoff))
+        if opts.parallel and opts.effort_cutoff_hz is None and low < min(
+                cutoff, PARALLEL_OVER_EXCITATION * f_exc):
+            parallel = low  # derivatives at the default, both sides of the fit filtered at low
+        else:
+            cutoff = low
     rev = np.broadcast_to(np.asarray(revolute, dtype=bool), q.shape[1:] if q.ndim > 1 else ())
     if opts.unwrap and np.any(rev):
         q = np.where(rev, unwrap_angle(q), q)
@@ -175,10 +199,16 @@ def condition_motion(t: np.ndarray, q: np.ndarray, effort: np.ndarray,
         qd_out = qd_f
     else:
         qd_out, qdd = qd_pos, qdd_pos
-    if opts.effort_cutoff_hz == "same":
+    qd_smooth, qdd_smooth = qd_out, qdd
+    if parallel:
+        effort = lowpass(effort, fs, parallel, opts.order)
+        qd_smooth, qdd_smooth = lowpass(qd_out, fs, parallel, opts.order), lowpass(qdd, fs, parallel, opts.order)
+    elif opts.effort_cutoff_hz == "same":
         effort = lowpass(effort, fs, cutoff, opts.order)
     elif opts.effort_cutoff_hz:
         effort = lowpass(effort, fs, float(opts.effort_cutoff_hz), opts.order)
     sl = slice(opts.border, t.shape[0] - opts.border, max(1, int(opts.decimate)))
     return {"t": t[sl], "q": qf[sl], "qd": qd_out[sl], "qdd": qdd[sl], "effort": effort[sl],
-            "fs": fs / max(1, int(opts.decimate)), "cutoff_hz": cutoff, "resampled": resampled}
+            "fs": fs / max(1, int(opts.decimate)), "cutoff_hz": parallel or cutoff,
+            "derivative_cutoff_hz": cutoff, "parallel_hz": parallel,
+            "qd_smooth": qd_smooth[sl], "qdd_smooth": qdd_smooth[sl], "resampled": resampled}

@@ -42,6 +42,9 @@ class Dataset:
         inputs: name -> (N,) input signals for residual cross-correlation (e.g. velocity).
         description: the plant :class:`~cablelab.description.Description`.
         source: where the data came from (bag path), for messages.
+        parallel_hz: cut-off (Hz) of the parallel filter (:mod:`cablelab.parallel_filter`):
+            ``y`` is low-passed with it and every regressor column is filtered the same way by
+            :meth:`cablelab.model.Model.regressor`; ``None`` = no parallel filter.
     """
 
     plant: str
@@ -59,6 +62,7 @@ class Dataset:
     inputs: dict = field(default_factory=dict)
     description: object = None
     source: str = ""
+    parallel_hz: float | None = None
 
     def __post_init__(self) -> None:
         self.t = np.asarray(self.t, dtype=float)
@@ -147,11 +151,16 @@ class Dataset:
                 return v[idx]
             return v
 
+        valid = self.valid[idx]
+        if self.parallel_hz:  # the regressor is filtered on the subset: its new edges settle
+            from .parallel_filter import edge_mask
+
+            valid = valid & edge_mask(self.t[idx], self.parallel_hz)
         return dataclasses.replace(
             self,
             t=self.t[idx], y=self.y[idx],
             signals={k: cut(v) for k, v in self.signals.items()},
-            act_vel=cut(self.act_vel), act_map=cut(self.act_map), valid=self.valid[idx],
+            act_vel=cut(self.act_vel), act_map=cut(self.act_map), valid=valid,
             regimes={k: cut(v) for k, v in self.regimes.items()},
             inputs={k: cut(v) for k, v in self.inputs.items()},
         )

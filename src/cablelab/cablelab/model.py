@@ -71,7 +71,8 @@ class Model:
 
         Returns:
             ``(Phi, params, y_known)``: Phi (N, C, p) for the free linear parameters, their
-            :class:`Param` list, and (N, C) the contribution of the fixed parameters.
+            :class:`Param` list, and (N, C) the contribution of the fixed parameters; filtered
+            by the dataset's parallel filter when it declares one (``ds.parallel_hz``).
         """
         blocks, cols = [], []
         for e in self.effect_units():
@@ -89,6 +90,11 @@ class Model:
                                     f"{', '.join(names) or 'none'})")
         free = [i for i, nme in enumerate(names) if nme not in self.fixed]
         known = [i for i, nme in enumerate(names) if nme in self.fixed]
+        if ds.parallel_hz and phi.shape[2]:
+            # parallel filtering (IDIM-LS): every column low-passed like the dataset's y
+            from .parallel_filter import parallel_filter
+
+            phi = parallel_filter(phi, ds.t, ds.parallel_hz)
         y_known = np.zeros((ds.n, ds.n_channels))
         if known:
             vals = np.array([self.fixed[names[i]] for i in known])

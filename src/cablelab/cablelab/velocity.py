@@ -73,11 +73,23 @@ def moving_mask(act_vel: np.ndarray, zone: np.ndarray) -> np.ndarray:
 def exclude_zero_speed(ds, floor: np.ndarray | float = 0.0, fraction: float = ZONE_FRACTION):
     """The dataset with samples in any actuator's zero-speed zone marked invalid (not fitted,
     not scored); the zone and the excluded share are kept in ``ds.signals`` (``zero_speed_zone``,
-    ``rest_share``) for reports. Datasets without actuator velocities are returned unchanged."""
+    ``rest_share``) for reports. Datasets without actuator velocities are returned unchanged.
+    The speeds tested are ``ds.signals["rest_velocity"]`` when the dataset keeps one (the
+    velocity in the band of the effort), else ``ds.act_vel``; on a parallel-filtered dataset the
+    samples next to a rest are left out too (:func:`cablelab.parallel_filter.rest_guard`).
+    Applied by the axis dataset and, for every other plant with joint or winch actuators, by
+    :func:`cablelab.workbench.load_checked`."""
     if ds.act_vel is None or ds.n < 3:
         return ds
-    zone = zero_speed_zone(ds.act_vel, floor, fraction)
-    moving = moving_mask(ds.act_vel, zone)
+    # the velocity in the band of the effort when the dataset keeps one (parallel filtering:
+    # act_vel is the lightly filtered velocity of the regressor, noisier near zero)
+    v = ds.signals.get("rest_velocity", ds.act_vel)
+    zone = zero_speed_zone(v, floor, fraction)
+    moving = moving_mask(v, zone)
+    if ds.parallel_hz:  # the parallel filter spreads the rests' model error: guard them
+        from .parallel_filter import rest_guard
+
+        moving = rest_guard(moving, ds.fs, ds.parallel_hz)
     return ds.replace(valid=ds.valid & moving,
                       signals={**ds.signals, "zero_speed_zone": zone,
                                "rest_share": float(1.0 - moving.mean())})
@@ -136,3 +148,33 @@ def quantization_aware_cutoff(q: np.ndarray, fs: float, default_hz: float, order
         while cut > MIN_CUTOFF_HZ and quantization_qdd_noise(quantum, fs, cut) > QDD_NOISE_FRACTION * rms:
             cut = max(cut / 1.25, MIN_CUTOFF_HZ)
     return cut
+
+
+#: share of the velocity's power below the excitation bandwidth
+EXCITATION_POWER = 0.99
+#: the cut-off is kept at least this multiple of the excitation bandwidth (when the default allows)
+CUTOFF_OVER_EXCITATION = 2.0
+#: parallel filtering when the cut-off is below this multiple of the excitation bandwidth (a
+#: 4th-order zero-phase Butterworth attenuates f_c / 4 by 6e-5 %, f_c / 2 by 0.4 %)
+PARALLEL_OVER_EXCITATION = 4.0
+
+
+def excitation_bandwidth(q: np.ndarray, fs: float, cutoff_hz: float, order: int = 4) -> float:
+    """Highest significant frequency of the motion, Hz: the frequency below which
+    :data:`EXCITATION_POWER` of the power of the velocity (positions low-passed at ``cutoff_hz``
+    and differentiated; every column of (N,) or (N, k) pooled) lies. Quantization noise carries
+    a negligible share of the velocity's power, so the estimate needs no reference signal."""
+    from .conditioning import lowpass
+
+    q = np.asarray(q, dtype=float).reshape(len(q), -1)
+    q = q[:, np.all(np.isfinite(q), axis=0)]
+    if q.shape[1] == 0 or q.shape[0] < 16:
+        return 0.0
+    v = np.gradient(lowpass(q, fs, cutoff_hz, order), 1.0 / fs, axis=0)
+    v = v - v.mean(axis=0)
+    p = (np.abs(np.fft.rfft(v, axis=0)) ** 2).sum(axis=1)
+    f = np.fft.rfftfreq(v.shape[0], 1.0 / fs)
+    c = np.cumsum(p)
+    if c[-1] <= 0:
+        return 0.0
+    return float(f[np.searchsorted(c, EXCITATION_POWER * c[-1])])

@@ -40,7 +40,9 @@ def load_checked(bag_path, description_path=None, options: dict | None = None, *
     the plant reads (gaps, clock jumps, stamps out of order, NaN samples), description vs bag
     (joint and cable names), negative cable tensions. Samples inside a gap (widened by the
     conditioning border) are marked invalid in ``dataset.valid``: fits use the contiguous
-    segments and never values interpolated across a gap.
+    segments and never values interpolated across a gap. Samples where an actuator is inside its
+    zero-speed zone are marked invalid for every plant with joint or winch actuators (capability
+    ``*_actuators``; :func:`cablelab.velocity.exclude_zero_speed`).
 
     Args:
         recover: read an unfinished bag (recorder killed) up to its last complete chunk.
@@ -66,6 +68,14 @@ def load_checked(bag_path, description_path=None, options: dict | None = None, *
         bag.require(topic, msgtype)
     check = check_bag(bag, plant, desc, options)
     ds = plant.dataset(bag, desc, dict(options or {}))
+    # drives that stop: every plant with friction-bearing actuators (joint or winch drives)
+    # leaves its zero-speed zone out of the fits (cablelab.velocity; a plant may have applied it
+    # itself with its encoder's floor). Swing modes or a hopping body are not drives: untouched.
+    from .velocity import exclude_zero_speed
+
+    drives = any(c.endswith("_actuators") for c in plant.capabilities)
+    if drives and "zero_speed_zone" not in ds.signals:
+        ds = exclude_zero_speed(ds)
     if check.gaps:
         cond = (options or {}).get("conditioning")
         border = getattr(cond, "border", 50)

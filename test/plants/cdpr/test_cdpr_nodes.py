@@ -39,6 +39,7 @@ def test_adapters_survive_bad_input(ros_context):
     sent, estimates = [], []
     # the nodes publish pre-serialised bytes: deserialised here by rclpy (checks the bytes too)
     ctl.pub_cmd.publish = _capture(sent, Float64MultiArray)
+    ctl.polled = sim.polled = []     # callbacks alone: the other nodes' DDS samples stay out
     est.pub.publish = _capture(estimates, InertiaStamped)
     nan = float("nan")
     try:

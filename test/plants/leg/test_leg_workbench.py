@@ -1,4 +1,5 @@
-"""Workbench on leg bags (spec 003_leg.md sec. 7, B7 diagnose part): data from the MuJoCo plant
+"""Workbench on leg bags (spec 003_leg.md sec. 7; the demo's case; B7's diagnose part on the
+round-trip records is in test_leg_identify.py): data from the MuJoCo plant
 with the impact map and a 2.7 N spring preload hidden; ``diagnose --greedy`` on the 003 model
 without impact must add ``impact_restitution`` then ``spring_preload`` and the error must fall.
 The workbench fit is the linear inverse model of plants/leg/dataset.py, which shares no code with

@@ -106,8 +106,9 @@ def significance(base, cand, n_candidates: int = 1, alpha: float = ALPHA) -> dic
     """
     rss0, rss1 = base.linear.rss, cand.linear.rss
     n = cand.linear.n
-    r1 = lag1_autocorrelation(cand.residual)
-    n_eff = max(n * (1.0 - r1) / (1.0 + r1), 3.0)
+    step = int(cand.extra.get("sample_step", 1))  # parallel-filtered data: fs / (2 f_c)
+    r1 = lag1_autocorrelation(cand.residual, step)
+    n_eff = max(n / step * (1.0 - r1) / (1.0 + r1), 3.0)
     p0, p1 = _n_params(base), _n_params(cand)
     dp = max(p1 - p0, 1)
     dof = max(n_eff - p1, 1.0)

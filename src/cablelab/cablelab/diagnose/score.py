@@ -10,7 +10,9 @@
 * Significance (:func:`lr_significance`): the Gaussian likelihood-ratio statistic with a variance
   per channel, ``LR = sum_c n_eff,c log(RSS0_c / RSS1_c)`` ~ chi^2(dp) under "no gain" (Wilks),
   where ``n_eff,c = n (1 - r1_c) / (1 + r1_c)`` is the AR(1) effective sample size of the
-  channel's residual (a filtered, oversampled residual is far from white), tested at
+  channel's residual (a filtered, oversampled residual is far from white; on a parallel-filtered
+  dataset it is taken every fs / (2 f_c) samples, :func:`~cablelab.fit.identify.sample_step`),
+  tested at
   ``alpha / m`` for the m candidates tried (Bonferroni). The BIC difference on the same
   effective samples is reported alongside.
 """
@@ -19,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.stats
 
-from ..fit.identify import lag1_autocorrelation
+from ..fit.identify import effective_samples
 
 
 def channel_nrmse(y: np.ndarray, y_hat: np.ndarray, valid: np.ndarray | None = None) -> np.ndarray:
@@ -60,8 +62,8 @@ def lr_significance(base, cand, n_candidates: int = 1, alpha: float = 0.01) -> d
     n = r1.shape[0]
     rss0 = np.sum(r0**2, axis=0)
     rss1 = np.sum(r1**2, axis=0)
-    n_eff = np.array([max(n * (1 - a) / (1 + a), 3.0)
-                      for a in (lag1_autocorrelation(r1[:, c]) for c in range(r1.shape[1]))])
+    step = int(cand.extra.get("sample_step", 1))  # parallel-filtered data: fs / (2 f_c)
+    n_eff = np.array([effective_samples(r1[:, c], step) for c in range(r1.shape[1])])
     with np.errstate(divide="ignore", invalid="ignore"):
         lr = float(np.sum(n_eff * np.log(np.maximum(rss0, 1e-300) / np.maximum(rss1, 1e-300))))
     dp = max(_n_free(cand) - _n_free(base), 1)

@@ -32,8 +32,9 @@ class Identification:
         model: the model.
         params: every parameter by name (free linear, nonlinear, fixed).
         stderr: standard error by name (0 for fixed): the LS covariance, inflated by
-            sqrt((1 + r1) / (1 - r1)) for the residual's lag-1 autocorrelation r1 (AR(1) effective
-            sample size); ``extra["stderr_white"]`` has the uninflated ones.
+            sqrt(tau) for the residual's integrated autocorrelation time tau
+            (:func:`correlation_time`; AR(1): (1 + r1) / (1 - r1)); ``extra["stderr_white"]``
+            has the uninflated ones.
         units: unit by name.
         fixed: names of the known (not fitted) parameters.
         linear: the inner :class:`LinearFit` (rank, condition, unidentifiable directions).
@@ -207,14 +208,17 @@ def identify(model: Model, ds: Dataset, *, on_deficient: str = "raise",
         y_hat, _ = model.predict(ds, params)
     resid = np.where(valid[:, None], ds2.y - y_hat, np.nan)
     # coloured residuals: the LS covariance assumes independent samples; inflate the standard
-    # errors by sqrt(n / n_eff) with the AR(1) effective sample size n_eff = n (1 - r1) / (1 + r1)
-    r1 = lag1_autocorrelation(resid)
-    inflation = float(np.sqrt((1.0 + r1) / (1.0 - r1)))
+    # errors by sqrt(n / n_eff) with the AR(1) effective sample size n_eff of the residual taken
+    # every `step` samples (parallel-filtered data: one sample per 1 / (2 f_c), else every one)
+    step = sample_step(ds)
+    r1 = lag1_autocorrelation(resid, step)
+    inflation = float(np.sqrt(resid.shape[0] / effective_samples(resid, step)))
     white = dict(stderr)
     stderr = {k: v * inflation for k, v in stderr.items()}
     return Identification(model, params, stderr, units, tuple(model.fixed), fit, y_hat, resid,
                           valid, tuple(ds.channels),
-                          extra={"stderr_white": white, "lag1": r1, "stderr_inflation": inflation})
+                          extra={"stderr_white": white, "lag1": r1, "stderr_inflation": inflation,
+                                 "sample_step": step})
 
 
 #: a channel residual below this fraction of the largest one is round-off (a channel the plant
@@ -243,17 +247,36 @@ def noise_weights(residual: np.ndarray) -> np.ndarray:
     return w / np.exp(np.mean(np.log(w)))
 
 
-def lag1_autocorrelation(residual: np.ndarray) -> float:
+def lag1_autocorrelation(residual: np.ndarray, step: int = 1) -> float:
     """Lag-1 autocorrelation of a residual (N,) or (N, C) (channels pooled, NaN rows dropped),
-    clipped to [0, 0.999]."""
+    clipped to [0, 0.999]; with ``step`` > 1, between samples ``step`` apart."""
     r = np.asarray(residual, dtype=float)
     r = r.reshape(r.shape[0], -1)
     r = r[np.isfinite(r).all(axis=1)]
-    if r.shape[0] < 3:
+    k = max(1, int(step))
+    if r.shape[0] < 2 * k + 1:
         return 0.0
     r = r - r.mean(axis=0)
     den = float(np.sum(r * r))
-    return float(np.clip(np.sum(r[1:] * r[:-1]) / den, 0.0, 0.999)) if den > 0 else 0.0
+    return float(np.clip(np.sum(r[k:] * r[:-k]) / den, 0.0, 0.999)) if den > 0 else 0.0
+
+
+def sample_step(ds: Dataset) -> int:
+    """Samples per independent sample of a residual of the dataset: ``fs / (2 f_c)`` for a
+    parallel-filtered dataset (a signal band-limited to f_c carries 2 f_c independent samples per
+    second, Nyquist), else 1."""
+    return max(1, int(ds.fs / (2.0 * float(ds.parallel_hz)))) if ds.parallel_hz else 1
+
+
+def effective_samples(residual: np.ndarray, step: int = 1) -> float:
+    """AR(1) effective sample size of a residual (N,) or (N, C) taken every ``step`` samples:
+    ``(n / step) (1 - r) / (1 + r)``, r the lag-``step`` autocorrelation
+    (:func:`lag1_autocorrelation`), n the finite rows; at least 3. ``step`` = 1 is the plain
+    AR(1) formula; :func:`sample_step` gives the step of a parallel-filtered dataset."""
+    r = np.asarray(residual, dtype=float)
+    n = int(np.isfinite(r.reshape(r.shape[0], -1)).all(axis=1).sum())
+    a = lag1_autocorrelation(r, step)
+    return max(n / max(1, int(step)) * (1.0 - a) / (1.0 + a), 3.0)
 
 
 class _OuterProblem:

@@ -71,7 +71,8 @@ def objective_residual(y_meas: np.ndarray, y_sim: np.ndarray, objective: str) ->
 
 def fit_simulation(simulate: Callable[[list[dict]], np.ndarray], params: Sequence[Param],
                    y_meas: np.ndarray, *, objective: str = "nmse", x0: Sequence[float] | None = None,
-                   max_iter: int = 50, verbose: bool = False, progress: bool = False) -> SimulationFit:
+                   max_iter: int = 50, verbose: bool = False, progress: bool = False,
+                   covariance: bool = True) -> SimulationFit:
     """Bounded fit of simulated to measured outputs.
 
     Args:
@@ -84,6 +85,8 @@ def fit_simulation(simulate: Callable[[list[dict]], np.ndarray], params: Sequenc
         x0: start (default the nominal values).
         progress: print a line with the objective and an ETA (upper bound: max_iter) on stderr
             every 2 s.
+        covariance: compute the standard errors (one batch of 2p extra rollouts); False: NaN
+            (e.g. the fits of cross-validation folds, whose spread is the uncertainty).
     Raises:
         CablelabError: unknown objective, infinite bounds, start outside the bounds.
     """
@@ -126,6 +129,12 @@ def fit_simulation(simulate: Callable[[list[dict]], np.ndarray], params: Sequenc
                                    iter_callback=report)
     x = np.clip(np.asarray(x, float).reshape(-1), lo, hi)
     values = dict(zip(names, map(float, x)))
+    if not covariance:
+        y_sim = np.asarray(simulate([values]))[0].reshape(y_meas.shape)
+        nm = float(np.sum(objective_residual(y_meas, y_sim, "nmse") ** 2))
+        rho = 1.0 - float(np.sum(objective_residual(y_meas, y_sim, "pearson") ** 2))
+        return SimulationFit(values, dict.fromkeys(names, float("nan")), objective, nm, rho, y_sim,
+                             iterations=len(trace), evaluations=count["n"])
     # Gauss-Newton covariance from a central finite-difference Jacobian (one batch of 2p rollouts)
     h = 1e-4 * scale
     pts = np.concatenate([np.clip(x[:, None] + np.diag(h), lo[:, None], hi[:, None]),
@@ -147,12 +156,16 @@ def fit_simulation(simulate: Callable[[list[dict]], np.ndarray], params: Sequenc
     from .identify import lag1_autocorrelation
 
     r1 = lag1_autocorrelation(r0.reshape(y_meas.shape))
-    se = se * np.sqrt((1.0 + r1) / (1.0 - r1))
+    inflation = float(np.sqrt((1.0 + r1) / (1.0 - r1)))
+    se = se * inflation
     y_sim = np.asarray(simulate([values]))[0].reshape(y_meas.shape)
     nm = float(np.sum(objective_residual(y_meas, y_sim, "nmse") ** 2))
     rho = 1.0 - float(np.sum(objective_residual(y_meas, y_sim, "pearson") ** 2))
+    # (what an identifiability analysis needs: the Jacobian at the optimum, its residual and the
+    # coloured-residual inflation of the standard errors)
     return SimulationFit(values, dict(zip(names, map(float, se))), objective, nm, rho, y_sim,
-                         iterations=len(trace), evaluations=count["n"])
+                         iterations=len(trace), evaluations=count["n"],
+                         extra={"jacobian": jac, "residual": r0, "se_inflation": inflation})
 
 
 # ----------------------------------------------------------------------------- free-run windows

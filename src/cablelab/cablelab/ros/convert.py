@@ -219,3 +219,39 @@ def string_msg(text: str) -> String:
     msg = String()
     msg.data = str(text)
     return msg
+
+
+def imu_msg(t: float, quaternion, angular_velocity, linear_acceleration=None,
+            frame_id: str = "imu"):
+    """sensor_msgs/Imu: orientation (x, y, z, w; sensor frame to world), angular velocity
+    (rad/s, sensor frame), linear acceleration (m/s^2, sensor frame, specific force). A field
+    given as None is marked unavailable (covariance[0] = -1, sensor_msgs convention)."""
+    from sensor_msgs.msg import Imu
+
+    msg = Imu()
+    msg.header.stamp = to_stamp(t)
+    msg.header.frame_id = frame_id
+    for name, values in (("orientation", quaternion), ("angular_velocity", angular_velocity),
+                         ("linear_acceleration", linear_acceleration)):
+        if values is None:
+            getattr(msg, f"{name}_covariance")[0] = -1.0
+            continue
+        v = np.asarray(values, float)
+        target = getattr(msg, name)
+        target.x, target.y, target.z = map(float, v[:3])
+        if name == "orientation":
+            target.w = float(v[3])
+    return msg
+
+
+def imu_arrays(msg):
+    """(t s, quaternion (4,) x, y, z, w, angular velocity (3,), linear acceleration (3,)); a field
+    marked unavailable (covariance[0] = -1) comes back as None."""
+    out = [from_stamp(msg.header.stamp)]
+    for name in ("orientation", "angular_velocity", "linear_acceleration"):
+        if getattr(msg, f"{name}_covariance")[0] == -1.0:
+            out.append(None)
+            continue
+        v = getattr(msg, name)
+        out.append(np.array([v.x, v.y, v.z, v.w]) if name == "orientation" else np.array([v.x, v.y, v.z]))
+    return tuple(out)

@@ -95,8 +95,10 @@ class PlantNode(Node):
         self.description = desc
 
     def publish_description(self, desc) -> None:
-        """Publish ``desc`` on ``/plant_description`` (transient local: late joiners get it)."""
+        """Publish ``desc`` on ``/plant_description`` (transient local: late joiners get it).
+        The publisher owns the description: it never takes another one from the topic."""
         self.description = desc
+        self.keep_first_description = True
         self._desc_pub = self.create_publisher(String, "/plant_description", DESCRIPTION_QOS)
         self._desc_pub.publish(convert.string_msg(desc.to_yaml()))
 

@@ -17,6 +17,7 @@ A :class:`~cablelab.errors.CablelabError` while building the node prints one lin
 from __future__ import annotations
 
 import argparse
+import gc
 import signal
 import sys
 import threading
@@ -51,6 +52,19 @@ class _Stop:
         self.event.set()
 
 
+def _tight_timers() -> None:
+    """Wake timed waits on time: Linux delays a normal thread's timed wake-up by up to its timer
+    slack (50 us by default) to batch wake-ups, a twentieth of a 1 kHz period. Set to 1 ns for
+    this thread and the threads it starts (DDS threads start in rclpy.init); no privilege
+    needed. Elsewhere (no prctl) nothing happens."""
+    try:
+        import ctypes
+
+        ctypes.CDLL(None, use_errno=True).prctl(29, 1, 0, 0, 0)   # PR_SET_TIMERSLACK
+    except (OSError, AttributeError):
+        pass
+
+
 def run_node(node_factory, args, ros_args: list[str], prog: str) -> int:
     """Init rclpy with ``ros_args``, build the node with ``node_factory(args)``, spin until
     SIGINT/SIGTERM (or ``node.done`` becomes True), shut down cleanly. Returns the exit code."""
@@ -60,6 +74,7 @@ def run_node(node_factory, args, ros_args: list[str], prog: str) -> int:
 
     stop = _Stop()
     old = {s: signal.signal(s, stop) for s in (signal.SIGINT, signal.SIGTERM)}
+    _tight_timers()
     rclpy.init(args=[prog] + ros_args, signal_handler_options=SignalHandlerOptions.NO)
     node = None
     code = 0
@@ -69,6 +84,10 @@ def run_node(node_factory, args, ros_args: list[str], prog: str) -> int:
         except CablelabError as exc:
             print(f"{prog}: error: {exc}", file=sys.stderr)
             return 2
+        # what start-up built lives to the end: keep it out of the collector's scans, so that a
+        # full collection in a 1 kHz callback costs microseconds, not milliseconds
+        gc.collect()
+        gc.freeze()
         factory = getattr(node, "executor_factory", None)   # a node may bring a leaner executor
         executor = factory() if callable(factory) else SingleThreadedExecutor()
         executor.add_node(node)

@@ -41,15 +41,20 @@ def dataset_from_arrays(t, q, effort, description, options: dict | None = None, 
                          source=source)
     unit = "N m" if revolute else "N"
     qd_c = c["qd"].reshape(-1)
+    qd_s = c["qd_smooth"].reshape(-1)
     ds = Dataset(
         plant="axis", t=c["t"], y=c["effort"].reshape(-1, 1), channels=("joint",), units=(unit,),
         signals={"q": c["q"].reshape(-1), "qd": qd_c, "qdd": c["qdd"].reshape(-1),
-                 "cutoff_hz": c["cutoff_hz"]},
+                 "cutoff_hz": c["cutoff_hz"], "rest_velocity": qd_s[:, None]},
         actuators=("joint",), act_vel=qd_c[:, None], act_units=((unit, "rad" if revolute else "m"),),
-        inputs={"velocity": qd_c, "acceleration": c["qdd"].reshape(-1)},
+        inputs={"velocity": qd_s, "acceleration": c["qdd_smooth"].reshape(-1)},
         regimes={"position": _position_bins(c["q"].reshape(-1))},
         description=description, source=source,
     )
+    if c["parallel_hz"]:
+        from ...parallel_filter import edge_mask
+
+        ds = ds.replace(parallel_hz=c["parallel_hz"], valid=ds.valid & edge_mask(ds.t, c["parallel_hz"]))
     # drives that stop: the zero-speed zone is not fitted (cablelab.velocity, issue 10)
     from ...velocity import exclude_zero_speed, position_quantum, speed_resolution
 

@@ -3,7 +3,9 @@
 All are columns of the inverse model of :mod:`.dataset` (``y = s (F_in + k (z_0 - z))`` =
 sum of effect terms), built from the dataset's parallel-filtered bases. ``leg_inertia`` (m) with
 ``stance_damping`` and ``flight_damping`` is the baseline (003's model without the impact map);
-the rest are the diagnose candidates.
+the rest are the diagnose candidates. ``contact_delay`` has no column: its nonlinear parameter
+tau_c rebuilds the dataset with the switch advanced by tau_c (:func:`.dataset.advance_contact`),
+searched outside the linear least squares like ``time_delay``.
 """
 from __future__ import annotations
 
@@ -86,6 +88,22 @@ register(Effect(
     signature="stance frequency against the measured 1.62 kg; explains beta_lo > 1 (E9)",
     reference="003 sec. 3.4 (beta_lo > 1)", regressor=_cols("acc_flight")))
 
+
+def _contact_delay(ds: Dataset, values) -> Dataset:
+    from .dataset import advance_contact
+
+    return advance_contact(ds, float(values.get("tau_c", 0.0)))
+
+
+register(Effect(
+    id="contact_delay", plants=LEG, params=(),
+    explanation="the contact switch closes and opens tau_c after the true touch-down and lift-off",
+    signature="velocity jump earlier than the switch edge; F_GRF estimate negative before lift-off",
+    reference="003 sec. 3.1 (contact switch); spec 003_leg.md sec. 7",
+    nonlinear=(Param("tau_c", "s", 0.0, 0.0, 0.020, "delay of the contact switch behind the true "
+                     "transition"),),
+    transform=_contact_delay))
+
 BASELINE = ("leg_inertia", "stance_damping", "flight_damping")
 CANDIDATES = ("impact_restitution", "spring_preload", "spring_nonlinearity", "guide_coulomb_friction",
-              "phase_effective_mass")
+              "phase_effective_mass", "contact_delay")

@@ -19,6 +19,8 @@ residual, per trajectory normalised, summed over trajectories (eq. 29).
 """
 from __future__ import annotations
 
+import dataclasses
+import threading
 from dataclasses import dataclass, field
 
 import mujoco
@@ -213,12 +215,16 @@ def _phase_model(p: LegParams, phase: int, dt: float) -> mujoco.MjModel:
     return m
 
 
-def _initial_state(model, z0: float, zd0: float) -> np.ndarray:
+def _initial_states(model, x0s) -> np.ndarray:
+    """(S, nstate) FULLPHYSICS initial states of the slide-joint model for (z, zdot) pairs
+    (one MjData for all: the state vector of this model differs only in qpos and qvel)."""
     d = mujoco.MjData(model)
-    d.qpos[0], d.qvel[0] = z0, zd0
-    x = np.empty(mujoco.mj_stateSize(model, mujoco.mjtState.mjSTATE_FULLPHYSICS))
-    mujoco.mj_getState(model, d, x, mujoco.mjtState.mjSTATE_FULLPHYSICS)
-    return x
+    sig = mujoco.mjtState.mjSTATE_FULLPHYSICS
+    out = np.empty((len(x0s), mujoco.mj_stateSize(model, sig)))
+    for i, (z0, zd0) in enumerate(x0s):
+        d.qpos[0], d.qvel[0] = z0, zd0
+        mujoco.mj_getState(model, d, out[i], sig)
+    return out
 
 
 def simulate_phase_segments(segs: list[Segment], param_sets: list[LegParams], dt: float = DT,
@@ -229,24 +235,32 @@ def simulate_phase_segments(segs: list[Segment], param_sets: list[LegParams], dt
     lens = np.array([s.n for s in segs])
     out = np.full((len(param_sets), len(segs), int(lens.max()), 2), np.nan)
     order = np.argsort(lens)
+    phases = {s.phase for s in segs}
+    mods = [{ph: _phase_model(p, ph, dt) for ph in phases} for p in param_sets]
+    xs = _initial_states(next(iter(mods[0].values())), [s.x0 for s in segs])
     for grp in np.array_split(order, min(buckets, len(segs))):
         if len(grp):
-            sub = _rollout_segments([segs[i] for i in grp], param_sets, dt)
+            sub = _rollout_segments([segs[i] for i in grp], param_sets, mods, xs[grp])
             out[:, grp, : sub.shape[2]] = sub
     return out
 
 
-def _rollout_segments(segs: list[Segment], param_sets: list[LegParams], dt: float) -> np.ndarray:
+#: per thread, two MjData for :func:`mujoco.rollout.rollout` (two rollout threads: the 2 cores),
+#: made once; every leg phase model has the same structure, so any of them can use these
+_ROLLOUT = threading.local()
+
+
+def _rollout_segments(segs: list[Segment], param_sets: list[LegParams], mods: list[dict],
+                      xs: np.ndarray) -> np.ndarray:
     import mujoco.rollout
 
     n_max = max(s.n for s in segs)
     models, x0, ctrl = [], [], []
-    for p in param_sets:
-        mods = {ph: _phase_model(p, ph, dt) for ph in {s.phase for s in segs}}
+    for p, mod in zip(param_sets, mods):
+        x0.extend(xs)
         for s in segs:
-            m = mods[s.phase]
+            m = mod[s.phase]
             models.append(m)
-            x0.append(_initial_state(m, *s.x0))
             u = np.zeros(n_max - 1)
             # the input over [t_n, t_n+1): mean of the measured samples at both ends (the
             # measured torque is known at the samples only; trapezoid = 2nd order)
@@ -254,8 +268,9 @@ def _rollout_segments(segs: list[Segment], param_sets: list[LegParams], dt: floa
             ctrl.append(u)
     if n_max < 2:
         return np.array(x0)[:, None, 1:3].reshape(len(param_sets), len(segs), 1, 2)
-    data = [mujoco.MjData(models[0]) for _ in range(2)]
-    state, _ = mujoco.rollout.rollout(models, data, np.array(x0), np.array(ctrl)[:, :, None])
+    if getattr(_ROLLOUT, "data", None) is None:
+        _ROLLOUT.data = [mujoco.MjData(models[0]) for _ in range(2)]
+    state, _ = mujoco.rollout.rollout(models, _ROLLOUT.data, np.array(x0), np.array(ctrl)[:, :, None])
     # FULLPHYSICS state = [time, qpos, qvel, ...]; row j is the state after step j + 1
     traj = np.concatenate([np.array(x0)[:, None, 1:3], state[:, :, 1:3]], axis=1)
     out = traj.reshape(len(param_sets), len(segs), n_max, 2)
@@ -264,10 +279,14 @@ def _rollout_segments(segs: list[Segment], param_sets: list[LegParams], dt: floa
     return out
 
 
-def simulate_stride(seg: Segment, p: LegParams, dt: float = DT) -> np.ndarray:
+def simulate_stride(seg: Segment, p: LegParams, dt: float = DT, sim: LegSim | None = None) -> np.ndarray:
     """(n, 2) hybrid simulation of one apex-to-apex stride from its measured apex state, driven by
-    the measured torque (applied while the simulated leg is in stance)."""
-    sim = LegSim(p, seg.x0[0], seg.x0[1], phase=int(seg.contact[0]), dt=dt)
+    the measured torque (applied while the simulated leg is in stance). ``sim``: a stepper of
+    the same parameters to reuse (reset to the stride's start)."""
+    if sim is None:
+        sim = LegSim(p, seg.x0[0], seg.x0[1], phase=int(seg.contact[0]), dt=dt)
+    else:
+        sim.reset(seg.x0[0], seg.x0[1], phase=int(seg.contact[0]))
     out = np.empty((seg.n, 2))
     q, v = sim._q, sim._v
     for i in range(seg.n):
@@ -281,9 +300,39 @@ def simulate_strides(segs: list[Segment], param_sets: list[LegParams]) -> np.nda
     n_max = max(s.n for s in segs)
     out = np.full((len(param_sets), len(segs), n_max, 2), np.nan)
     for k, p in enumerate(param_sets):
+        sim = LegSim(p, segs[0].x0[0], segs[0].x0[1], dt=DT)
         for j, s in enumerate(segs):
-            out[k, j, : s.n] = simulate_stride(s, p)
+            out[k, j, : s.n] = simulate_stride(s, p, sim=sim)
     return out
+
+
+class SimulationMemo:
+    """Memoised segment simulations: ``memo(simulate)(segs, param_sets)`` returns what
+    ``simulate`` would and simulates only the (segment, parameter set) pairs not seen before.
+    The k-fold fits of a stage start from the all-data fit, so their first evaluations and
+    Jacobians, and the held-out validations, repeat simulations of the same segments with the
+    same parameters."""
+
+    def __init__(self, simulate):
+        self.simulate = simulate
+        self.store: dict = {}
+        self.hits = self.misses = 0
+
+    def __call__(self, segs: list[Segment], param_sets: list[LegParams]) -> np.ndarray:
+        n_max = max(s.n for s in segs)
+        out = np.full((len(param_sets), len(segs), n_max, 2), np.nan)
+        for k, p in enumerate(param_sets):
+            key = dataclasses.astuple(p)
+            todo = [j for j, s in enumerate(segs) if (id(s), key) not in self.store]
+            self.hits += len(segs) - len(todo)
+            self.misses += len(todo)
+            if todo:
+                sim = self.simulate([segs[j] for j in todo], [p])[0]
+                for i, j in enumerate(todo):
+                    self.store[(id(segs[j]), key)] = sim[i, : segs[j].n]
+            for j, s in enumerate(segs):
+                out[k, j, : s.n] = self.store[(id(s), key)]
+        return out
 
 
 # ----------------------------------------------------------------------------- NMSE (eq. 28)
@@ -309,7 +358,7 @@ def segment_metrics(segs: list[Segment], sim: np.ndarray) -> dict[str, np.ndarra
 
 
 def _fit(segs, simulate, base: LegParams, names: tuple[str, ...], max_iter: int = 30,
-         x0: dict | None = None) -> dict:
+         x0: dict | None = None, covariance: bool = True) -> dict:
     """Minimise sum_i J_i (003 eq. 29) over ``names``: the measured and simulated trajectories are
     normalised per segment and channel, so the residual norm is the eq. 28 sum (up to a constant
     factor applied by :func:`fit_simulation`)."""
@@ -326,7 +375,8 @@ def _fit(segs, simulate, base: LegParams, names: tuple[str, ...], max_iter: int 
 
     start = {n: getattr(base, n) for n in names} if x0 is None else x0
     params = [Param(n, UNITS[n], float(np.clip(start[n], *BOUNDS[n])), *BOUNDS[n]) for n in names]
-    res = fit_simulation(run, params, y_n.reshape(-1, 1), objective="nmse", max_iter=max_iter)
+    res = fit_simulation(run, params, y_n.reshape(-1, 1), objective="nmse", max_iter=max_iter,
+                         covariance=covariance)
     return res.params
 
 
@@ -350,13 +400,19 @@ class StageResult:
 def cross_validate(segs, simulate, base: LegParams, names, k: int, name: str, max_iter: int = 30,
                    warm: bool = False) -> StageResult:
     """k-fold CV (003 sec. 3.4): fit on k-1 folds, validate on the held-out one. With ``warm``,
-    one fit on all segments first, then each fold starts from it (fewer iterations)."""
+    one fit on all segments first, then each fold starts from it (fewer iterations). The
+    simulations are memoised (:class:`SimulationMemo`): a fold repeats the all-data fit's
+    simulations of its segments at the start point, and the fold fits skip the covariance
+    (their spread over the folds is the reported sd, as in 003 Table 2)."""
+    simulate = SimulationMemo(simulate)
     x0 = _fit(segs, simulate, base, names, max_iter) if warm else None
     fits, mets = [], []
     for f in _folds(len(segs), k):
-        train = [s for i, s in enumerate(segs) if i not in set(f)]
+        held = set(f.tolist())
+        train = [s for i, s in enumerate(segs) if i not in held]
         val = [segs[i] for i in f]
-        pv = _fit(train, simulate, base, names, max_iter if not warm else WARM_FOLD_ITER, x0)
+        pv = _fit(train, simulate, base, names, max_iter if not warm else WARM_FOLD_ITER, x0,
+                  covariance=False)
         fits.append(pv)
         mets.append(segment_metrics(val, simulate(val, [base.replace(**pv)])[0]))
     params = {n: float(np.mean([f[n] for f in fits])) for n in names}
@@ -376,6 +432,7 @@ class Identification:
     stride_metrics: dict
     apex: dict
     timings: dict = field(default_factory=dict)
+    cpu_timings: dict = field(default_factory=dict)
 
     def table1(self) -> str:
         """Per-phase validation NMSE / MAE / max error in 003 Table 1's format (markdown)."""
@@ -433,15 +490,16 @@ def identify(records: list[HopRecord], base: LegParams | None = None, *, folds=(
     import time
 
     bar = tqdm(total=4, desc="leg identification", disable=not progress)
-    clock = [time.perf_counter()]
+    clock = [time.perf_counter(), time.process_time()]
 
     def lap(name):
-        now = time.perf_counter()
-        timings[name] = now - clock[0]
-        clock[0] = now
+        now, cpu = time.perf_counter(), time.process_time()
+        timings[name], cpu_timings[name] = now - clock[0], cpu - clock[1]
+        clock[0], clock[1] = now, cpu
         bar.update()
 
     timings: dict = {}
+    cpu_timings: dict = {}
     fl = cross_validate(phase_segments(records, 0, base), simulate_phase_segments, start, ("d_f",),
                         folds[0], "flight", max_iter, warm=True)
     lap("flight")
@@ -463,7 +521,7 @@ def identify(records: list[HopRecord], base: LegParams | None = None, *, folds=(
             "nmse_full": segment_metrics(strides_, sims[0]), "nmse_no_impact": segment_metrics(strides_, sims[1])}
     lap("validation")
     bar.close()
-    return Identification(fl, st, im, final, whole, apex, timings)
+    return Identification(fl, st, im, final, whole, apex, timings, cpu_timings)
 
 
 __all__ = ["HopRecord", "Identification", "Segment", "StageResult", "apex_errors", "cross_validate",

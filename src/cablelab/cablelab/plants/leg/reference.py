@@ -43,9 +43,21 @@ class ReferenceResult:
         return [(e[0], e[2]) for e in self.events if e[1] == "apex"]
 
 
+def schedule_lookup(schedule, block_s: float, T: float, P: float):
+    """``(T, P)`` of eq. 26 for a stance that starts at ``t_d``: the fixed pair, or the pair of
+    the ``block_s``-long block of ``schedule`` that holds ``t_d`` (the last one after its end)."""
+    if not schedule:
+        return lambda t_d: (T, P)
+    sched = [tuple(map(float, x)) for x in schedule]
+    return lambda t_d: sched[min(int(max(t_d, 0.0) // block_s), len(sched) - 1)]
+
+
 def run_reference(p: LegParams, z0: float, zd0: float, duration: float, T: float = 0.0,
-                  P: float = 0.3, zoh_dt: float | None = None) -> ReferenceResult:
-    """Simulate the hybrid leg from (z0, zd0) for ``duration`` s under 003 eq. 26 (T, P)."""
+                  P: float = 0.3, zoh_dt: float | None = None, *, schedule=None,
+                  block_s: float = 4.0) -> ReferenceResult:
+    """Simulate the hybrid leg from (z0, zd0) for ``duration`` s under 003 eq. 26 (T, P), or
+    with ``schedule`` [(T, P), ...] a new pair every ``block_s`` s (chosen at each touch-down)."""
+    pair = schedule_lookup(schedule, block_s, T, P)
     m, k, g = p.m, p.k, p.g
     mf = p.m if p.m_f is None else p.m_f
     z_td = 2.0 * p.L * math.cos(p.theta0)
@@ -61,7 +73,8 @@ def run_reference(p: LegParams, z0: float, zd0: float, duration: float, T: float
             t = math.floor(t / zoh_dt + 1e-9) * zoh_dt
             if t < t_d - 1e-12:  # the sample period of the touch-down carries no torque yet
                 return 0.0
-        return T * math.sin(2.0 * math.pi * (t - t_d) / P) / math.sqrt(max(4.0 * p.L**2 - z * z, 1e-12))
+        Tn, Pn = pair(t_d)
+        return Tn * math.sin(2.0 * math.pi * (t - t_d) / Pn) / math.sqrt(max(4.0 * p.L**2 - z * z, 1e-12))
 
     segments, events = [], []
     t, z, zd = 0.0, z0, zd0
@@ -125,21 +138,26 @@ def run_reference(p: LegParams, z0: float, zd0: float, duration: float, T: float
 
 def sampled_trajectory(p: LegParams, z0: float, zd0: float, duration: float, T: float = 0.0,
                        P: float = 0.3, dt: float = 1e-3, *, resolution: float = 9e-5,
-                       seed: int | None = 0, rtol: float | None = None):
+                       seed: int | None = 0, rtol: float | None = None, schedule=None,
+                       block_s: float = 4.0, contact_delay: float = 0.0):
     """The reference solution sampled at ``dt`` like the hardware (continuous eq. 26 torque,
-    sampled; 0.09 mm encoder, differentiated velocity, contact switch) as a
-    :class:`~cablelab.plants.leg.sim.Trajectory`: data for tests that the MuJoCo code did not
-    generate."""
+    sampled; 0.09 mm encoder, differentiated velocity, contact switch ``contact_delay`` s late) as
+    a :class:`~cablelab.plants.leg.sim.Trajectory`: data for tests that the MuJoCo code did not
+    generate. ``schedule``, ``block_s``: as :func:`run_reference`."""
     from .sim import Trajectory, measure
 
-    ref = run_reference(p, z0, zd0, duration, T, P)
+    ref = run_reference(p, z0, zd0, duration, T, P, schedule=schedule, block_s=block_s)
+    pair = schedule_lookup(schedule, block_s, T, P)
     t = np.arange(0.0, ref.t_end + 1e-12, dt)
     z, zd, ph = ref.sample(t)
     td = np.array([e[0] for e in ref.events if e[1] == "touchdown"])
     k = np.searchsorted(td, t, side="right") - 1
     t_d = np.where(k >= 0, td[np.maximum(k, 0)], 0.0)
-    tau = np.where(ph == 1, T * np.sin(2 * np.pi * (t - t_d) / P), 0.0)
+    # the eq. 26 pair of each sample's stance (before the first touch-down: the pair at t = 0)
+    TP = np.array([pair(0.0)] + [pair(x) for x in td])
+    Tn, Pn = TP[k + 1, 0], TP[k + 1, 1]
+    tau = np.where(ph == 1, Tn * np.sin(2 * np.pi * (t - t_d) / Pn), 0.0)
     f_in = np.where(ph == 1, tau / np.sqrt(np.maximum(4 * p.L**2 - z * z, 1e-12)), 0.0)
     g = np.where(ph == 1, f_in + p.k * (p.spring_rest - z) + p.F0 - p.d_s * zd, 0.0)
     traj = Trajectory(t, z, zd, ph, tau, f_in, g, [])
-    return measure(traj, resolution=resolution, seed=seed)
+    return measure(traj, resolution=resolution, contact_delay=contact_delay, seed=seed)

@@ -80,6 +80,12 @@ class LegSim:
         self.model = build_model(params, dt)
         self.data = mujoco.MjData(self.model)
         self._q, self._v = self.data.qpos, self.data.qvel  # cached views (hot loop)
+        self.reset(z, zd, phase)
+
+    def reset(self, z: float, zd: float = 0.0, phase: int | None = None) -> None:
+        """Restart from (z, zd) at t = 0 with the same parameters (reuses the model and data)."""
+        params, dt = self.p, self.dt
+        mujoco.mj_resetData(self.model, self.data)
         self.phase = (STANCE if z < params.z_td else FLIGHT) if phase is None else phase
         self._q[0] = z
         # MuJoCo's semi-implicit Euler is a leapfrog whose velocity lives half a step after the
@@ -111,6 +117,9 @@ class LegSim:
         """Change the simulated stance mass (and the MuJoCo body mass), kg."""
         self.p = self.p.replace(m=m)
         self.model.body_mass[1] = m
+        # the joint-space inertia is built from the constants mj_setConst derives from body_mass
+        # (without it MuJoCo kept the old mass in M while gravity used the new one)
+        mujoco.mj_setConst(self.model, mujoco.MjData(self.model))
 
     # -------------------------------------------------------------- internals
     def _phase_force(self, z: float, zd: float) -> float:

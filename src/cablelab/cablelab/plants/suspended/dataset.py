@@ -7,6 +7,13 @@ mode (cable angles q8 = swing_x, q9 = swing_y about S, and platform yaw phi^z):
 ``J_x qdd8 = -[mgl_x sin q8 + f_v8 qd8 + f_s8 sign(qd8) + ...]`` (channel ``swing_x``, N m),
 the same for ``swing_y`` (q9) and ``J_z phidd = -[k_yaw phi + f_v7 phid + ...]`` (``yaw``).
 
+Channel ``stretch`` (N): the radial equation of the lower body (mass M_r, everything below the
+rope) on a cable of measured length ``l = |p - S|``, with ``d`` = l minus its median (the dynamic
+stretch about the static one) and ``u`` the cable direction (``|udot|^2 = qd9^2 + cos^2 q9 qd8^2``):
+``M_r (ddd - l |udot|^2) - M_r g (cos q8 cos q9 - 1) = -[k_c d + c_c dd]``. A rigid cable keeps
+d at zero (the channel is then not excited and zeroed); an elastic one bounces (spec sec. 7
+``cable_elasticity``).
+
 Output y = nominal inertia x measured angular acceleration, with the nominal modal inertias of
 the description's parameter set (:func:`modal_inertias`: the links turning with each joint plus
 the platform and arms translating at distance L, spec 4.5). The swing angles come from the
@@ -27,18 +34,19 @@ from .params import VirtualParams
 from .reference import planar_bodies
 from .swing import swing_from_pose
 
-__all__ = ["dataset", "dataset_from_arrays", "modal_inertias", "CHANNELS", "POSE_TOPIC",
+__all__ = ["dataset", "dataset_from_arrays", "modal_inertias", "radial_mass", "CHANNELS", "POSE_TOPIC",
            "JOINT_STATES", "CUTOFF_HZ"]
 
-CHANNELS = ("swing_x", "swing_y", "yaw")
+CHANNELS = ("swing_x", "swing_y", "yaw", "stretch")
 POSE_TOPIC = "/suspended/platform_pose"
 JOINT_STATES = "/suspended/joint_states"
 POSE = "geometry_msgs/msg/PoseStamped"
 #: position low-pass cut-off, Hz: the swing is at 0.5 Hz (LiCAS) / 0.24 Hz (CRANEbot), yaw below
 #: 0.6 Hz; 1 mm of mocap noise differentiated twice needs a low cut-off (cf. crane: 3 Hz)
 CUTOFF_HZ = 2.0
-#: amplitude (rad) below which a channel counts as not excited: swing_x, swing_y, yaw
-MIN_AMPLITUDE = (0.01, 0.01, 0.02)
+#: amplitude below which a channel counts as not excited: swing_x, swing_y, yaw (rad), stretch (m;
+#: 1 mm of mocap noise low-passed at 2 Hz stays well below 3 mm)
+MIN_AMPLITUDE = (0.01, 0.01, 0.02, 0.003)
 
 
 def modal_inertias(p: VirtualParams) -> np.ndarray:
@@ -74,28 +82,40 @@ def dataset_from_arrays(t, pos, quat_wxyz, desc_section, description=None, optio
         opts = dataclasses.replace(opts, cutoff_hz=CUTOFF_HZ)
     p = desc_section.params()
     s = swing_from_pose(pos, quat_wxyz, p.S, rest_pos=np.array(p.S) - [0, 0, p.L], rest_yaw=0.0)
-    q = np.column_stack([s["swing_x"], s["swing_y"], s["yaw"]])
+    l = np.linalg.norm(np.asarray(pos, float) - np.asarray(p.S, float), axis=1)
+    q = np.column_stack([s["swing_x"], s["swing_y"], s["yaw"], l - np.median(l)])
     c = condition_motion(np.asarray(t, float), q, np.zeros((len(q), 1)), opts, revolute=False,
                          source=source)
     q, qd, qdd = c["q"], c["qd"], c["qdd"]
     J = modal_inertias(p)
     g = description.gravity if description is not None else 9.81
+    M_r = radial_mass(p)
     amp = np.abs(q[:, :2]).max(axis=1)
     edges = np.quantile(amp, [1 / 3, 2 / 3])
     labels = np.array(["small swing", "medium swing", "large swing"])
-    y = qdd * J
+    y = np.empty_like(q)
+    y[:, :3] = qdd[:, :3] * J
+    lk = np.median(l) + q[:, 3]
+    udot2 = qd[:, 1] ** 2 + np.cos(q[:, 1]) ** 2 * qd[:, 0] ** 2
+    y[:, 3] = M_r * (qdd[:, 3] - lk * udot2) - M_r * g * (np.cos(q[:, 0]) * np.cos(q[:, 1]) - 1.0)
     # a channel the record does not excite carries only differentiated noise: its output is
     # zeroed (the columns keep the measured motion, so every parameter stays fitted, to ~0)
     excited = np.abs(q - q.mean(axis=0)).max(axis=0) > np.asarray(options.get("min_amplitude", MIN_AMPLITUDE))
     y[:, ~excited] = 0.0
     return Dataset(
-        plant="suspended", t=c["t"], y=y, channels=CHANNELS, units=("N m", "N m", "N m"),
+        plant="suspended", t=c["t"], y=y, channels=CHANNELS, units=("N m", "N m", "N m", "N"),
         signals={"q": q, "qd": qd, "qdd": qdd, "J": J, "g": g, "L": p.L, "excited": excited,
                  "cutoff_hz": c.get("cutoff_hz", opts.cutoff_hz)},
-        actuators=CHANNELS, act_vel=qd, act_units=(("N m", "rad"),) * 3,
+        actuators=CHANNELS, act_vel=qd, act_units=(("N m", "rad"),) * 3 + (("N", "m"),),
         inputs={"swing_x rate": qd[:, 0], "swing_y rate": qd[:, 1], "yaw rate": qd[:, 2]},
         regimes={"swing amplitude": labels[np.searchsorted(edges, amp)]},
         description=description, source=source)
+
+
+def radial_mass(p: VirtualParams) -> float:
+    """Mass below the rope (link 10 and the lower body: platform links + arms), kg: what an
+    axial cable spring carries (the slide joint of :func:`.mjcf.virtual_xml` sits in link 10)."""
+    return float(planar_bodies(p)["M_B"] + p.m_plat)
 
 
 def section_of(description):

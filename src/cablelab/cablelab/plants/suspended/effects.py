@@ -18,6 +18,10 @@ every column is the negative of the term per unit parameter.
 
 * ``pose_sensor_offset``: constant offset of the measured rest pose; in the swing equation a
   constant torque ``mgl * delta`` per channel.
+* ``cable_elasticity``: axial spring-damper of the rope (CRANEbot steel rope; spec sec. 7), on the
+  ``stretch`` channel: ``k_c d + c_c dd`` (N/m, N s/m) with d the dynamic stretch of the measured
+  cable length (:mod:`.dataset`). Its signature, the vertical bounce at ``sqrt(k_c / M_r)``, is
+  what a rigid-cable model cannot produce.
 
 ``time_delay`` is the generic effect of :mod:`cablelab.effects.delay`.
 """
@@ -34,7 +38,7 @@ SIGN_EPS = 0.005   # rad/s, smooth sign width
 
 
 def _zeros(ds: Dataset, p: int) -> np.ndarray:
-    return np.zeros((ds.n, 3, p))
+    return np.zeros((ds.n, len(ds.channels), p))
 
 
 def _gravity(ds: Dataset) -> np.ndarray:
@@ -80,6 +84,14 @@ def _drag(ds: Dataset) -> np.ndarray:
     b = _zeros(ds, 2)
     for k in range(2):
         b[:, k, k] = -L ** 3 * np.abs(qd[:, k]) * qd[:, k]
+    return b
+
+
+def _elastic(ds: Dataset) -> np.ndarray:
+    q, qd = ds.require_signal("q"), ds.require_signal("qd")
+    b = _zeros(ds, 2)
+    b[:, 3, 0] = -q[:, 3]
+    b[:, 3, 1] = -qd[:, 3]
     return b
 
 
@@ -145,6 +157,13 @@ SUSPENDED_EFFECTS = (
         signature="swing excited when the arms move; residual correlates with arm acceleration",
         reference="000 sec. 6, Fig. 11-12", regressor=_arm)),
     register(Effect(
+        id="cable_elasticity", plants=_P,
+        params=(Param("k_c", "N/m", 1e4, 0.0, np.inf, "axial rope stiffness"),
+                Param("c_c", "N s/m", 0.0, 0.0, np.inf, "axial rope damping")),
+        explanation="the rope stretches: the platform bounces vertically on an axial spring",
+        signature="vertical bounce at sqrt(k_c/M) in the cable length; tension varies at twice "
+                  "the swing frequency", reference="spec 000 sec. 7 (CRANEbot rope)", regressor=_elastic)),
+    register(Effect(
         id="pose_sensor_offset", plants=_P,
         params=(Param("off_x", "N m", 0.0, -np.inf, np.inf, "mgl_x x rest-angle offset of swing_x"),
                 Param("off_y", "N m", 0.0, -np.inf, np.inf, "mgl_y x rest-angle offset of swing_y"),
@@ -159,4 +178,4 @@ BASELINE = ("cable_link_inertia", "cable_joint_viscous_friction")
 #: arm-command data, which the pose-only dataset does not carry: on unforced control records it
 #: fits the swing model's reduction error (a false positive), so it is not tried here.
 CANDIDATES = ("cable_joint_coulomb_friction", "virtual_yaw_stiffness", "air_drag",
-              "pose_sensor_offset")
+              "pose_sensor_offset", "cable_elasticity")

@@ -2,9 +2,13 @@
 
 * ``estimator`` (``payload_estimator --plant suspended``): ``/suspended/platform_pose`` ->
   :class:`~.swing.SwingEstimator` -> ``/suspended/swing_estimate`` (names swing_x, swing_y, yaw,
-  r_x, r_y; position and velocity), stamped like the pose. NaN, wrong-length and frozen-stamp
+  r_x, r_y; position and velocity), stamped like the pose. ``/suspended/imu`` when present
+  (spec 5.2): yaw from its orientation and yaw rate from its gyro for poses within
+  ``imu_max_lag`` s (stamps) of an IMU sample, else from the pose; a stale (``imu_timeout`` s
+  wall) or NaN IMU is reported on /diagnostics once the IMU has been seen. NaN, wrong-length and frozen-stamp
   poses are held and counted on /diagnostics. ROS parameters: ``suspension_point`` [x, y, z] m
-  (default: the LiCAS repo set), ``rest_window`` s, ``velocity_tau`` s, ``pose_timeout`` s wall.
+  (default: the LiCAS repo set), ``rest_position`` [x, y, z] m and ``rest_yaw`` rad (default NaN:
+  the mean over the first ``rest_window`` s), ``velocity_tau`` s, ``pose_timeout`` s wall.
 * ``sim`` (``cable_sim_node --plant suspended``): the virtual-joint model (``model:=virtual``)
   or the truth plant (``model:=truth``) of ``variant`` in real time; arm position servos follow
   ``/suspended/reference`` (JointTrajectory, arm joint names; unknown names / wrong lengths are
@@ -15,15 +19,30 @@
   ``start_swing_x``, ``start_swing_y``, ``start_yaw`` rad, ``pose_noise`` m.
   ``arm_input:=effort``: torque motors driven by ``/suspended/effort_commands`` instead (a
   stale command, older than ``command_timeout`` s wall, means zero torque and WARN).
+  ``lockstep`` (default false; needs ``arm_input:=effort``): after publishing a state the
+  simulation waits for the command answering it and advances one period (``rate``) as soon as
+  it arrives, so DDS latency and CPU load slow the run down instead of delaying the stiff arm
+  loop (:class:`cablelab.ros.lockstep.LockStep`, time starts with the first answer; the state is
+  resent every ``lockstep_resend`` s while waiting; ``lockstep_timeout`` s without an answer:
+  real time with zero torque until commands flow again). Use ``rate:=1000`` (one physics step
+  per command): the LiCAS joint-3 loop (k_d / I ~ 1000 1/s) is unstable with a 10 ms hold.
+  ``wait_for_subscribers`` (time starts when ``/suspended/joint_states`` has that many
+  subscribers), ``duration`` s (sim time; the node exits when reached, 0 = run for ever),
+  ``imu`` (default true: ``/suspended/imu``, the platform's orientation, gyro and accelerometer
+  in the platform frame).
 * ``controller`` (``pd_feedforward --plant suspended``): on each ``/suspended/joint_states``
   publishes ``/suspended/effort_commands`` = :func:`~.controller.pd_gravity` with the gravity
   under the attitude of ``/suspended/platform_pose``; reference from ``/suspended/reference``
   plus the built-in ``excitation`` (none | x | y | z, ``excitation_level`` 0..2, 000 Fig. 7) and
   ``sway_damping`` k_s (r_y rate of ``/suspended/swing_estimate``; older than
-  ``estimate_stale`` s = off). Parameters: ``variant``.
+  ``estimate_stale`` s = off). Parameters: ``variant``, ``pose_sync`` (default false; true with
+  a simulator: a joint state is answered only once the pose of the same stamp arrived, so the
+  gravity term uses the attitude of that instant however DDS orders the two topics; while
+  poses do not flow, at once).
 """
 from __future__ import annotations
 
+import math
 import time
 
 from ...errors import CablelabError
@@ -36,9 +55,10 @@ ROLES = ("estimator", "sim", "controller")
 
 
 def _estimator_class():
+    import numpy as np
     from geometry_msgs.msg import PoseStamped
     from ...ros.plant_node import PlantNode
-    from sensor_msgs.msg import JointState
+    from sensor_msgs.msg import Imu, JointState
 
     from ...ros import convert
     from ...ros.inputs import WARN
@@ -49,16 +69,40 @@ def _estimator_class():
             super().__init__("payload_estimator")
             p = self.declare_parameter
             S = [float(v) for v in p("suspension_point", list(parameter_set("licas").S)).value]
+            rest = [float(v) for v in p("rest_position", [float("nan")] * 3).value]
+            rest_yaw = float(p("rest_yaw", float("nan")).value)
+            if len(rest) != 3:
+                raise CablelabError(f"payload_estimator suspended: parameter rest_position={rest!r} "
+                                    "(expected [x, y, z] m)")
             self.est = SwingEstimator(S, rest_window=float(p("rest_window", 2.0).value),
+                                      imu_max_lag=float(p("imu_max_lag", 0.05).value),
+                                      rest_pos=rest if all(map(math.isfinite, rest)) else None,
+                                      rest_yaw=rest_yaw if math.isfinite(rest_yaw) else None,
                                       velocity_tau=float(p("velocity_tau", 0.05).value))
+            self.use_fast_executor()
             self.inputs.add("platform_pose", timeout=float(p("pose_timeout", 0.5).value), length=3)
+            self.imu_timeout = float(p("imu_timeout", 0.5).value)
+            self.imu_used = 0            # estimates whose yaw came from the IMU
             self.rejected = 0
             self.last_problem = ""
             self.pub = self.create_publisher(JointState, "/suspended/swing_estimate", publisher_qos())
+            self.create_subscription(Imu, "/suspended/imu", self.on_imu, catch_up_qos())
             self.create_subscription(PoseStamped, "/suspended/platform_pose", self.on_pose, catch_up_qos())
             self.start_diagnostics()
 
+        def on_imu(self, msg: Imu) -> None:
+            """Optional input: monitored (stale / NaN on /diagnostics) from its first message on."""
+            if "imu" not in self.inputs.inputs:
+                self.inputs.add("imu", timeout=self.imu_timeout, length=7, required=False)
+            t, qx, gyro, _ = convert.imu_arrays(msg)
+            if qx is None or gyro is None:
+                self.inputs.accept("imu", None, time.monotonic())
+                return
+            if self.inputs.accept("imu", np.r_[qx, gyro], time.monotonic()):
+                self.est.imu(t, qx[[3, 0, 1, 2]], gyro)
+
         def extend_status(self, level, msg, values):
+            values["yaw from IMU"] = str(self.imu_used)
             values["held samples"] = str(self.rejected)
             if self.rejected:
                 level = max(level, WARN)
@@ -71,6 +115,7 @@ def _estimator_class():
             self.inputs.accept("platform_pose", pos, time.monotonic())
             q = quat_xyzw[[3, 0, 1, 2]] if quat_xyzw is not None and len(quat_xyzw) == 4 else quat_xyzw
             s = self.est.step(t, pos, q)
+            self.imu_used += s.source == "imu"
             if not s.ok:
                 self.rejected += 1
                 self.last_problem = s.message
@@ -85,18 +130,19 @@ def _sim_class():
     import numpy as np
     from geometry_msgs.msg import PoseStamped
     from ...ros.plant_node import PlantNode
-    from sensor_msgs.msg import JointState
+    from sensor_msgs.msg import Imu, JointState
     from std_msgs.msg import Float64MultiArray
     from trajectory_msgs.msg import JointTrajectory
 
     from ...description import load_description
     from ...ros import convert
     from ...ros.clock import ClockPublisher
+    from ...ros.lockstep import ADVANCE, FREE, RESEND, LockStep
     from ...ros.qos import publisher_qos, stream_qos
     from ...rotations import wxyz_to_xyzw
     from .bag import description_yaml
     from .mjcf import VJ, arm_joint_names, build_truth, build_virtual
-    from .sim import STATE_SPEC, initial_state, truth_start
+    from .sim import STATE_SPEC, initial_state, platform_imu, truth_start
     from .swing import swing_from_pose
 
     class SuspendedSimNode(PlantNode):
@@ -137,6 +183,18 @@ def _sim_class():
             self.rng = np.random.default_rng(0)
             self.rate = float(p("rate", 100.0).value)
             self.steps = max(1, int(round(1.0 / (self.rate * self.model.opt.timestep))))
+            self.duration = float(p("duration", 0.0).value)
+            self.done = False
+            lockstep = bool(p("lockstep", False).value)
+            if lockstep and not motors:
+                raise CablelabError("cable_sim_node suspended: parameter lockstep=true needs "
+                                    "arm_input=effort (lock-step waits for effort commands)")
+            self.lock = LockStep(lockstep, wait_first=True,
+                                 timeout=float(p("lockstep_timeout", 10.0).value),
+                                 resend=float(p("lockstep_resend", 0.25).value))
+            self.start_gate()
+            self.use_fast_executor()
+            self.site = self.model.site("platform").id
             self.inputs.add("reference", timeout=1e9, length=len(self.names))
             self.inputs.add("effort_commands", timeout=float(p("command_timeout", 0.5).value),
                             length=len(self.names))
@@ -144,6 +202,8 @@ def _sim_class():
             self.pub_pose = self.create_publisher(PoseStamped, "/suspended/platform_pose", publisher_qos())
             self.pub_sw = self.create_publisher(JointState, "/suspended/ground_truth/swing", publisher_qos())
             self.pub_vj = self.create_publisher(JointState, "/suspended/ground_truth/virtual_joints", publisher_qos())
+            self.pub_imu = (self.create_publisher(Imu, "/suspended/imu", publisher_qos())
+                            if bool(p("imu", True).value) else None)
             self.clock = ClockPublisher(self)
             self.publish_description(self.description)
             if motors:
@@ -152,9 +212,11 @@ def _sim_class():
                 self.create_subscription(JointTrajectory, "/suspended/reference", self.on_reference, stream_qos())
             self.start_diagnostics()
             self.timer = self.create_timer(1.0 / self.rate, self.tick)
+            self.publish_state()
 
         def extend_status(self, level, msg, values):
             values["sim time s"] = f"{self.data.time:.3f}"
+            values["stale answers ignored (lock-step)"] = str(self.lock.stale_answers)
             return level, msg, values
 
         def on_reference(self, msg: JointTrajectory) -> None:
@@ -167,27 +229,69 @@ def _sim_class():
 
         def on_effort(self, msg: Float64MultiArray) -> None:
             u = convert.float_array(msg)
-            if self.inputs.accept("effort_commands", u, time.monotonic()):
+            if not self.inputs.accept("effort_commands", u, time.monotonic()):
+                return
+            if self.lock.offer(convert.command_stamp(msg)):     # False: answers an earlier state
                 self.data.ctrl[:len(self.names)] = u
+                if self.lock.enabled:
+                    self.advance()        # lock-step: the answer is here, step at once
 
         def tick(self) -> None:
-            if self.arm_input == "effort" and not self.inputs.fresh("effort_commands", time.monotonic()):
+            now = time.monotonic()
+            if self.waiting_for_subscribers(self.pub_js, self.lock.published_at, self.publish_state,
+                                            max(self.lock.resend, 0.5)):
+                return
+            step = self.lock.poll(now)
+            if step == RESEND:
+                self.publish_state()      # the controller may have missed it (not connected yet)
+            if step not in (ADVANCE, FREE):
+                return
+            if self.arm_input == "effort" and step == FREE and \
+                    not self.inputs.fresh("effort_commands", now):
                 self.data.ctrl[:len(self.names)] = 0.0      # stale command: no torque (reported)
+            self.advance()
+
+        def advance(self) -> None:
+            """One publishing period of physics, then the new state out."""
+            if self.done:
+                return
             for _ in range(self.steps):
                 mujoco.mj_step(self.model, self.data)
+            self.publish_state()
+            if self.duration and self.data.time >= self.duration - 1e-9:
+                self.done = True          # the runner stops the node (exit 0)
+
+        def shutdown(self) -> None:
+            """Before the node goes (e.g. ``duration`` reached): wait (at most 5 s per topic) until
+            the subscribers acknowledged what was published, so a recorder that lags behind the
+            lock-step loop still gets the end of the run."""
+            from rclpy.duration import Duration
+
+            for pub in (self.pub_pose, self.pub_imu, self.pub_js, self.pub_sw, self.pub_vj):
+                if pub is not None:
+                    pub.wait_for_all_acked(Duration(seconds=5.0))
+
+        def publish_state(self) -> None:
+            """Publish the current state: IMU, pose, then joint states (the estimator then has the
+            IMU sample of a pose's stamp, and a controller the attitude of the state it answers)."""
             mujoco.mj_forward(self.model, self.data)
             t = float(self.data.time)
             pos, quat = self.data.sensordata[:3].copy(), self.data.sensordata[3:7].copy()
             q, qd = self.data.qpos[self.jq], self.data.qvel[self.jv]
             eff = self.data.qfrc_actuator[self.jv]
-            self.pub_js.publish(convert.joint_state_msg(t, self.names, q, qd, eff))
+            if self.pub_imu is not None:
+                gyro, acc = platform_imu(self.model, self.data, self.site)
+                self.pub_imu.publish(convert.imu_msg(t, wxyz_to_xyzw(quat[None])[0], gyro, acc,
+                                                     frame_id="platform"))
             meas = pos + (self.rng.normal(0, self.noise, 3) if self.noise > 0 else 0.0)
             self.pub_pose.publish(convert.pose_msg(t, meas, wxyz_to_xyzw(quat[None])[0]))
+            self.pub_js.publish(convert.joint_state_msg(t, self.names, q, qd, eff))
             sw = swing_from_pose(pos[None], quat[None], self.params.S, rest_pos=self.rest, rest_yaw=0.0)
             self.pub_sw.publish(convert.joint_state_msg(t, list(CHANNELS), [float(sw[k][0]) for k in CHANNELS]))
             if self.vq:
                 self.pub_vj.publish(convert.joint_state_msg(t, list(VJ), self.data.qpos[self.vq]))
             self.clock.publish(t)
+            self.lock.published(t)
 
     return SuspendedSimNode
 
@@ -213,11 +317,21 @@ def _controller_class():
             self.names = list(arm_joint_names(self.params))
             n = len(self.names)
             self.kp, self.kd, self.lim = gains(self.params)
+            self.use_fast_executor()
             self.gravity = ArmGravity(self.params)
-            self.excitation = str(p("excitation", "none").value)
+            from rcl_interfaces.msg import ParameterDescriptor
+
+            exc = p("excitation", "none", ParameterDescriptor(dynamic_typing=True)).value
+            self.excitation = "y" if exc is True else str(exc)    # (YAML reads a bare y as true)
+            if self.excitation not in ("none", "x", "y", "z"):
+                raise CablelabError(f"pd_feedforward suspended: parameter excitation={exc!r} "
+                                    "(expected none, x, y or z)")
             self.level = int(p("excitation_level", 1).value)
             self.k_s = float(p("sway_damping", 0.0).value)
             self.stale = float(p("estimate_stale", 0.2).value)
+            self.pose_sync = bool(p("pose_sync", False).value)
+            self.pose_t = -np.inf
+            self.pending = None          # pose_sync: joint state waiting for its pose
             self.q_ref, self.qd_ref = np.zeros(n), np.zeros(n)
             self.R = np.eye(3)
             self.v_swing, self.t_swing = np.nan, -np.inf
@@ -225,18 +339,23 @@ def _controller_class():
             self.inputs.add("platform_pose", timeout=0.5, length=3)
             self.inputs.add("reference", timeout=1e9, length=n)
             self.pub = self.create_publisher(Float64MultiArray, "/suspended/effort_commands", publisher_qos())
-            self.create_subscription(JointState, "/suspended/joint_states", self.on_joints, catch_up_qos())
+            # (pose first: an executor taking one sample per topic per round in creation order then
+            # has the attitude of a state before the state, as the simulator publishes them)
             self.create_subscription(PoseStamped, "/suspended/platform_pose", self.on_pose, catch_up_qos())
+            self.create_subscription(JointState, "/suspended/joint_states", self.on_joints, catch_up_qos())
             self.create_subscription(JointState, "/suspended/swing_estimate", self.on_swing, catch_up_qos())
             self.create_subscription(JointTrajectory, "/suspended/reference", self.on_reference, stream_qos())
             self.start_diagnostics()
 
         def on_pose(self, msg: PoseStamped) -> None:
-            _, pos, qx = convert.pose_arrays(msg)
+            t, pos, qx = convert.pose_arrays(msg)
             if self.inputs.accept("platform_pose", pos, time.monotonic()) and np.all(np.isfinite(qx)):
                 from ...rotations import quat_to_matrix, xyzw_to_wxyz
 
                 self.R = quat_to_matrix(xyzw_to_wxyz(qx / np.linalg.norm(qx)))
+                self.pose_t = t
+                if self.pending is not None and t >= self.pending[0] - 1e-9:
+                    self.answer(*self.pending)       # pose_sync: the attitude of that instant is here
 
         def on_swing(self, msg: JointState) -> None:
             t, names, _, qd, _ = convert.joint_state_arrays(msg)
@@ -258,6 +377,15 @@ def _controller_class():
             if not self.inputs.accept("joint_states", q if ok else None, time.monotonic()) or not ok \
                     or not np.all(np.isfinite(qd)):
                 return
+            self.pending = None
+            if self.pose_sync and self.pose_t < t - 1e-9 and self.inputs.fresh("platform_pose", time.monotonic()):
+                self.pending = (t, q, qd)            # answered when the pose of stamp t arrives
+                return
+            self.answer(t, q, qd)
+
+        def answer(self, t, q, qd) -> None:
+            """Publish the command answering the joint state of stamp ``t``."""
+            self.pending = None
             q_ref, qd_ref = self.q_ref.copy(), self.qd_ref.copy()
             if self.excitation in ("x", "y", "z"):
                 qe, qde = fig7_excitation(np.array([t]), self.params, self.excitation, self.level)

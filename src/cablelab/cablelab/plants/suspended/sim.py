@@ -7,6 +7,8 @@
   arm position servos. The LiCAS ``paper`` levelling needs the state each step and runs
   :func:`simulate_paper_levelling` (Python step loop, the one exception).
 * :func:`outputs`: the 000 eq. 4 channels ``r_x, r_y, yaw`` (pose-based, D7) of a run.
+* :func:`platform_imu`: what an IMU on the platform (LiCAS BNO055 on the shoulder structure,
+  spec 5) reads: gyro and accelerometer in the platform frame.
 """
 from __future__ import annotations
 
@@ -21,7 +23,7 @@ from .params import VirtualParams
 from .swing import swing_from_pose
 
 __all__ = ["initial_state", "simulate", "simulate_paper_levelling", "Run", "outputs",
-           "truth_start", "STATE_SPEC"]
+           "truth_start", "platform_imu", "STATE_SPEC"]
 
 STATE_SPEC = mujoco.mjtState.mjSTATE_FULLPHYSICS
 
@@ -160,3 +162,17 @@ def outputs(run: Run, S, rest_pos, rest_yaw: float = 0.0) -> np.ndarray:
     """(N, 3) 000 eq. 4 outputs ``[r_x, r_y, yaw]`` of a run against a known rest pose."""
     s = swing_from_pose(run.pos, run.quat, S, rest_pos=rest_pos, rest_yaw=rest_yaw)
     return np.stack([s["r_x"], s["r_y"], s["yaw"]], axis=1)
+
+
+def platform_imu(model: mujoco.MjModel, data: mujoco.MjData, site: int) -> tuple[np.ndarray, np.ndarray]:
+    """(angular velocity rad/s, specific force m/s^2), both in the frame of ``site`` (id), as a
+    strapdown IMU there reads them: the gyro is the site's angular velocity, the accelerometer
+    its linear acceleration minus gravity (a platform at rest reads +g up), exactly MuJoCo's
+    ``gyro`` / ``accelerometer`` sensors (:func:`mujoco.mj_objectVelocity` /
+    :func:`mujoco.mj_objectAcceleration`, local frame). Needs ``mj_forward`` done on ``data``."""
+    vel = np.zeros(6)
+    acc = np.zeros(6)
+    mujoco.mj_objectVelocity(model, data, mujoco.mjtObj.mjOBJ_SITE, site, vel, 1)
+    mujoco.mj_rnePostConstraint(model, data)
+    mujoco.mj_objectAcceleration(model, data, mujoco.mjtObj.mjOBJ_SITE, site, acc, 1)
+    return vel[:3].copy(), acc[3:].copy()

@@ -10,6 +10,14 @@ rest position (000 eq. 4 output x_s), ``yaw = atan2(R10, R00)`` unwrapped minus 
 :func:`swing_from_pose` is the batch form (vectorised over time); :class:`SwingEstimator` is the
 live one (``step`` per pose sample, finite-difference rates through a first-order low-pass
 ``velocity_tau``, NaN / frozen-stamp samples held and flagged).
+
+IMU (spec 5.2, LiCAS BNO055 on the shoulder structure; axes = platform axes): when an IMU sample
+(:meth:`SwingEstimator.imu`) is at most ``imu_max_lag`` s from a pose sample, the yaw comes from
+the IMU orientation (carried to the pose stamp with the gyro's yaw rate) and the yaw rate from
+the gyro, without the low-pass lag:
+:func:`yaw_rate` is the exact derivative of ``atan2(R10, R00)`` for ``Rdot = [w]x R``
+(world angular velocity ``w = R w_body``): ``w_z - R20 (w_x R00 + w_y R10) / (R00^2 + R10^2)``.
+Without a recent IMU sample the pose is used again.
 """
 from __future__ import annotations
 
@@ -17,8 +25,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["CHANNELS", "swing_angles", "yaw_from_quat", "swing_from_pose", "SwingEstimator",
-           "SwingSample"]
+__all__ = ["CHANNELS", "swing_angles", "yaw_from_quat", "yaw_rate", "swing_from_pose",
+           "SwingEstimator", "SwingSample"]
 
 #: names of /suspended/swing_estimate (CONTRACT)
 CHANNELS = ("swing_x", "swing_y", "yaw", "r_x", "r_y")
@@ -36,6 +44,15 @@ def yaw_from_quat(quat_wxyz) -> np.ndarray:
     q = np.asarray(quat_wxyz, float)
     w, x, y, z = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
     return np.arctan2(2 * (x * y + w * z), 1 - 2 * (y * y + z * z))
+
+
+def yaw_rate(R, omega_world) -> np.ndarray:
+    """d/dt of ``atan2(R10, R00)`` (rad/s) for rotation matrices R (..., 3, 3) turning at world
+    angular velocity ``omega_world`` (..., 3): exact (see module docstring)."""
+    R = np.asarray(R, float)
+    w = np.asarray(omega_world, float)
+    r00, r10, r20 = R[..., 0, 0], R[..., 1, 0], R[..., 2, 0]
+    return w[..., 2] - r20 * (w[..., 0] * r00 + w[..., 1] * r10) / (r00 ** 2 + r10 ** 2)
 
 
 def swing_from_pose(pos, quat_wxyz, S, *, rest_pos=None, rest_yaw=None, t=None,
@@ -70,6 +87,7 @@ class SwingSample:
     velocity: np.ndarray
     ok: bool
     message: str = ""
+    source: str = "pose"        # of yaw and its rate: "pose" or "imu"
 
 
 class SwingEstimator:
@@ -78,10 +96,11 @@ class SwingEstimator:
     Args:
         S: (3,) suspension point, m. rest_pos: (3,) rest position or None (mean of the first
         ``rest_window`` s). rest_yaw: rad or None. velocity_tau: low-pass time constant, s.
+        imu_max_lag: largest stamp difference, s, between a pose and the IMU sample used with it.
     """
 
     def __init__(self, S, *, rest_pos=None, rest_yaw=None, rest_window: float = 2.0,
-                 velocity_tau: float = 0.05):
+                 velocity_tau: float = 0.05, imu_max_lag: float = 0.05):
         self.S = np.asarray(S, float)
         self.rest_pos = None if rest_pos is None else np.asarray(rest_pos, float)
         self.rest_yaw = rest_yaw
@@ -94,6 +113,23 @@ class SwingEstimator:
         self._vel = np.zeros(5)
         self._yaw_prev = None
         self._yaw_unwrapped = 0.0
+        self.imu_max_lag = float(imu_max_lag)
+        self._imu = None                   # (t, raw yaw, yaw rate) of the last good IMU sample
+
+    def imu(self, t: float, quat_wxyz, gyro) -> bool:
+        """Take one IMU sample: orientation (4,) w x y z (IMU = platform frame to world) and
+        angular velocity (3,) rad/s in the IMU frame. False (ignored) if NaN, zero or of wrong
+        length; the estimator then keeps using the pose once the last good sample is too old."""
+        from ...rotations import quat_to_matrix
+
+        q = np.asarray(quat_wxyz, float)
+        w = np.asarray(gyro, float)
+        if q.shape != (4,) or w.shape != (3,) or not (np.all(np.isfinite(q)) and np.all(np.isfinite(w))) \
+                or not np.any(q):
+            return False
+        R = quat_to_matrix(q)
+        self._imu = (float(t), float(yaw_from_quat(q)), float(yaw_rate(R, R @ w)))
+        return True
 
     def step(self, t: float, pos, quat_wxyz) -> SwingSample:
         """Process one pose sample (``t`` s, ``pos`` (3,) m, ``quat_wxyz`` (4,))."""
@@ -107,8 +143,9 @@ class SwingEstimator:
         l = float(np.sqrt(d @ d))
         sx = np.arctan2(d[1], -d[2])
         sy = np.arcsin(min(1.0, max(-1.0, -d[0] / l)))
-        w, x, y, z = quat
-        yaw_raw = np.arctan2(2 * (x * y + w * z), 1 - 2 * (y * y + z * z))
+        imu = self._imu if self._imu is not None and abs(t - self._imu[0]) <= self.imu_max_lag else None
+        # (IMU yaw carried to the pose stamp with its own rate: exact for equal stamps)
+        yaw_raw = imu[1] + imu[2] * (t - imu[0]) if imu is not None else float(yaw_from_quat(quat))
         if self._yaw_prev is None:
             self._yaw_unwrapped = yaw_raw
         else:
@@ -133,8 +170,10 @@ class SwingEstimator:
             raw = (xk - self._prev_x) / dt
             a = dt / (self.tau + dt)
             self._vel = self._vel + a * (raw - self._vel)
+        if imu is not None:
+            self._vel[2] = imu[2]          # gyro: no finite difference, no low-pass lag
         self._prev_t, self._prev_x = t, xk
-        return SwingSample(xk, self._vel.copy(), True)
+        return SwingSample(xk, self._vel.copy(), True, source="pose" if imu is None else "imu")
 
     def _hold(self, msg: str) -> SwingSample:
         x = self._prev_x if self._prev_x is not None else np.full(5, np.nan)

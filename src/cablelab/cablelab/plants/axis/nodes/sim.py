@@ -14,11 +14,11 @@ republished every ``lockstep_resend`` s while waiting, e.g. before the controlle
 ``wait_for_subscribers`` (int, default 0: time starts only when ``/axis/joint_states`` has that
 many matched subscriptions, at most 60 s, so a recorder started with the run misses nothing).
 
-Lock-step matching: a command that names the stamp of the state it answers
-(:func:`cablelab.ros.convert.command_msg`, as the cablelab controllers send) is applied only if
-it answers the latest state; an answer to an earlier one (e.g. to a state resent while waiting)
-is counted on /diagnostics and ignored, so resends can never add a control delay. A command that
-names no stamp answers whatever state was published last.
+Lock-step matching (:class:`cablelab.ros.lockstep.LockStep`, ``wait_first``): a command that
+names the stamp of the state it answers is applied only if it answers the latest state; answers
+to earlier ones (e.g. to a state resent while waiting) are counted on /diagnostics and ignored,
+so resends can never add a control delay. A command that names no stamp answers whatever state
+was published last.
 
 The effort reported with a state is the command held over the period that ends at that state.
 """
@@ -33,6 +33,7 @@ from ....description import load_description
 from ..sim import AxisSim, AxisTruth
 from ....ros import convert
 from ....ros.clock import ClockPublisher
+from ....ros.lockstep import ADVANCE, FREE, RESEND, LockStep
 from ....ros.plant_node import PlantNode
 from ....ros.qos import publisher_qos, stream_qos
 
@@ -51,10 +52,8 @@ class AxisSimNode(PlantNode):
                           viscous=p("viscous", 5.0).value, coulomb=p("coulomb", 1.0).value,
                           offset=p("offset", 0.0).value, timestep=p("timestep", 0.001).value)
         self.rate = float(p("rate", 200.0).value)
-        self.lockstep = bool(p("lockstep", False).value)
         self.resend = float(p("lockstep_resend", 0.25).value)
-        self.answered = False  # lockstep: the command answering the last published state arrived
-        self.stale_answers = 0  # lockstep: answers to earlier states, ignored
+        self.lock = LockStep(bool(p("lockstep", False).value), wait_first=True, resend=self.resend)
         self.start_gate()
         self.last_publish = time.monotonic()
         self.sim = AxisSim(self.description, truth)
@@ -72,37 +71,34 @@ class AxisSimNode(PlantNode):
 
     def extend_status(self, level, msg, values):
         values["sim time s"] = f"{self.sim.t:.3f}"
-        values["stale answers ignored (lock-step)"] = str(self.stale_answers)
+        values["stale answers ignored (lock-step)"] = str(self.lock.stale_answers)
         return level, msg, values
 
     def on_command(self, msg: Float64MultiArray) -> None:
         values = convert.float_array(msg)
         if not self.inputs.accept("effort_command", values, time.monotonic()):
             return
-        stamp = convert.command_stamp(msg)
-        if self.lockstep and stamp is not None and not convert.same_stamp(stamp, self.sim.t):
-            self.stale_answers += 1  # answers an earlier state (already stepped past it)
-            return
-        self.u = float(values[0])
-        self.answered = True
+        if self.lock.offer(convert.command_stamp(msg)):  # False: answers an earlier state
+            self.u = float(values[0])
 
     def tick(self) -> None:
         now = time.monotonic()
         if self.waiting_for_subscribers(self.pub_js, self.last_publish, self.publish_state, self.resend):
             return
-        if self.lockstep and not self.answered:
-            if now - self.last_publish > self.resend:
+        step = self.lock.poll(now)
+        if step not in (ADVANCE, FREE):
+            if step == RESEND:
                 self.publish_state()  # the controller may have missed it (not connected yet)
             return
-        if not self.lockstep and not self.inputs.fresh("effort_command", now):
+        if step == FREE and not self.inputs.fresh("effort_command", now):
             self.u = 0.0  # no (fresh) command: the drive is switched off
         self.sim.advance(self.u, 1.0 / self.rate)
         self.publish_state()
 
     def publish_state(self) -> None:
-        self.answered = False
         self.last_publish = time.monotonic()
         t, q, qd = self.sim.state()
+        self.lock.published(t, self.last_publish)
         self.clock.publish(t)
         self.pub_js.publish(convert.joint_state_msg(t, ["joint"], [q], [qd], [self.sim.measured_effort(self.u)]))
         self.pub_truth.publish(convert.joint_state_msg(t, ["joint"], [q], [qd], [self.u]))

@@ -37,9 +37,12 @@ from ..live import ControllerConfig, LiveController
 from ....ros import convert
 from ....rotations import xyzw_to_wxyz
 from ....ros.inputs import ERROR, WARN
+from ....ros.fastspin import drain, poll
+from ....stamped import StampedBuffer
 from ....ros.plant_node import PlantNode
 from ....ros.qos import stream_qos
-from ....ros.rawmsg import RawTemplate
+from ....ros import rawmsg
+from ....ros.rawmsg import RawReader, RawTemplate
 
 
 class CdprController(PlantNode):
@@ -60,7 +63,7 @@ class CdprController(PlantNode):
             raise CablelabError("pd_feedforward: parameter model must be I or II")
         self.estimate_timeout = float(p("estimate_timeout", 2.0).value)
         self.controller = None
-        self.ref = None
+        self.refs = StampedBuffer()     # the reference may run ahead of the states
         self.sent = 0
         self.skipped = 0
         self.estimates_rejected = 0
@@ -75,12 +78,20 @@ class CdprController(PlantNode):
         self.pub_cmd = self.create_publisher(Float64MultiArray, "/cdpr/effort_commands", q)
         self.keep_first_description = True   # the first valid description configures the law
         self.listen_for_description(p("description", "").value)
-        self.create_subscription(MultiDOFJointTrajectory, "/cdpr/reference", self.on_reference, q)
-        self.create_subscription(InertiaStamped, "/cdpr/payload_estimate", self.on_estimate, q)
-        self.create_subscription(JointState, "/cdpr/joint_states", self.on_state, q)
+        # the 1 kHz inputs arrive as bytes, decoded without rclpy message objects (RawReader)
+        self.readers = {"state": RawReader(JointState), "reference": RawReader(MultiDOFJointTrajectory)}
+        ref_sub = self.create_subscription(MultiDOFJointTrajectory, "/cdpr/reference", self.on_reference, q, raw=True)
+        est_sub = self.create_subscription(InertiaStamped, "/cdpr/payload_estimate", self.on_estimate, q)
+        self.create_subscription(JointState, "/cdpr/joint_states", self.on_state, q, raw=True)
         self.pending = None
         self.sync_wait = float(p("sync_wait", 0.005).value)
         self.estimate_wait = float(p("estimate_wait", 0.0).value)
+        # only a state wakes the node: the reference (published before the state of its stamp)
+        # and the estimate wait queued until a state or the timer takes them (one wake-up per
+        # cycle at 1 kHz instead of three); an awaited estimate (estimate_wait) still wakes it
+        self.polled = [ref_sub] if self.estimate_wait > 0 and self.feedforward else [ref_sub, est_sub]
+        for sub in self.polled:
+            poll(self, sub)
         self.est_stamp = None       # newest estimate stamp received (valid or not)
         self.create_timer(0.002, self.on_timer)
         self.use_fast_executor()
@@ -100,10 +111,15 @@ class CdprController(PlantNode):
         self.inputs.set_length("joint_states", len(desc.cdpr.cables))
 
     def on_reference(self, msg: MultiDOFJointTrajectory) -> None:
-        r = convert.multidof_arrays(msg)           # position None (rejected) when empty
+        """A reference sample (MultiDOFJointTrajectory or its serialised bytes)."""
+        try:
+            r = rawmsg.multidof_arrays(msg, self.readers["reference"])   # position None when empty
+        except ValueError:
+            self.inputs.accept("reference", None, time.monotonic())     # not a message: rejected
+            return
         if self.inputs.accept("reference", r["position"], time.monotonic()):
-            self.ref = (r["t"], r["position"], xyzw_to_wxyz(r["quaternion"]),
-                        r["linear_velocity"], r["linear_acceleration"])
+            self.refs.push(r["t"], (r["position"], xyzw_to_wxyz(r["quaternion"]),
+                                    r["linear_velocity"], r["linear_acceleration"]))
             self.try_command()
 
     def on_estimate(self, msg: InertiaStamped) -> None:
@@ -117,14 +133,20 @@ class CdprController(PlantNode):
         self.try_command()                  # a state may have been waiting for this estimate
 
     def on_state(self, msg: JointState) -> None:
-        """Keep the state; command now if the reference of its stamp is here (else a little later,
-        see :meth:`on_timer`: DDS does not order samples across topics)."""
-        self.pending = (msg, time.monotonic())
+        """Keep the state (JointState or its serialised bytes); command now if the reference of
+        its stamp is here (else a little later, see :meth:`on_timer`: DDS does not order samples
+        across topics)."""
+        drain(*self.polled)         # the reference and estimate that came before it
+        try:
+            state = rawmsg.joint_state_arrays(msg, self.readers["state"])
+        except ValueError:
+            state = (float("nan"), [], None, None, None)      # rejected by command()
+        self.pending = (state, time.monotonic())
         self.try_command()
 
     def _waiting_for(self, t: float) -> tuple[bool, bool]:
         """(reference of stamp t not here yet, estimate of stamp t awaited and not here yet)."""
-        ref = self.ref is not None and self.ref[0] < t - 1e-9
+        ref = bool(self.refs) and self.refs.newest < t - 1e-9
         est = (self.estimate_wait > 0 and self.feedforward
                and (self.est_stamp is None or self.est_stamp < t - 1e-9))
         return ref, est
@@ -132,25 +154,26 @@ class CdprController(PlantNode):
     def try_command(self, force: bool = False) -> None:
         if self.pending is None:
             return
-        msg, _ = self.pending
-        t = convert.from_stamp(msg.header.stamp)
-        if not force and any(self._waiting_for(t)):
+        state, _ = self.pending
+        if not force and any(self._waiting_for(state[0])):
             return                  # the reference (or awaited estimate) of this stamp is on its way
         self.pending = None
-        self.command(msg)
+        self.command(state)
 
     def on_timer(self) -> None:
+        drain(*self.polled)
         if self.pending is None:
             return
         age = time.monotonic() - self.pending[1]
-        ref, est = self._waiting_for(convert.from_stamp(self.pending[0].header.stamp))
+        ref, est = self._waiting_for(self.pending[0][0])
         if (ref and age > self.sync_wait) or (not ref and est and age > self.estimate_wait) \
                 or (not ref and not est):
             self.try_command(force=True)
 
-    def command(self, msg: JointState) -> None:
+    def command(self, state) -> None:
+        """One command for ``state`` = (t, names, position, velocity, effort)."""
         t0 = time.perf_counter()
-        t, _names, q, qd, _eff = convert.joint_state_arrays(msg)
+        t, _names, q, qd, _eff = state
         if self.controller is None:
             self.skipped += 1
             self.last_skip = time.monotonic()
@@ -161,12 +184,12 @@ class CdprController(PlantNode):
             self.last_skip = time.monotonic()
             self.last_problem = "bad motor state (NaN, empty or wrong length)"
             return
-        if self.ref is None or not self.inputs.fresh("reference", time.monotonic()):
+        if not self.refs or not self.inputs.fresh("reference", time.monotonic()):
             self.skipped += 1
             self.last_skip = time.monotonic()
             self.last_problem = "no fresh reference: not commanding (brakes hold)"
             return
-        _, pos, quat, vel, acc = self.ref
+        _, (pos, quat, vel, acc) = self.refs.at(t)
         tau = self.controller.update(t, q, qd, pos, quat, vel, acc)
         if tau is None:
             self.skipped += 1

@@ -13,6 +13,9 @@ ROS parameters: ``description``, ``model`` ("II" | "I"), ``tensions`` ("dynamome
 ``"motor"``), ``pose`` ("desired" | "measured"), ``platform_inertia`` (bool), ``coulomb``,
 ``viscous`` (friction compensation, N m, N m s/rad), ``pulley_radius`` (m, 0 = the
 description's), ``stale_after`` (s of stamps between tension and pose), ``input_timeout`` (s wall),
+``poll_period`` (s, default 0: every input sample wakes the node and gives one estimate; > 0:
+batch mode for 1 kHz loops on small machines: the inputs are taken every ``poll_period`` s, every
+sample is estimated and the newest estimate is published, one per period),
 ``fast_executor`` (default true: :class:`cablelab.ros.fastspin.FastExecutor`; false = rclpy's
 SingleThreadedExecutor), ``rt_priority`` (0 = normal scheduling; 1-99 = SCHED_FIFO, see
 :func:`cablelab.ros.fastspin.set_realtime_priority`). The estimate goes out as a pre-serialised message
@@ -33,9 +36,12 @@ from ..live import EstimatorConfig, LiveEstimator
 from ....ros import convert
 from ....rotations import xyzw_to_wxyz
 from ....ros.inputs import ERROR, WARN
+from ....ros.fastspin import drain, poll
+from ....stamped import StampedBuffer
 from ....ros.plant_node import PlantNode
 from ....ros.qos import stream_qos
-from ....ros.rawmsg import RawTemplate
+from ....ros import rawmsg
+from ....ros.rawmsg import RawReader, RawTemplate
 
 
 class CdprPayloadEstimator(PlantNode):
@@ -54,13 +60,14 @@ class CdprPayloadEstimator(PlantNode):
                                 "{dynamometer, motor}, pose in {desired, measured}")
         timeout = float(p("input_timeout", 0.5).value)
         self.estimator = None
-        self.pose = None        # (t, position, quat wxyz, acceleration)
+        self.poses = StampedBuffer()    # t -> (position, quat wxyz, acceleration); may run ahead
         self.motor = None       # (t, velocity, effort)
         self.published = 0
         self.skipped = 0
         self.last_problem = ""
         self.last_skip = -1e9     # wall time of the last skipped sample
         self.latency = []       # processing times, s (for the benchmark)
+        self.readers = {"joints": RawReader(JointState), "reference": RawReader(MultiDOFJointTrajectory)}
         self.inputs.add("tensions", timeout=timeout)
         self.inputs.add("pose", timeout=timeout)
         if self.config.tensions == "motor":
@@ -72,13 +79,25 @@ class CdprPayloadEstimator(PlantNode):
         # the pose first: when both wait in one wake-up, a tension sample meets the pose of its
         # stamp (FastExecutor and rclpy's executor take ready topics in creation order)
         if self.config.pose == "desired":
-            self.create_subscription(MultiDOFJointTrajectory, "/cdpr/reference", self.on_reference, q)
+            subs = [self.create_subscription(MultiDOFJointTrajectory, "/cdpr/reference", self.on_reference, q,
+                                             raw=True)]
         else:
-            self.create_subscription(PoseStamped, "/cdpr/platform_pose", self.on_pose, q)
+            subs = [self.create_subscription(PoseStamped, "/cdpr/platform_pose", self.on_pose, q)]
         if self.config.tensions == "motor":        # (1 kHz of traffic nobody reads otherwise)
-            self.create_subscription(JointState, "/cdpr/joint_states", self.on_joints, q)
+            subs.append(self.create_subscription(JointState, "/cdpr/joint_states", self.on_joints, q, raw=True))
         else:
-            self.create_subscription(JointState, "/cdpr/cable_tensions", self.on_tensions, q)
+            subs.append(self.create_subscription(JointState, "/cdpr/cable_tensions", self.on_tensions, q, raw=True))
+        # batch mode: the inputs wake nobody; a timer takes what queued every poll_period s,
+        # estimates every sample and publishes the newest estimate (one per period)
+        self.poll_period = float(p("poll_period", 0.0).value)
+        if self.poll_period < 0 or self.poll_period > 0.1:
+            raise CablelabError("payload_estimator: parameter poll_period must be in [0, 0.1] s")
+        self.newest = None          # (t, m, com) not published yet (batch mode)
+        if self.poll_period > 0:
+            for sub in subs:
+                poll(self, sub)
+            self.polled = subs
+            self.create_timer(self.poll_period, self.on_poll)
         self.use_fast_executor()
         self.t_est = RawTemplate(convert.inertia_msg(0.0, 0.0, [0.0, 0.0, float("nan")]))
         self._est_m, self._est_com = self.t_est["inertia.m"], self.t_est.vector("inertia.com")
@@ -97,19 +116,35 @@ class CdprPayloadEstimator(PlantNode):
             self.inputs.set_length("joint_states", n)
 
     def on_reference(self, msg: MultiDOFJointTrajectory) -> None:
-        r = convert.multidof_arrays(msg)           # position None (rejected) when empty
+        """A reference sample (MultiDOFJointTrajectory or its serialised bytes)."""
+        try:
+            r = rawmsg.multidof_arrays(msg, self.readers["reference"])   # position None when empty
+        except ValueError:
+            self.inputs.accept("pose", None, time.monotonic())          # not a message: rejected
+            return
         if self.inputs.accept("pose", r["position"], time.monotonic()):
-            self.pose = (r["t"], r["position"], xyzw_to_wxyz(r["quaternion"]), r["linear_acceleration"])
+            self.poses.push(r["t"], (r["position"], xyzw_to_wxyz(r["quaternion"]), r["linear_acceleration"]))
 
     def on_pose(self, msg: PoseStamped) -> None:
         t, pos, q = convert.pose_arrays(msg)
         if self.inputs.accept("pose", pos, time.monotonic()):
-            self.pose = (t, pos, xyzw_to_wxyz(q), None)
+            self.poses.push(t, (pos, xyzw_to_wxyz(q), None))
+
+    def _joint_state(self, msg):
+        """(t, names, q, qd, effort) of a JointState or its bytes; None for bytes that are not one."""
+        try:
+            return rawmsg.joint_state_arrays(msg, self.readers["joints"])
+        except ValueError:
+            return None
 
     def on_joints(self, msg: JointState) -> None:
-        t, _names, _q, qd, eff = convert.joint_state_arrays(msg)
         if self.config.tensions != "motor":
             return
+        js = self._joint_state(msg)
+        if js is None:
+            self.inputs.accept("joint_states", None, time.monotonic())
+            return
+        t, _names, _q, qd, eff = js
         if self.inputs.accept("joint_states", eff, time.monotonic()) and qd is not None:
             self.motor = (t, qd, eff)
             self.estimate(t, None)
@@ -117,7 +152,11 @@ class CdprPayloadEstimator(PlantNode):
     def on_tensions(self, msg: JointState) -> None:
         if self.config.tensions != "dynamometer":
             return
-        t, _names, _q, _qd, eff = convert.joint_state_arrays(msg)
+        js = self._joint_state(msg)
+        if js is None:
+            self.inputs.accept("tensions", None, time.monotonic())
+            return
+        t, _names, _q, _qd, eff = js
         self.inputs.accept("tensions", eff, time.monotonic())
         self.estimate(t, eff)
 
@@ -130,12 +169,12 @@ class CdprPayloadEstimator(PlantNode):
             self.last_skip = time.monotonic()
             self.last_problem = "waiting for /plant_description"
             return
-        if self.pose is None:
+        if not self.poses:
             self.skipped += 1
             self.last_skip = time.monotonic()
             self.last_problem = f"no {self.config.pose} pose yet"
             return
-        tp, pos, quat, acc = self.pose
+        tp, (pos, quat, acc) = self.poses.at(t)
         kw = {"tensions": tensions}
         times = {"pose": tp}
         if self.config.tensions == "motor":
@@ -148,14 +187,27 @@ class CdprPayloadEstimator(PlantNode):
             self.last_problem = self.estimator.status[-1][1]
             return
         m, com = res
+        if self.poll_period > 0:
+            self.newest = (t, m, com)                          # published by on_poll
+        else:
+            self.publish_estimate(t, m, com)
+        self.latency.append(time.perf_counter() - t0)
+        if len(self.latency) > 100000:
+            del self.latency[:50000]
+
+    def publish_estimate(self, t: float, m: float, com) -> None:
         self.t_est.stamp(t)                                    # pre-serialised InertiaStamped
         self._est_m[0] = m
         self._est_com[:2] = com[:2]
         self.pub.publish(self.t_est.data())
         self.published += 1
-        self.latency.append(time.perf_counter() - t0)
-        if len(self.latency) > 100000:
-            del self.latency[:50000]
+
+    def on_poll(self) -> None:
+        """Batch mode: estimate every queued sample, publish the newest estimate."""
+        drain(*self.polled)
+        if self.newest is not None:
+            self.publish_estimate(*self.newest)
+            self.newest = None
 
     def extend_status(self, level, msg, values):
         est_status = self.estimator.status if self.estimator is not None else [(ERROR, self.last_problem)]

@@ -18,7 +18,8 @@ ROS parameters: ``description`` (YAML file or text; default CAROCA), ``payload_m
 ``payload_com`` [x, y, z] (m), ``pulleys`` (bool), ``winch_coulomb`` (N m), ``winch_viscous``
 (N m s/rad), ``motor_inertia`` (kg m^2), ``tension_noise`` (N), ``tension_bias`` [n] (N),
 ``torque_noise`` (N m), ``pose_noise`` (m), ``timestep`` (s; 0 = min(2 ms, 1/rate)), ``rate`` (Hz), ``real_time``,
-``publish_reference``, ``publish_pose``, ``trajectory_speed`` (time scale of the s-curve),
+``publish_reference``, ``reference_lead`` (s the published reference runs ahead of the state:
+default one period in real time, 0 in lock-step), ``publish_pose``, ``trajectory_speed`` (time scale of the s-curve),
 ``settle`` (s held at A before the trajectory starts), ``duration`` (s of simulated time after
 which the node exits; 0 = run until stopped), ``command_timeout`` (s wall, real time),
 ``lockstep_timeout`` (s wall, lock-step), ``extras_every`` (publish /clock, the measured pose and
@@ -46,6 +47,7 @@ from ..trajectory import pick_and_place
 from ....ros import convert
 from ....rotations import wxyz_to_xyzw
 from ....ros.inputs import WARN
+from ....ros.fastspin import drain, poll
 from ....ros.plant_node import PlantNode
 from ....ros.qos import stream_qos
 from ....ros.rawmsg import RawTemplate
@@ -85,6 +87,11 @@ class CdprSimNode(PlantNode):
         self.settle = float(p("settle", 1.0).value)
         self.duration = float(p("duration", 0.0).value)
         self.extras_every = max(1, int(p("extras_every", 1).value))
+        # real time: the reference of the next step goes out right after the state (off the
+        # state -> command critical path; the consumers look it up by stamp)
+        lead = float(p("reference_lead", -1.0).value)
+        self.reference_lead = (1.0 / self.rate if self.real_time else 0.0) if lead < 0 else lead
+        self._ref_sent = None
         self.start_gate()
         self.command_timeout = float(p("command_timeout", 0.5).value)
         self.lockstep_timeout = float(p("lockstep_timeout", 10.0).value)
@@ -112,6 +119,7 @@ class CdprSimNode(PlantNode):
         self.dropped_steps = 0
         self.stale_command_steps = 0
         self.missed_steps = 0       # steps with any of: late, braked, stale command (each once)
+        self.command_age = [0, 0, 0]   # steps whose command answers the state 1, 2, >= 3 periods back
         self.latency = []           # wall time of one step (physics + publishing), s
         self.k = 0
         self.done = False
@@ -138,7 +146,12 @@ class CdprSimNode(PlantNode):
             self.get_logger().warning("rt_priority ignored: lock-step mode runs as fast as possible")
         self.use_fast_executor()
         self._templates()
-        self.create_subscription(Float64MultiArray, "/cdpr/effort_commands", self.on_command, q)
+        cmd = self.create_subscription(Float64MultiArray, "/cdpr/effort_commands", self.on_command, q)
+        # real time: the commands wait queued until the step that applies them takes them (one
+        # wake-up per step, the timer's); lock-step: a command wakes the node (it is the trigger)
+        self.polled = [cmd] if self.real_time else []
+        for sub in self.polled:
+            poll(self, sub)
         self.start_diagnostics()
         self.timer = self.create_timer(1.0 / self.rate if self.real_time else 0.0002, self.tick)
         self.publish_state()
@@ -172,7 +185,8 @@ class CdprSimNode(PlantNode):
                        else "as fast as possible (lock-step)",
                        "late steps": str(self.late_steps), "dropped steps": str(self.dropped_steps),
                        "stale command steps": str(self.stale_command_steps),
-                       "missed steps": str(self.missed_steps)})
+                       "missed steps": str(self.missed_steps),
+                       "command age 1/2/3+ periods": "/".join(str(a) for a in self.command_age)})
         if self.latency:
             values["latency p99 ms"] = f"{1000 * np.percentile(np.asarray(self.latency[-1000:]), 99):.3f}"
         if slack:
@@ -219,6 +233,7 @@ class CdprSimNode(PlantNode):
         if not self.real_time:
             self.step_once()
             return
+        drain(*self.polled)
         now = time.monotonic()
         if self._wall0 is None:
             self._wall0 = now - self.k / self.rate
@@ -258,9 +273,12 @@ class CdprSimNode(PlantNode):
                 missed = True
         else:
             self.brake_q = None
-            if self.real_time and self.u_stamp is not None and self.u_stamp < self.sim.time - 1e-6:
-                self.stale_command_steps += 1           # the answer to the last state is not here
-                missed = True
+            if self.real_time and self.u_stamp is not None:
+                age = int(round((self.sim.time - self.u_stamp) * self.rate))   # 0: the last state
+                self.command_age[min(max(age, 0), 2)] += 1
+                if age > 0:
+                    self.stale_command_steps += 1       # the answer to the last state is not here
+                    missed = True
             self.sim.step(self.u, self.nstep)
         self.k += 1
         if missed and self.commands and self.real_time:
@@ -293,12 +311,9 @@ class CdprSimNode(PlantNode):
         if extra:
             self.t_clock.stamp(t, "clock")
             self.pub_clock.publish(self.t_clock.data())
-        if self.publish_reference:
-            pos, vel, acc = self.reference(t)
-            tr, tv, ta = self._ref_views
-            tr[:], tv[:], ta[:] = pos, vel, acc
-            self.t_ref.stamp(t)
-            self.pub_ref.publish(self.t_ref.data())
+        lead = self.reference_lead
+        if self.publish_reference and (not lead or self._ref_sent is None):
+            self._publish_reference(t)                 # before the state of its stamp
         js = self.t_js
         js.stamp(t)
         js["position"][:] = ms["motor_angle"]
@@ -310,6 +325,8 @@ class CdprSimNode(PlantNode):
         ten["position"][:] = ms["cable_length"]
         ten["effort"][:] = ms["tension"]
         self.pub_ten.publish(ten.data())
+        if self.publish_reference and lead:
+            self._publish_reference(t + lead)          # ahead: waits for the next state
         if extra:
             if self.publish_pose:
                 self._pose(self.t_pose, t, ms["position"], ms["quat"])
@@ -321,6 +338,14 @@ class CdprSimNode(PlantNode):
             self.pub_tpay.publish(self.t_tpay.data())
         self._last_pub_wall = time.monotonic()
         self.commands_at_pub = self.commands
+
+    def _publish_reference(self, t: float) -> None:
+        pos, vel, acc = self.reference(t)
+        tr, tv, ta = self._ref_views
+        tr[:], tv[:], ta[:] = pos, vel, acc
+        self.t_ref.stamp(t)
+        self.pub_ref.publish(self.t_ref.data())
+        self._ref_sent = t
 
     @staticmethod
     def _pose(tpl: RawTemplate, t: float, position, quat_wxyz) -> None:

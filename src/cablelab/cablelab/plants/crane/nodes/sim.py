@@ -22,11 +22,11 @@ busy machine can take seconds, which a recorder would otherwise miss). Without a
 drives hold the crane (gravity compensation + damping, like a brake) and the node reports WARN
 on /diagnostics.
 
-Lock-step matching: a command naming the stamp of the state it answers
-(:func:`cablelab.ros.convert.command_msg`, as the cablelab controller sends) answers the latest
-state only if the stamps agree; answers to earlier states (e.g. to states published while the
-simulation still ran in real time) are counted and ignored, so they never add a control delay.
-A command naming no stamp answers the last published state.
+Lock-step matching (:class:`cablelab.ros.lockstep.LockStep`, real time until commands flow): a
+command naming the stamp of the state it answers answers the latest state only if the stamps
+agree; answers to earlier states (e.g. to states published while the simulation still ran in
+real time) are counted and ignored, so they never add a control delay. A command naming no stamp
+answers the last published state.
 """
 from __future__ import annotations
 
@@ -44,6 +44,7 @@ from ....errors import CablelabError
 from ..control import LIVE_GAINS, hold_command
 from ..model import JOINTS, CraneParams
 from ....ros import convert
+from ....ros.lockstep import ADVANCE, FREE, LockStep
 from ....ros.plant_node import PlantNode
 from ....ros.qos import publisher_qos, stream_qos
 from ..sim import CraneSim, CraneTruth
@@ -79,10 +80,8 @@ class CraneSimNode(PlantNode):
                            timestep=float(p("timestep", 0.001).value))
         q0 = _vec(p("initial", [0.0, 0.5, 0.6]).value, 3, "initial")
         self.rate = float(p("rate", 100.0).value)
-        self.lockstep = bool(p("lockstep", True).value)
-        self.lockstep_timeout = float(p("lockstep_timeout", 10.0).value)
-        self.answered = False       # the command answering the last published state arrived
-        self.stale_answers = 0      # lock-step: answers to earlier states, ignored
+        self.lock = LockStep(bool(p("lockstep", True).value), wait_first=False,
+                             timeout=float(p("lockstep_timeout", 10.0).value))
         self.start_gate()
         self.published_at = time.monotonic()
         self.sim = CraneSim(truth, q0)
@@ -103,7 +102,7 @@ class CraneSimNode(PlantNode):
 
     def extend_status(self, level, msg, values):
         values["fallback (hold) steps"] = str(self.fallbacks)
-        values["stale answers ignored (lock-step)"] = str(self.stale_answers)
+        values["stale answers ignored (lock-step)"] = str(self.lock.stale_answers)
         values["simulation resets"] = str(self.sim.resets)
         if self.sim.resets:
             level = 2
@@ -115,27 +114,20 @@ class CraneSimNode(PlantNode):
         values = convert.float_array(msg)
         if not self.inputs.accept("effort_commands", values, time.monotonic()):
             return
-        stamp = convert.command_stamp(msg)
-        if self.lockstep and stamp is not None and not convert.same_stamp(stamp, self.sim.time):
-            self.stale_answers += 1      # answers an earlier state: never applied late
-            if self.u is None:
-                self.u = values.copy()   # but commands flow: lock-step starts with the next state
-            return
-        self.u = values.copy()
-        self.answered = True
+        if self.lock.offer(convert.command_stamp(msg)):  # False: answers an earlier state
+            self.u = values.copy()       # (never applied late; lock-step starts with the next)
 
     def tick(self) -> None:
         now = time.monotonic()
         if self.waiting_for_subscribers(self.pub_js, self.published_at, self.publish_state):
             return
-        if self.lockstep and self.u is not None and not self.answered:
-            if now - self.published_at < self.lockstep_timeout:
-                return  # wait for the controller's answer to the last state
-            self.u = None  # no answer for lockstep_timeout s: real time (hold) until commands flow
-        if self.lockstep and self.answered:
+        step = self.lock.poll(now)   # no answer for lockstep_timeout s: FREE (hold) until commands flow
+        if step not in (ADVANCE, FREE):
+            return  # wait for the controller's answer to the last state
+        if step == ADVANCE:
             u = self.u  # the answer to the last state, however late it came
         elif (self.u is None or not self.inputs.fresh("effort_commands", now)
-                or self.lockstep):
+                or self.lock.enabled):
             _, q, qd = self.sim.state()
             u = hold_command(q[None, :3], qd[None, :3], self.sim.truth.params, LIVE_GAINS,
                              swing=q[None, 3:])[0]
@@ -146,9 +138,9 @@ class CraneSimNode(PlantNode):
         self.publish_state()
 
     def publish_state(self) -> None:
-        self.answered = False
         self.published_at = time.monotonic()
         t, q, qd = self.sim.state()
+        self.lock.published(t, self.published_at)
         m = self.sim.measurement()
         self.pub_clock.publish(convert.clock_msg(t))
         self.pub_js.publish(convert.joint_state_msg(t, JOINTS, m["joints"], m["joint_rates"], m["effort"]))
