@@ -191,22 +191,13 @@ def dataset_from_arrays(arr: CdprArrays, description, source: str = "data",
     qd = arr.motor_velocity[sl]
     sig = {"tensions": t, "position": pos, "R": R, "acc": arr.acc[sl], "W": W, "pulley_slope": slope,
            "act_scale": act_scale, "velocity": arr.velocity[sl]}
-    ds = Dataset(
+    return Dataset(
         plant="cdpr", t=arr.t[sl], y=y, channels=CHANNELS, units=UNITS, signals=sig,
         actuators=tuple(f"winch_{i}" for i in range(1, n + 1)), act_vel=qd,
         act_map=W * act_scale[None, None, :], act_units=((unit, "rad"),) * n,
         regimes={k2: v[sl] for k2, v in _regimes(arr).items()},
         inputs={"vertical acceleration": arr.acc[sl, 2], "speed": np.linalg.norm(arr.velocity[sl], axis=1)},
         description=description, source=source)
-    if arr.source == "motor":
-        # tensions from motor torques carry the winch friction (001 eq. 15): samples in a winch's
-        # zero-speed zone are not fitted (cablelab.velocity, issue 10), since there the smooth
-        # friction band holds any torque and the sign of a noisy or differentiated encoder
-        # velocity is noise. Dynamometers do not see winch friction: all their samples count.
-        from ...velocity import exclude_zero_speed
-
-        ds = exclude_zero_speed(ds)
-    return ds
 
 
 def dataset(bag, description, options: dict | None = None) -> Dataset:
