@@ -62,6 +62,13 @@ def lr_significance(base, cand, n_candidates: int = 1, alpha: float = 0.01) -> d
     n = r1.shape[0]
     rss0 = np.sum(r0**2, axis=0)
     rss1 = np.sum(r1**2, axis=0)
+    # a channel whose residual is round-off under both fits (rms < 1e-12 in its unit: a channel
+    # the dataset zeroes where it is not excited, e.g. the suspended yaw) carries no information;
+    # its log ratio of two round-offs would swamp the test either way
+    live = np.sqrt(np.maximum(rss0, rss1) / max(n, 1)) > 1e-12
+    if not live.any():
+        live[:] = True
+    r1, rss0, rss1 = r1[:, live], rss0[live], rss1[live]
     step = int(cand.extra.get("sample_step", 1))  # parallel-filtered data: fs / (2 f_c)
     n_eff = np.array([effective_samples(r1[:, c], step) for c in range(r1.shape[1])])
     with np.errstate(divide="ignore", invalid="ignore"):
