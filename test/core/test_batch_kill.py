@@ -111,3 +111,25 @@ def test_whole_batch_killed_then_rerun_resumes(fleet, tmp_path):
     ran = int(p.stdout.split("(")[1].split(" diagnosed")[0])
     assert ran <= MACHINES * DAYS - done
     _check_complete(out)
+
+
+def test_sigterm_writes_every_finished_bag_then_rerun_does_only_the_rest(fleet, tmp_path):
+    """SIGTERM (a scheduler's job kill, `kill PID`) of the batch: the bags finished by then are
+    gathered and written before it exits, so the re-run diagnoses exactly the others."""
+    out = tmp_path / "out"
+    proc = subprocess.Popen(_cmd(fleet, out), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        _wait_parts(out, 3, proc)
+        proc.send_signal(signal.SIGTERM)
+        _, stderr = proc.communicate(timeout=120)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode != 0, "batch finished before the signal; make bags longer"
+    assert "Traceback" not in stderr, stderr[-2000:]
+    done = _bags_written(out)
+    assert 3 <= done < MACHINES * DAYS
+    p = subprocess.run(_cmd(fleet, out)[:-1], capture_output=True, text=True, timeout=240)
+    assert p.returncode == 0, p.stderr[-3000:]
+    assert f"({MACHINES * DAYS - done} diagnosed now" in p.stdout, (done, p.stdout)
+    _check_complete(out)

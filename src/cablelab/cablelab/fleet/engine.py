@@ -2,16 +2,19 @@
 
 Default: a :class:`distributed.LocalCluster` sized to the machine (one single-threaded worker
 process per core), started and stopped here; ``scheduler="tcp://HOST:8786"`` uses an existing
-cluster instead. Every bag is one task (memory stays per bag); a task whose worker dies is
-rescheduled by Dask (``allowed-failures``); the tasks never raise (failures are rows). Finished
-bags' rows are written to ``OUT/parts/`` once a second and at exit, interrupt or SIGTERM
-(:class:`cablelab.fleet.table.PartWriter`), so a re-run with the same OUT skips the bags already
-done and an interrupted batch resumes.
+cluster instead. A task diagnoses a small group of bags one after the other (memory stays one
+bag's; :func:`groups`: up to :data:`MAX_GROUP` bags per task while many remain, single bags at
+the end); a task whose worker dies is rescheduled by Dask (``allowed-failures``); the tasks
+never raise (failures are rows). Finished bags' rows are written to ``OUT/parts/`` once a second
+and at exit, interrupt or SIGTERM (:class:`cablelab.fleet.table.PartWriter`), so a re-run with
+the same OUT skips the bags already done and an interrupted batch resumes.
 
-Per-bag cost of the engine (``bench/bench_batch.py``): the bags go out in one ``client.map`` and
-come back in batches (``as_completed(...).batches()``, one gather per batch); the LocalCluster's
-periodic housekeeping is slowed (:data:`LOCAL_CONFIG`), since at Dask's defaults the event-loop
-health tick (every 20 ms in each server) alone cost about 1 % of a core per process.
+What the engine costs per bag beyond the bag's own diagnosis (``bench/bench_batch.py``; found
+with py-spy on the client and worker processes): Dask's fixed cost per task in the scheduler,
+client and worker event loops (shared by the bags of a group), one gather and one parquet part
+per second instead of per bag, the client polling its futures' local state instead of a
+coroutine and a thread wake-up per finished task (``as_completed``), and the LocalCluster's
+periodic housekeeping, slowed by :data:`LOCAL_CONFIG`.
 """
 from __future__ import annotations
 
@@ -36,12 +39,11 @@ def default_workers() -> int:
 
 #: Dask settings of the LocalCluster (scheduler, nannies, workers). The worker's statistical
 #: profiler (a thread sampling the task's stack every 10 ms) competes for the GIL with the task.
-#: Housekeeping at Dask's defaults cost ~25 ms of CPU per second in this process (scheduler,
-#: nannies, client) and ~19 ms/s in each worker while tasks ran: the event-loop health tick
-#: every 20 ms per server (~half of it), the system monitor every 0.5 s, the nanny's memory
-#: check every 0.1 s, work stealing (useless here: one-bag tasks are queued on the scheduler,
-#: ``worker-saturation``).
-#: Measured by ``bench/bench_batch.py --idle``.
+#: The rest is housekeeping that burns CPU in every process all the time, idle or not: the
+#: event-loop health tick every 20 ms per server (the largest part), the system monitor every
+#: 0.5 s, the nanny's memory check every 0.1 s, work stealing (nothing to steal here: tasks are
+#: queued on the scheduler, ``worker-saturation``, and the last ones are single bags).
+#: ``bench/bench_batch.py --idle`` prints the idle CPU per second with Dask's defaults and these.
 LOCAL_CONFIG = {
     "distributed.worker.profile.enabled": False,
     "distributed.admin.tick.interval": "1s",
@@ -66,10 +68,11 @@ def start_client(scheduler: str | None = None, workers: int | None = None, *, qu
     import dask
 
     # Dask's default MALLOC_TRIM_THRESHOLD_=64 KiB makes glibc trim after every large numpy free,
-    # which slows the allocation-heavy fit; one task holds one bag, so memory stays bounded
-    # without it. Single-threaded BLAS as Dask sets it (one worker process per core).
+    # which slows the allocation-heavy fit; a task holds one bag at a time, so memory stays
+    # bounded without it. Single-threaded BLAS as Dask sets it (one worker process per core).
     env = {"OMP_NUM_THREADS": 1, "MKL_NUM_THREADS": 1, "OPENBLAS_NUM_THREADS": 1}
-    with dask.config.set({"distributed.nanny.pre-spawn-environ": env, **(LOCAL_CONFIG if config is None else config)}):
+    settings = LOCAL_CONFIG if config is None else config
+    with dask.config.set({"distributed.nanny.pre-spawn-environ": env, **settings}):
         cluster = LocalCluster(n_workers=workers or default_workers(), threads_per_worker=1,
                                processes=True, dashboard_address=":0", silence_logs=logging.ERROR)
     return Client(cluster), cluster
@@ -77,10 +80,11 @@ def start_client(scheduler: str | None = None, workers: int | None = None, *, qu
 
 def run_batch(root, out, *, effects=(), greedy: bool = False, folds: int = 5, scheduler: str | None = None,
               workers: int | None = None, group_by: str | None = None, reports: bool = False,
-              progress: bool = True, client=None) -> dict:
+              progress: bool = True, client=None, max_group: int | None = None) -> dict:
     """Diagnose every bag under ``root`` into ``out`` (the dashboard link always goes to stderr,
     the progress bar when ``progress``); returns ``{"refs", "hashes", "ran",
-    "skipped", "table", "seconds", "dashboard"}`` (the table: :mod:`cablelab.fleet.table`)."""
+    "skipped", "table", "seconds", "dashboard"}`` (the table: :mod:`cablelab.fleet.table`).
+    ``max_group``: most bags per task (default :data:`MAX_GROUP`; 1: one task per bag)."""
     out = Path(out)
     try:
         out.mkdir(parents=True, exist_ok=True)
@@ -104,7 +108,8 @@ def run_batch(root, out, *, effects=(), greedy: bool = False, folds: int = 5, sc
             seen.add(h)
             rep = str(out / "bags" / h) if reports else None
             todo.append((ref, h, rep))
-        ran, failed = _run(client, todo, out, effects, greedy, folds, progress)
+        ran, failed = _run(client, todo, out, effects, greedy, folds, progress,
+                           MAX_GROUP if max_group is None else max_group)
     finally:
         if own:
             client.close()
