@@ -32,11 +32,21 @@ def _cmd(root, out):
             "--greedy", "--json"]
 
 
+def _bags_written(out) -> int:
+    """Bags whose rows are in a (whole) part file: parts hold every bag finished in ~1 s."""
+    hashes = set()
+    for p in (out / "parts").glob("*.parquet") if (out / "parts").is_dir() else ():
+        try:
+            hashes |= set(pq.read_table(p, columns=["bag_hash"]).column("bag_hash").to_pylist())
+        except Exception:  # noqa: BLE001 - a part being renamed into place
+            continue
+    return len(hashes)
+
+
 def _wait_parts(out, n, proc, timeout=120.0):
     t0 = time.monotonic()
     while time.monotonic() - t0 < timeout:
-        d = out / "parts"
-        if d.is_dir() and len(list(d.glob("*.parquet"))) >= n:
+        if _bags_written(out) >= n:
             return
         if proc.poll() is not None:
             pytest.fail(f"batch ended before {n} bags were done: {proc.stderr.read()[-2000:]}")
@@ -68,7 +78,7 @@ def test_worker_killed_mid_batch_loses_no_row(fleet, tmp_path):
         victim = workers[0]
         victim.send_signal(signal.SIGKILL)
         victim.wait(10)
-        done_at_kill = len(list((out / "parts").glob("*.parquet")))
+        done_at_kill = _bags_written(out)
         assert done_at_kill < MACHINES * DAYS, "batch finished before the kill; make bags longer"
         stdout, stderr = proc.communicate(timeout=240)
     finally:
@@ -94,10 +104,32 @@ def test_whole_batch_killed_then_rerun_resumes(fleet, tmp_path):
     finally:
         if proc.poll() is None:
             proc.kill()
-    done = len(list((out / "parts").glob("*.parquet")))
+    done = _bags_written(out)
     assert 5 <= done < MACHINES * DAYS
     p = subprocess.run(_cmd(fleet, out)[:-1], capture_output=True, text=True, timeout=240)
     assert p.returncode == 0, p.stderr[-3000:]
     ran = int(p.stdout.split("(")[1].split(" diagnosed")[0])
     assert ran <= MACHINES * DAYS - done
+    _check_complete(out)
+
+
+def test_sigterm_writes_every_finished_bag_then_rerun_does_only_the_rest(fleet, tmp_path):
+    """SIGTERM (a scheduler's job kill, `kill PID`) of the batch: the bags finished by then are
+    gathered and written before it exits, so the re-run diagnoses exactly the others."""
+    out = tmp_path / "out"
+    proc = subprocess.Popen(_cmd(fleet, out), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        _wait_parts(out, 3, proc)
+        proc.send_signal(signal.SIGTERM)
+        _, stderr = proc.communicate(timeout=120)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode != 0, "batch finished before the signal; make bags longer"
+    assert "Traceback" not in stderr, stderr[-2000:]
+    done = _bags_written(out)
+    assert 3 <= done < MACHINES * DAYS
+    p = subprocess.run(_cmd(fleet, out)[:-1], capture_output=True, text=True, timeout=240)
+    assert p.returncode == 0, p.stderr[-3000:]
+    assert f"({MACHINES * DAYS - done} diagnosed now" in p.stdout, (done, p.stdout)
     _check_complete(out)
