@@ -108,7 +108,15 @@ def profile_summary(path: Path, top: int = 8) -> list[tuple[str, float]]:
     return [(f, n / max(total, 1)) for f, n in leaf.most_common(top)]
 
 
-def closed_loop(seconds: float, log, env: dict | None = None, py_spy: str | None = None) -> dict:
+#: ``--pin``: the placement a 2-core deployment gives the loop without privileges: the simulator
+#: and the controller on a core each, the estimator (off the state -> command path) beside the
+#: simulator at the lowest priority (nice 19), so that it only takes what the simulator leaves
+PINNED = {"sim": {"cpu_affinity": [0]}, "controller": {"cpu_affinity": [1]},
+          "estimator": {"cpu_affinity": [0], "niceness": 19}}
+
+
+def closed_loop(seconds: float, log, env: dict | None = None, py_spy: str | None = None,
+                pin: bool = False) -> dict:
     from bench_cdpr import run_closed_loop
 
     from cablelab.ros.launch import Launcher
@@ -119,7 +127,7 @@ def closed_loop(seconds: float, log, env: dict | None = None, py_spy: str | None
         hook, spies = _py_spy_profiles(py_spy, tmp, max(1.0, min(seconds - 3.0, 30.0)), log)
     with Launcher(log_dir=tmp / "logs", env=env) as launch:
         log(f"ROS_DOMAIN_ID {launch.domain_id}, logs in {launch.log_dir}")
-        r = run_closed_loop(launch, seconds, {}, log, on_started=hook)
+        r = run_closed_loop(launch, seconds, {}, log, on_started=hook, node_params=PINNED if pin else None)
     for name, proc in spies:
         proc.wait(timeout=60)
         f = tmp / f"{name}.txt"
@@ -130,6 +138,7 @@ def closed_loop(seconds: float, log, env: dict | None = None, py_spy: str | None
         raise SystemExit("bench_realtime: the simulator never reported on /diagnostics (see the logs)")
     r["rate_hz"] = 1000
     r["rt_priority"] = False
+    r["placement"] = PINNED if pin else None
     return r
 
 
@@ -138,6 +147,9 @@ def main(argv=None) -> int:
     bench.parser.add_argument("--seconds", type=float, default=60.0, help="closed-loop steady state, s (60)")
     bench.parser.add_argument("--repeat", type=int, default=3, help="offline tries, best of (3)")
     bench.parser.add_argument("--skip-loop", action="store_true", help="offline part only")
+    bench.parser.add_argument("--pin", action="store_true",
+                              help="place the nodes (no privilege): sim and estimator (nice 19) on CPU 0, "
+                                   "controller on CPU 1 (needs >= 2 CPUs)")
     bench.parser.add_argument("--skip-offline", action="store_true", help="closed loop only")
     bench.parser.add_argument("--publication-mode", choices=("synchronous", "asynchronous"), default=None,
                               help="RMW_FASTRTPS_PUBLICATION_MODE for the three nodes (default: rmw's)")
@@ -157,11 +169,11 @@ def main(argv=None) -> int:
             env["RMW_FASTRTPS_PUBLICATION_MODE"] = args.publication_mode.upper()
         if args.transports:
             env["FASTDDS_BUILTIN_TRANSPORTS"] = args.transports
-        r = closed_loop(args.seconds, bench.log, env, args.py_spy)
+        r = closed_loop(args.seconds, bench.log, env, args.py_spy, args.pin)
         out["closed_loop"] = {"rate_hz": r["rate_hz"], "seconds": r["seconds"],
                               "realtime_factor": r["realtime_factor"], "missed_cycles": r["missed_cycles"],
                               "p99_ms": r["p99_ms"], "rt_priority": r["rt_priority"],
-                              "command_age_steps": r["command_age"]}
+                              "command_age_steps": r["command_age"], "placement": r["placement"]}
     if args.json:
         print(json.dumps(out))
         return 0
@@ -176,7 +188,8 @@ def main(argv=None) -> int:
                       unit="", target="<= 3")]
     if "closed_loop" in out:
         c = out["closed_loop"]
-        rows += [dict(case=f"closed loop 1 kHz, 3 processes, no RT priority, {c['seconds']:.0f} s steady state",
+        where = "sim + estimator (nice 19) on CPU 0, controller on CPU 1" if args.pin else "no CPU placement"
+        rows += [dict(case=f"closed loop 1 kHz, 3 processes, no RT priority, {where}, {c['seconds']:.0f} s steady state",
                       value=c["realtime_factor"], unit="x real time", target=">= 0.99"),
                  dict(case="missed cycles (steps braked, late or with a stale command, + dropped)",
                       value=f"{c['missed_cycles']} (braked {r['braked']}, late {r['late']}, "

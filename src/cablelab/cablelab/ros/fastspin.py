@@ -30,7 +30,8 @@ from __future__ import annotations
 
 from contextlib import ExitStack
 
-__all__ = ["FastExecutor", "supports", "set_realtime_priority", "poll", "drain"]
+__all__ = ["FastExecutor", "supports", "set_realtime_priority", "set_cpu_affinity", "set_background",
+           "poll", "drain"]
 
 
 def set_realtime_priority(priority: int) -> str:
@@ -51,6 +52,51 @@ def set_realtime_priority(priority: int) -> str:
     except (OSError, AttributeError) as exc:
         return f"SCHED_FIFO {priority} not available ({exc}): normal scheduling"
     return f"SCHED_FIFO {priority} on {len(tids)} threads"
+
+
+def set_cpu_affinity(cpus) -> str:
+    """Pin every thread of this process (and the threads they start later) to ``cpus`` (CPU
+    numbers), as a real-time deployment places a control loop's processes on their own cores;
+    no privilege is needed. Returns a one-line result for the log."""
+    import os
+
+    cpus = sorted({int(c) for c in cpus})
+    if not cpus:
+        return "no CPU affinity"
+    try:
+        tids = [int(t) for t in os.listdir("/proc/self/task")]
+        for tid in tids:
+            os.sched_setaffinity(tid, cpus)
+    except (OSError, AttributeError, ValueError) as exc:
+        return f"CPU affinity {cpus} not available ({exc})"
+    return f"CPU affinity {cpus} on {len(tids)} threads"
+
+
+def set_background(niceness: int) -> str:
+    """Lower this process's CPU priority by ``niceness`` (1-19), for a node that is not on the
+    loop's critical path (e.g. a slowly varying estimate): the process's nice value and, where
+    Linux groups each session's processes (autogroup, on by default on desktops), the nice value
+    of its group, which is what the scheduler weighs against other sessions. Lowering a priority
+    needs no privilege. Returns a one-line result for the log."""
+    import os
+
+    niceness = max(0, min(int(niceness), 19))
+    if niceness == 0:
+        return "normal priority"
+    done = []
+    try:
+        for tid in (int(t) for t in os.listdir("/proc/self/task")):
+            os.setpriority(os.PRIO_PROCESS, tid, max(os.getpriority(os.PRIO_PROCESS, tid), niceness))
+        done.append(f"nice {niceness}")
+    except (OSError, AttributeError) as exc:
+        done.append(f"nice not available ({exc})")
+    try:
+        with open("/proc/self/autogroup", "w") as f:
+            f.write(str(niceness))
+        done.append("autogroup too")
+    except OSError:
+        pass
+    return ", ".join(done)
 
 
 def poll(node, subscription) -> None:

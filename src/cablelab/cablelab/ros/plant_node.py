@@ -55,11 +55,20 @@ class PlantNode(Node):
         return value
 
     def use_fast_executor(self, default: bool = True) -> None:
-        """Parameters ``fast_executor`` (spin with :class:`~cablelab.ros.fastspin.FastExecutor`)
-        and ``rt_priority`` (SCHED_FIFO priority, 0 = off)."""
-        from .fastspin import set_realtime_priority
+        """Parameters ``fast_executor`` (spin with :class:`~cablelab.ros.fastspin.FastExecutor`),
+        ``rt_priority`` (SCHED_FIFO priority, 0 = off; needs the privilege), and the placement a
+        deployment gives a 1 kHz loop without privileges: ``cpu_affinity`` (CPU numbers the
+        node's threads run on, [] = any) and ``niceness`` (0-19: lower priority for a node off
+        the critical path)."""
+        from .fastspin import set_background, set_cpu_affinity, set_realtime_priority
 
         self.fast = bool(self.param("fast_executor", default))
+        cpus = [int(c) for c in self.param("cpu_affinity", [-1]) if int(c) >= 0]
+        if cpus:
+            self.get_logger().info(f"cpu_affinity: {set_cpu_affinity(cpus)}")
+        nice = int(self.param("niceness", 0))
+        if nice > 0:
+            self.get_logger().info(f"niceness: {set_background(nice)}")
         rt = int(self.param("rt_priority", 0))
         if rt > 0:
             self.get_logger().info(f"rt_priority: {set_realtime_priority(rt)}")
