@@ -15,7 +15,7 @@ from __future__ import annotations
 
 from ...registry import Plant, register_plant
 from . import effects as _effects  # noqa: F401  (registers the effect ids)
-from .dataset import POSE, POSE_TOPIC, dataset
+from .dataset import POSE, POSE_TOPIC, SUSPENSION_TOPIC, dataset
 from .description import parse_section
 
 JOINT_STATE = "sensor_msgs/msg/JointState"
@@ -50,6 +50,7 @@ SUSPENDED = register_plant(Plant(
         "/suspended/swing_estimate": JOINT_STATE,
         "/suspended/ground_truth/swing": JOINT_STATE,
         "/suspended/ground_truth/virtual_joints": JOINT_STATE,
+        SUSPENSION_TOPIC: POSE,                # optional, docs/contract-additions.md (suspension_motion)
     },
 ))
 
