@@ -104,6 +104,22 @@ def test_rigidly_levelled_control_does_not_call_levelling(tmp_path):
     assert len(out["greedy"]) == 1
 
 
+def test_cranebot_swing_is_not_called_levelled(tmp_path):
+    # CRANEbot's platform follows the cable (J11/J12 target 0): the level-platform candidate is
+    # not offered there (it would absorb the reduced model's platform-rotation inertia), and a
+    # nominal CRANEbot swing shows nothing significant
+    p = parameter_set("cranebot")
+    m = build_virtual(p)
+    run = simulate(m, initial_state(m, {"J8": 0.1, "J9": 0.06}), 15.0)[0]
+    path = tmp_path / "cranebot_swing"
+    write_run(path, run, p.S, description_yaml("cranebot"), pos_noise=1e-3, seed=7)
+    plant, desc, ds = workbench.load(path)
+    assert "platform_levelling" not in plant.candidates(desc)
+    assert "platform_levelling" in plant.candidates(workbench.load(_levelled_bag(tmp_path, 10.0))[1])
+    out = _diagnose(path)
+    assert not any(r["significant"] for r in out["ranking"])
+
+
 # ---- suspension_motion -------------------------------------------------------------------------
 
 def _hook_bag(tmp_path, name, amplitude):
@@ -153,3 +169,26 @@ def test_still_hook_control_does_not_call_suspension_motion(tmp_path):
     out = _diagnose(path)
     assert not _row(out, "suspension_motion")["significant"]
     assert len(out["greedy"]) == 1
+
+
+@pytest.mark.parametrize("bad", ["one_message", "wrong_type"])
+def test_bad_suspension_topic_is_a_one_line_error_naming_it(tmp_path, bad):
+    from cablelab.bags import BagWriter
+    from cablelab.errors import CablelabError
+
+    t = np.arange(200) * 0.01
+    pos = np.tile([0.0, 0.0, 1.0], (200, 1))
+    quat = np.tile([0.0, 0.0, 0.0, 1.0], (200, 1))
+    path = tmp_path / bad
+    with BagWriter(path) as w:
+        w.write_description(description_yaml("licas"))
+        w.write_clock(t)
+        w.write_poses("/suspended/platform_pose", t, pos, quat)
+        if bad == "one_message":
+            w.write_poses(SUSPENSION_TOPIC, t[:1], pos[:1], quat[:1])
+        else:
+            w.write_joint_states(SUSPENSION_TOPIC, t, ("x",), position=pos[:, :1])
+    with pytest.raises(CablelabError) as e:
+        workbench.load(path)
+    msg = str(e.value)
+    assert SUSPENSION_TOPIC in msg and "\n" not in msg

@@ -30,6 +30,13 @@ def baseline(description) -> tuple[str, ...]:
 
 
 def candidates(description) -> tuple[str, ...]:
+    """Spec sec. 7 candidates; ``platform_levelling`` only where the nominal swing model's level
+    platform is the variant's own (LiCAS, target -q8/-q9). CRANEbot's platform follows the cable
+    (target 0): there the tilt relative to the cable absorbs the reduced model's platform-rotation
+    inertia and would be called on nominal data (README, "Platform levelling")."""
+    sec = getattr(description, "suspended", None)
+    if sec is not None and not sec.params().level_to_swing:
+        return tuple(c for c in _effects.CANDIDATES if c != "platform_levelling")
     return _effects.CANDIDATES
 
 
