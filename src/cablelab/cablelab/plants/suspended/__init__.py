@@ -15,7 +15,7 @@ from __future__ import annotations
 
 from ...registry import Plant, register_plant
 from . import effects as _effects  # noqa: F401  (registers the effect ids)
-from .dataset import POSE, POSE_TOPIC, dataset
+from .dataset import POSE, POSE_TOPIC, SUSPENSION_TOPIC, dataset
 from .description import parse_section
 
 JOINT_STATE = "sensor_msgs/msg/JointState"
@@ -30,6 +30,13 @@ def baseline(description) -> tuple[str, ...]:
 
 
 def candidates(description) -> tuple[str, ...]:
+    """Spec sec. 7 candidates; ``platform_levelling`` only where the nominal swing model's level
+    platform is the variant's own (LiCAS, target -q8/-q9). CRANEbot's platform follows the cable
+    (target 0): there the tilt relative to the cable absorbs the reduced model's platform-rotation
+    inertia and would be called on nominal data (README, "Platform levelling")."""
+    sec = getattr(description, "suspended", None)
+    if sec is not None and not sec.params().level_to_swing:
+        return tuple(c for c in _effects.CANDIDATES if c != "platform_levelling")
     return _effects.CANDIDATES
 
 
@@ -50,6 +57,7 @@ SUSPENDED = register_plant(Plant(
         "/suspended/swing_estimate": JOINT_STATE,
         "/suspended/ground_truth/swing": JOINT_STATE,
         "/suspended/ground_truth/virtual_joints": JOINT_STATE,
+        SUSPENSION_TOPIC: POSE,                # optional, docs/contract-additions.md (suspension_motion)
     },
 ))
 

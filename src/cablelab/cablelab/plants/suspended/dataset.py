@@ -34,11 +34,14 @@ from .params import VirtualParams
 from .reference import planar_bodies
 from .swing import swing_from_pose
 
-__all__ = ["dataset", "dataset_from_arrays", "modal_inertias", "radial_mass", "CHANNELS", "POSE_TOPIC",
-           "JOINT_STATES", "CUTOFF_HZ"]
+__all__ = ["dataset", "dataset_from_arrays", "modal_inertias", "radial_mass", "platform_tilt", "CHANNELS",
+           "POSE_TOPIC", "SUSPENSION_TOPIC", "JOINT_STATES", "CUTOFF_HZ"]
 
 CHANNELS = ("swing_x", "swing_y", "yaw", "stretch")
 POSE_TOPIC = "/suspended/platform_pose"
+#: optional: measured pose of the suspension point S (crane hook / drone), a measured input of
+#: ``suspension_motion`` (docs/contract-additions.md)
+SUSPENSION_TOPIC = "/suspended/suspension_pose"
 JOINT_STATES = "/suspended/joint_states"
 POSE = "geometry_msgs/msg/PoseStamped"
 #: position low-pass cut-off, Hz: the swing is at 0.5 Hz (LiCAS) / 0.24 Hz (CRANEbot), yaw below
@@ -73,20 +76,39 @@ def modal_inertias(p: VirtualParams) -> np.ndarray:
     return np.array([Jx, Jy, Jz])
 
 
+def platform_tilt(quat_wxyz) -> np.ndarray:
+    """(N, 2) world tilt of the platform about x and y, rad: the body z axis
+    ``z_b = Rx(a) Ry(b) e_z = (sin b, -sin a cos b, cos a cos b)`` (independent of yaw), so
+    ``a = atan2(-z_b,y, z_b,z)``, ``b = asin(z_b,x)``; for the chain J8..J12 (000 eq. 1) a = q8 + q11
+    and b = q9 + q12 to first order."""
+    w, x, y, z = np.asarray(quat_wxyz, float).T
+    zb = np.stack([2 * (x * z + w * y), 2 * (y * z - w * x), 1 - 2 * (x * x + y * y)], -1)
+    return np.column_stack([np.arctan2(-zb[:, 1], zb[:, 2]), np.arcsin(np.clip(zb[:, 0], -1.0, 1.0))])
+
+
 def dataset_from_arrays(t, pos, quat_wxyz, desc_section, description=None, options: dict | None = None,
-                        *, source: str = "data") -> Dataset:
-    """Dataset from platform poses ``pos`` (N, 3) m and ``quat_wxyz`` (N, 4) at stamps ``t`` (N,)."""
+                        *, source: str = "data", suspension=None) -> Dataset:
+    """Dataset from platform poses ``pos`` (N, 3) m and ``quat_wxyz`` (N, 4) at stamps ``t`` (N,).
+
+    ``suspension``: measured position of the suspension point S at the same stamps (N, 3) m, or
+    None (S fixed at the description's ``S``). When given, the swing angles are taken about the
+    moving S and its acceleration is the signal ``a_S`` of ``suspension_motion``."""
     options = options or {}
     opts = options.get("conditioning") or Conditioning()
     if opts.cutoff_hz is None:
         opts = dataclasses.replace(opts, cutoff_hz=CUTOFF_HZ)
     p = desc_section.params()
-    s = swing_from_pose(pos, quat_wxyz, p.S, rest_pos=np.array(p.S) - [0, 0, p.L], rest_yaw=0.0)
-    l = np.linalg.norm(np.asarray(pos, float) - np.asarray(p.S, float), axis=1)
+    S = np.broadcast_to(np.asarray(p.S, float), np.shape(pos)) if suspension is None else np.asarray(suspension, float)
+    s = swing_from_pose(pos, quat_wxyz, S, rest_pos=np.array(p.S) - [0, 0, p.L], rest_yaw=0.0)
+    l = np.linalg.norm(np.asarray(pos, float) - S, axis=1)
     q = np.column_stack([s["swing_x"], s["swing_y"], s["yaw"], l - np.median(l)])
-    c = condition_motion(np.asarray(t, float), q, np.zeros((len(q), 1)), opts, revolute=False,
-                         source=source)
-    q, qd, qdd = c["q"], c["qd"], c["qdd"]
+    # conditioned together with the swing (same grid and filter): platform tilt, S
+    extra = np.column_stack([platform_tilt(quat_wxyz), S])
+    c = condition_motion(np.asarray(t, float), np.column_stack([q, extra]), np.zeros((len(q), 1)), opts,
+                         revolute=False, source=source)
+    tilt, tilt_d = c["q"][:, 4:6], c["qd"][:, 4:6]
+    a_S = c["qdd"][:, 6:9]
+    q, qd, qdd = c["q"][:, :4], c["qd"][:, :4], c["qdd"][:, :4]
     J = modal_inertias(p)
     g = description.gravity if description is not None else 9.81
     M_r = radial_mass(p)
@@ -105,7 +127,9 @@ def dataset_from_arrays(t, pos, quat_wxyz, desc_section, description=None, optio
     return Dataset(
         plant="suspended", t=c["t"], y=y, channels=CHANNELS, units=("N m", "N m", "N m", "N"),
         signals={"q": q, "qd": qd, "qdd": qdd, "J": J, "g": g, "L": p.L, "excited": excited,
-                 "cutoff_hz": c.get("cutoff_hz", opts.cutoff_hz)},
+                 "cutoff_hz": c.get("cutoff_hz", opts.cutoff_hz), "tilt": tilt, "tilt_d": tilt_d,
+                 "level_to_swing": bool(p.level_to_swing),
+                 "a_S": a_S if suspension is not None else None},
         actuators=CHANNELS, act_vel=qd, act_units=(("N m", "rad"),) * 3 + (("N", "m"),),
         inputs={"swing_x rate": qd[:, 0], "swing_y rate": qd[:, 1], "yaw rate": qd[:, 2]},
         regimes={"swing amplitude": labels[np.searchsorted(edges, amp)]},
@@ -131,5 +155,12 @@ def dataset(bag, description, options: dict | None = None) -> Dataset:
     bag.require(POSE_TOPIC, POSE)
     ps = bag.pose(POSE_TOPIC)
     quat = ps.quaternion[:, [3, 0, 1, 2]]                 # x y z w -> w x y z
+    S = None
+    if bag.has(SUSPENSION_TOPIC):                          # optional measured input
+        bag.require(SUSPENSION_TOPIC, POSE)
+        ss = bag.pose(SUSPENSION_TOPIC)
+        if len(ss.t) < 2:
+            raise CablelabError(f"{bag.path}: topic {SUSPENSION_TOPIC} has {len(ss.t)} message(s), needs >= 2")
+        S = np.column_stack([np.interp(ps.t, ss.t, ss.position[:, k]) for k in range(3)])
     return dataset_from_arrays(ps.t, ps.position, quat, section_of(description), description,
-                               options, source=str(bag.path))
+                               options, source=str(bag.path), suspension=S)

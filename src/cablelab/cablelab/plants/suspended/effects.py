@@ -23,6 +23,20 @@ every column is the negative of the term per unit parameter.
   cable length (:mod:`.dataset`). Its signature, the vertical bounce at ``sqrt(k_c / M_r)``, is
   what a rigid-cable model cannot produce.
 
+* ``platform_levelling``: finite-gain PD levelling on J11/J12 (spec sec. 7, 000 eq. 2; LiCAS
+  target q11^d = -q8, CRANEbot 0). The nominal swing model treats the platform as held exactly
+  level (the infinitely stiff limit: it translates at L, modal inertias of :mod:`.dataset`). A
+  PD of gains k_p, k_d on the levelling error e (LiCAS: the measured world tilt q8 + q11;
+  CRANEbot: the tilt relative to the cable, q11) pushes back on the cable: in coordinates
+  (cable angle, platform tilt) the generalised force of the J11 torque tau = -k_p e - k_d de on
+  the cable angle is -tau, so the columns are ``+e`` and ``+de`` (signal ``tilt`` from the pose).
+* ``suspension_motion``: prescribed motion of S (crane hook, drone; J1-J6 of 000). For the chain
+  hung at S, the pivot acceleration a_S acts like gravity: the generalised force on swing angle
+  q is ``-(sum m_i l_i) (du/dq) . a_S`` with u the unit cable direction (the gravity term is the
+  same with a_S = g e_z). The coefficient is the static moment (kg m), which must agree with the
+  baseline's ``mgl``; the input a_S is measured (topic ``/suspended/suspension_pose``, absent =
+  column 0, reported as not excited).
+
 ``time_delay`` is the generic effect of :mod:`cablelab.effects.delay`.
 """
 from __future__ import annotations
@@ -112,6 +126,33 @@ def _arm(ds: Dataset) -> np.ndarray:
     return b
 
 
+def _levelling(ds: Dataset) -> np.ndarray:
+    tilt, tilt_d = ds.require_signal("tilt"), ds.require_signal("tilt_d")
+    if not ds.signals.get("level_to_swing", True):       # CRANEbot: target 0 relative to the cable
+        q, qd = ds.require_signal("q"), ds.require_signal("qd")
+        tilt, tilt_d = tilt - q[:, :2], tilt_d - qd[:, :2]
+    b = _zeros(ds, 4)
+    for k in range(2):
+        b[:, k, k] = tilt[:, k]
+        b[:, k, 2 + k] = tilt_d[:, k]
+    return b
+
+
+def _suspension(ds: Dataset) -> np.ndarray:
+    a = ds.signals.get("a_S")
+    b = _zeros(ds, 2)
+    if a is None:
+        return b
+    q = ds.require_signal("q")
+    s8, c8, s9, c9 = np.sin(q[:, 0]), np.cos(q[:, 0]), np.sin(q[:, 1]), np.cos(q[:, 1])
+    # u = (-sin q9, cos q9 sin q8, -cos q9 cos q8): du/dq8, du/dq9
+    du8 = np.column_stack([np.zeros_like(s8), c9 * c8, c9 * s8])
+    du9 = np.column_stack([-c9, -s9 * s8, s9 * c8])
+    b[:, 0, 0] = -np.einsum("ij,ij->i", du8, a)
+    b[:, 1, 1] = -np.einsum("ij,ij->i", du9, a)
+    return b
+
+
 _P = ("suspended",)
 SUSPENDED_EFFECTS = (
     register(Effect(
@@ -171,6 +212,24 @@ SUSPENDED_EFFECTS = (
         explanation="the measured rest pose is offset: the restoring moment acts about a shifted "
                     "angle (constant torque = static moment x offset)",
         signature="constant residual in r or yaw", reference="spec 000 sec. 7", regressor=_offset)),
+    register(Effect(
+        id="platform_levelling", plants=_P,
+        params=(Param("kp11", "N m/rad", 300.0, 0.0, np.inf, "levelling stiffness J11 (about x)"),
+                Param("kp12", "N m/rad", 300.0, 0.0, np.inf, "levelling stiffness J12 (about y)"),
+                Param("kd11", "N m s/rad", 1.0, 0.0, np.inf, "levelling damping J11"),
+                Param("kd12", "N m s/rad", 1.0, 0.0, np.inf, "levelling damping J12")),
+        explanation="the platform is levelled by a finite-gain PD on J11/J12 (not held exactly "
+                    "level): its tilt pushes back on the cable",
+        signature="platform roll/pitch from the pose tracks the swing; swing period off by a few %",
+        reference="000 eq. 2, sec. 4 (J11/J12 virtual PD); spec 000 sec. 4.3, 7", regressor=_levelling)),
+    register(Effect(
+        id="suspension_motion", plants=_P,
+        params=(Param("ml_x", "kg m", 5.0, 0.0, np.inf, "static moment about S moved by a_S (swing_x)"),
+                Param("ml_y", "kg m", 5.0, 0.0, np.inf, "static moment about S moved by a_S (swing_y)")),
+        explanation="the suspension point moves (crane hook sway, drone drift): its measured "
+                    "acceleration drives the swing like a moving pivot",
+        signature="swing correlates with the suspension acceleration",
+        reference="spec 000 sec. 7 (J1-J6 prescribed); moving-pivot pendulum", regressor=_suspension)),
 )
 
 BASELINE = ("cable_link_inertia", "cable_joint_viscous_friction")
@@ -178,4 +237,4 @@ BASELINE = ("cable_link_inertia", "cable_joint_viscous_friction")
 #: arm-command data, which the pose-only dataset does not carry: on unforced control records it
 #: fits the swing model's reduction error (a false positive), so it is not tried here.
 CANDIDATES = ("cable_joint_coulomb_friction", "virtual_yaw_stiffness", "air_drag",
-              "pose_sensor_offset", "cable_elasticity")
+              "pose_sensor_offset", "cable_elasticity", "platform_levelling", "suspension_motion")

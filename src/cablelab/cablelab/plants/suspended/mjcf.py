@@ -31,6 +31,9 @@ __all__ = ["virtual_xml", "build_virtual", "truth_xml", "build_truth", "arm_join
            "levelling_ctrl", "effective_cable_inertias", "VJ", "AXES"]
 
 VJ = ("J7", "J8", "J9", "J10", "J11", "J12")
+#: hook body carrying S in the ``moving_suspension`` truth, kg, and its position-servo bandwidth, Hz
+HOOK_MASS = 200.0
+HOOK_BANDWIDTH_HZ = 5.0
 AXES = {"x": "1 0 0", "y": "0 1 0", "z": "0 0 1"}
 _AXIS_IDX = {"x": 0, "y": 1, "z": 2}
 #: cable joint turning about each axis (where an inertia excess goes as armature, spec 4.2)
@@ -134,7 +137,7 @@ _PLATFORM_SENSORS = """  <sensor>
 
 def virtual_xml(p: VirtualParams, *, levelling: str = "tendon", cable_elasticity=None,
                 timestep: float = 1e-3, integrator: str = "implicitfast", lock=(),
-                freeze_arms: bool = False, arm_motors: bool = False) -> str:
+                freeze_arms: bool = False, arm_motors: bool = False, moving_suspension: bool = False) -> str:
     """MJCF of the virtual-joint chain (module docstring).
 
     Args:
@@ -144,6 +147,10 @@ def virtual_xml(p: VirtualParams, *, levelling: str = "tendon", cable_elasticity
         lock: virtual joints left out (held at 0), e.g. ``("J7", "J9", "J10", "J12")`` for the
             planar reduction of spec 4.5. freeze_arms: arms rigid at q = 0 (no joints, no servos).
         arm_motors: arm torque motors (ctrl = N m) instead of the repo position servos.
+        moving_suspension: truth switch for ``suspension_motion``: S sits on a heavy hook body
+            (:data:`HOOK_MASS`) with horizontal slides ``hook_x``, ``hook_y`` driven by stiff
+            position servos (actuators ``hook_x``, ``hook_y``, ctrl = displacement of S, m; the
+            last two actuators). The realised S is the hook's qpos (a measured input).
     """
     lock = set(lock)
     if levelling not in ("tendon", "paper"):
@@ -174,11 +181,23 @@ def virtual_xml(p: VirtualParams, *, levelling: str = "tendon", cable_elasticity
     if p.level_to_swing and levelling == "paper":
         lvl_act = "\n    ".join(f'<motor name="level_{j}" joint="{j}"/>' for j in ("J11", "J12")
                                    if j not in lock)
+    hook_open = hook_close = hook_act = ""
+    link7_pos = _f(p.S)
+    if moving_suspension:
+        hook_open = (f'<body name="hook" pos="{_f(p.S)}">\n      <joint name="hook_x" type="slide" axis="1 0 0"/>'
+                     f'<joint name="hook_y" type="slide" axis="0 1 0"/>'
+                     f'<inertial pos="0 0 0" mass="{HOOK_MASS!r}" diaginertia="1 1 1"/>')
+        hook_close = "</body>"
+        link7_pos = "0 0 0"
+        kp = float(HOOK_MASS * (2 * np.pi * HOOK_BANDWIDTH_HZ) ** 2)
+        hook_act = "\n    ".join(f'<position name="{j}" joint="{j}" kp="{kp!r}" kv="{float(2 * np.sqrt(kp * HOOK_MASS))!r}"/>'
+                                  for j in ("hook_x", "hook_y"))
     return f"""<mujoco model="suspended_{p.variant}_virtual">
   {_option(timestep, integrator)}
   <worldbody>
-    <site name="S" pos="{_f(p.S)}"/>
-    <body name="link7" pos="{_f(p.S)}">
+    {hook_open}
+    <site name="S" pos="{"0 0 0" if moving_suspension else _f(p.S)}"/>
+    <body name="link7" pos="{link7_pos}">
       {"" if "J7" in lock else f'<joint name="J7" axis="0 0 1" stiffness="{p.kp7!r}" damping="{p.kd7 + fv[0]!r}" frictionloss="{fs[0]!r}" armature="{float(armature["J7"])!r}"/>'}
       <inertial pos="0 0 {-p.l7z!r}" mass="{m7!r}" diaginertia="{_f(I7)}"/>
       <body name="link8">
@@ -206,11 +225,13 @@ def virtual_xml(p: VirtualParams, *, levelling: str = "tendon", cable_elasticity
         </body>
       </body>
     </body>
+    {hook_close}
   </worldbody>
   {tendon}
   <actuator>
     {_actuators(p, freeze_arms, arm_motors)}
     {lvl_act}
+    {hook_act}
   </actuator>
 {_PLATFORM_SENSORS}"""
 
