@@ -20,7 +20,10 @@
 Hidden effects (from ``cablelab.plants.cdpr.plant.candidates``): ``pulley_geometry`` (sheaves in
 the truth, not in the description), ``tension_sensor_offset``, ``winch_coulomb_friction`` and
 ``winch_viscous_friction`` (these two are read from the motor torques, ``--tensions motor``, where
-friction is visible; dynamometers do not see it), ``platform_inertia`` (not in the nominal model);
+friction is visible; dynamometers do not see it), ``platform_inertia`` (not in the nominal model),
+``time_delay`` (dynamometers and motor torques read the truth of ``tau`` = 10-30 ms earlier: the
+whole chain reference -> tensions -> torques is evaluated at ``t - tau``, while the winch angles
+and the reference topic are not delayed);
 one, or two, or none (control). The nominal model is the plant's (``cdpr_gravity`` [+
 ``pulley_geometry`` when the description gives a sheave radius]) + ``platform_inertia``
 (``--effects``), except when the inertia is the hidden effect. The described sheave radius is
@@ -44,9 +47,10 @@ LIMITS = ((-1.0, 1.0), (-0.3, 0.3), (0.6, 1.1))
 NAMES = tuple(f"cable_{i}" for i in range(1, 9))
 WINCHES = tuple(f"winch_{i}" for i in range(1, 9))
 ONE = [("pulley_geometry",), ("tension_sensor_offset",), ("winch_coulomb_friction",),
-       ("winch_viscous_friction",), ("platform_inertia",)]
+       ("winch_viscous_friction",), ("platform_inertia",), ("time_delay",)]
 TWO = [("pulley_geometry", "tension_sensor_offset"), ("pulley_geometry", "platform_inertia"),
-       ("winch_coulomb_friction", "winch_viscous_friction"), ("platform_inertia", "tension_sensor_offset")]
+       ("winch_coulomb_friction", "winch_viscous_friction"), ("platform_inertia", "tension_sensor_offset"),
+       ("pulley_geometry", "time_delay")]
 MOTOR = ("winch_coulomb_friction", "winch_viscous_friction")
 
 
@@ -84,6 +88,8 @@ def draw_case(seed: int, kind: str | None = None) -> PlantCase:
     truth.update(duration=float(rng.uniform(40, 60)), profile=profile, rest_fraction=float(rng.uniform(0.2, 0.5)),
                  noise_rel=10 ** rng.uniform(-2.5, -1.5, 8), ar=float(rng.uniform(0, 0.8)),
                  outlier_rate=float(rng.choice([0.0, 0.002])), quantum=2 * np.pi / 2 ** int(rng.integers(12, 16)))
+    tau = float(rng.uniform(10e-3, 30e-3))          # drawn last: the other draws do not depend on it
+    truth["tau"] = tau if "time_delay" in hidden else 0.0
     case.true_params = _true_params(case)
     return case
 
@@ -112,6 +118,8 @@ def _true_params(case: PlantCase) -> dict:
         out["winch_coulomb_friction"] = {f"Fc[{n}]": v for n, v in zip(WINCHES, tr["Fc"])}
     if "winch_viscous_friction" in case.hidden:
         out["winch_viscous_friction"] = {f"Fv[{n}]": v for n, v in zip(WINCHES, tr["Fv"])}
+    if "time_delay" in case.hidden:
+        out["time_delay"] = {"tau": tr["tau"]}
     return out
 
 
@@ -154,6 +162,25 @@ def structure_matrix(u: np.ndarray) -> np.ndarray:
 
 # ----------------------------------------------------------------------------- truth + sensors
 
+def _winch_truth(tr: dict, p, v, a, t):
+    """Exact motion -> wrench -> tensions -> winch angle, rate and motor torque on the grid ``t``."""
+    u, L = cable_directions(p, tr["r_p"])
+    W = structure_matrix(u)
+    w = np.zeros((t.size, 6))
+    w[:, :3] = tr["m"] * (a + [0.0, 0.0, G])              # m (a - g), g = (0, 0, -G)
+    t0 = np.full(8, tr["m"] * G / 8 / 0.6)
+    Wp = np.linalg.pinv(W)                                 # (N, 8, 6)
+    ten = t0 + np.einsum("nij,nj->ni", Wp, w - np.einsum("nij,j->ni", W, t0))
+    if ten.min() <= 0.05 * t0[0]:
+        raise RuntimeError(f"cable tension {ten.min():.1f} N is not positive enough")
+    scale = GEAR / DRUM
+    L0 = cable_directions(np.array([[0.0, 0.0, 0.85]]), tr["r_p"])[1][0]   # lengths at the start pose
+    theta = scale * (L - L0)                               # motor angle, rad
+    omega = np.gradient(theta, t, axis=0)                  # exact motion is smooth: fine differences
+    motor = ten / scale + tr["Fc"] * np.tanh(omega / tr["eps"]) + tr["Fv"] * omega
+    return theta, omega, ten, motor
+
+
 def simulate(case: PlantCase) -> dict:
     """Reference motion -> wrench -> tensions -> winch motion and torques -> sensor readings."""
     rng = np.random.default_rng(case.seed + 7919)
@@ -163,19 +190,12 @@ def simulate(case: PlantCase) -> dict:
     n = int(round(tr["duration"] * case.fs))
     t = np.arange(n) / case.fs
     p, v, a = ref(t)
-    u, L = cable_directions(p, tr["r_p"])
-    W = structure_matrix(u)
-    w = np.zeros((n, 6))
-    w[:, :3] = tr["m"] * (a + [0.0, 0.0, G])              # m (a - g), g = (0, 0, -G)
+    theta, omega, ten, motor = _winch_truth(tr, *ref(t), t)
+    if tr.get("tau", 0.0) != 0.0:                          # sensors read the truth of t - tau
+        td = t - tr["tau"]
+        _, _, ten, motor = _winch_truth(tr, *ref(td), td)
     t0 = np.full(8, tr["m"] * G / 8 / 0.6)
-    Wp = np.linalg.pinv(W)                                 # (N, 8, 6)
-    ten = t0 + np.einsum("nij,nj->ni", Wp, w - np.einsum("nij,j->ni", W, t0))
-    if ten.min() <= 0.05 * t0[0]:
-        raise RuntimeError(f"case {case.seed}: cable tension {ten.min():.1f} N is not positive enough")
     scale = GEAR / DRUM
-    theta = scale * (L - L[0])                             # motor angle, rad
-    omega = np.gradient(theta, t, axis=0)                  # exact motion is smooth: fine differences
-    motor = ten / scale + tr["Fc"] * np.tanh(omega / tr["eps"]) + tr["Fv"] * omega
     dyn = ten + tr["b"]
     for i in range(8):
         dyn[:, i] += coloured_noise(rng, n, tr["noise_rel"][i] * t0[0], tr["ar"], tr["outlier_rate"])

@@ -17,14 +17,16 @@
 
 Hidden effects are drawn from the crane's candidates (``cablelab.plants.crane.plant.candidates``):
 ``joint_coulomb_friction``, ``torque_sensor_offset``, ``base_tilt``, ``counterbalance``,
-``joint_viscous_friction`` (one, or two of them), plus control cases with nothing hidden. The
+``joint_viscous_friction``, ``time_delay`` (one, or two of them), plus control cases with nothing hidden. The
 nominal model is the plant's (``crane_rigid_body`` + ``counterbalance`` when described) plus
 ``joint_viscous_friction`` (``--effects``) except in the viscous cases. The description's boom
 mass and counterbalance are known parameters (``--fix m_b=.. --fix m_c=.. --fix l_c=..``): with
 m_b free, (m_b, m_c, l_c) keep one unidentifiable direction (plants/crane/README.md), and a free
 counterbalance moment absorbs a luff torque offset (cos(beta) over the luff range vs a constant).
 When the counterbalance is the hidden effect only m_b is fixed, so its m_c and l_c are fitted.
-``time_delay`` is not among the crane's candidates, so no crane case hides it.
+``time_delay``: the recorded efforts are the motor commands of ``tau`` earlier (10-30 ms at
+100/200 Hz): the 1 kHz command sequence is interpolated at ``t - tau`` here, the joint positions
+and motion capture are not delayed (measured effort delayed relative to the motion).
 """
 from __future__ import annotations
 
@@ -35,9 +37,10 @@ from cases_common import PlantCase, coloured_noise, moves_and_rests, quantize
 
 JOINT_NAMES = ("slew", "luff", "hoist")
 ONE = [("joint_coulomb_friction",), ("torque_sensor_offset",), ("base_tilt",), ("counterbalance",),
-       ("joint_viscous_friction",)]
+       ("joint_viscous_friction",), ("time_delay",)]
 TWO = [("joint_coulomb_friction", "torque_sensor_offset"), ("joint_coulomb_friction", "base_tilt"),
-       ("counterbalance", "joint_coulomb_friction"), ("base_tilt", "torque_sensor_offset")]
+       ("counterbalance", "joint_coulomb_friction"), ("base_tilt", "torque_sensor_offset"),
+       ("joint_coulomb_friction", "time_delay")]
 #: joint ranges of the reference moves: slew rad, luff rad, rope length m
 LIMITS = ((-1.2, 1.2), (0.15, 1.1), (0.4, 0.9))
 KP, KD = np.array([30.0, 40.0, 400.0]), np.array([10.0, 12.0, 40.0])
@@ -84,6 +87,8 @@ def draw_case(seed: int, kind: str | None = None) -> PlantCase:
                       outlier_rate=float(rng.choice([0.0, 0.002])), mocap_noise=float(rng.uniform(2e-4, 1e-3)),
                       quantum=[2 * np.pi / 2 ** int(rng.integers(16, 19)), 2 * np.pi / 2 ** int(rng.integers(16, 19)),
                                10.0 ** rng.uniform(-6, -5)])
+    tau = float(rng.uniform(10e-3, 30e-3))          # drawn last: the other draws do not depend on it
+    case.truth["tau"] = tau if "time_delay" in hidden else 0.0
     case.true_params = _true_params(case)
     return case
 
@@ -126,6 +131,8 @@ def _true_params(case: PlantCase) -> dict:
              - tr["counterbalance_distance"] * tr["counterbalance_mass"])
         out["base_tilt"] = {"tilt_a": K * gb[0], "tilt_b": K * gb[1],
                             "tilt_pa": tr["payload_mass"] * gb[0], "tilt_pb": tr["payload_mass"] * gb[1]}
+    if "time_delay" in case.hidden:
+        out["time_delay"] = {"tau": tr["tau"]}
     return out
 
 
@@ -169,6 +176,7 @@ def simulate(case: PlantCase) -> dict:
     fc, eps = np.asarray(tr["coulomb"], float), np.asarray(tr["eps"], float)
     m = (n + dec - 1) // dec
     qpos, qvel, sens, ctrl = np.empty((m, 5)), np.empty((m, 5)), np.empty((m, model.nsensordata)), np.empty((m, 3))
+    u_all = np.empty((n, 3))                        # every 1 kHz command, for a delayed measurement
     madr = (model.M_rowadr + model.M_rownnz - 1)[idx]   # diagonal of the sparse mass matrix (data.M)
     j = 0
     for k in range(n):  # the 1 kHz control loop (feedback every step, zero-order hold)
@@ -177,6 +185,7 @@ def simulate(case: PlantCase) -> dict:
         mujoco.mj_fwdVelocity(model, data)
         u = KP * (qr[k] - data.qpos[idx]) + KD * (vr[k] - v) + data.qfrc_bias[idx] + data.M[madr] * ar[k]
         data.ctrl[:] = u
+        u_all[k] = u
         data.qfrc_applied[idx] = -fc * np.tanh(v / eps)   # smooth Coulomb friction (truth)
         if k % dec == 0:
             qpos[j], qvel[j], ctrl[j] = data.qpos, data.qvel, u
@@ -185,7 +194,9 @@ def simulate(case: PlantCase) -> dict:
             sens[j] = data.sensordata                # computed at the state before the step
             j += 1
     t = tgrid[::dec]
-    motor = ctrl
+    # the effort measured at t is the command of t - tau (tau = 0: the sampled command itself)
+    motor = (ctrl if tr.get("tau", 0.0) == 0.0 else
+             np.column_stack([np.interp(t - tr["tau"], tgrid, u_all[:, i]) for i in range(3)]))
     eff = np.empty_like(motor)
     for i in range(3):
         sigma = tr["noise_rel"][i] * float(np.sqrt(np.mean(motor[:, i] ** 2)))

@@ -113,3 +113,27 @@ def test_suspended_hidden_pose_offset_significant(tmp_path):
     case = _case(cases_suspended, 4, "one")
     assert case.hidden == ("pose_sensor_offset",)
     _assert_found(_diagnose(cases_suspended, case, tmp_path), case, rel=np.inf)
+
+
+# time delay: the measured efforts / tensions lag the motion by tau (interpolated in the generator)
+def _assert_delay(out, case):
+    first = out["ranking"][0]
+    assert first["effect"] == "time_delay" and first["significant"], out["ranking"][:2]
+    assert [g["added"] for g in out["greedy"][1:]] == ["time_delay"]
+    tau, se = out["final"]["params"]["tau"], out["final"]["stderr"]["tau"]
+    true = case.true_params["time_delay"]["tau"]
+    assert abs(tau - true) < 0.15 * true, (tau, true)
+    # a finite, honest uncertainty: positive, small against tau, and the error within 5 stderr
+    assert 0.0 < se < 0.1 * true and abs(tau - true) < 5 * se + 1e-4, (tau, se, true)
+
+
+def test_crane_hidden_time_delay_found_with_tau_and_its_stderr(tmp_path):
+    case = _case(cases_crane, 2, "one", duration=30.0)
+    assert case.hidden == ("time_delay",) and case.fs == 100.0
+    _assert_delay(_diagnose(cases_crane, case, tmp_path), case)
+
+
+def test_cdpr_hidden_time_delay_found_with_tau_and_its_stderr(tmp_path):
+    case = _case(cases_cdpr, 55, "one", duration=30.0)
+    assert case.hidden == ("time_delay",) and case.fs == 200.0 and case.options["tensions"] == "dynamometer"
+    _assert_delay(_diagnose(cases_cdpr, case, tmp_path), case)

@@ -61,6 +61,12 @@ class Plant:
             every fit (:func:`cablelab.bagcheck.check_bag`; ``series``: topic -> decoded series):
             names against the description (one-line errors), physically impossible values.
         package: the Python package of the plant (filled in by :func:`get_plant`).
+        remeasure: optional ``fn(ds, shifted) -> Dataset`` used by ``time_delay``
+            (:mod:`cablelab.effects.delay`) when the output channels are raw measurements mapped
+            through a motion-dependent matrix (CDPR: wrench = W(pose) x measured tensions):
+            ``shifted`` has every motion signal at ``t - tau``; the hook puts the raw
+            measurement back unshifted and re-forms ``y`` and the signals computed from it
+            with the map of the time the measurement belongs to. None: nothing to re-form.
     """
 
     name: str
@@ -81,6 +87,7 @@ class Plant:
     checked_topics: tuple[str, ...] = ()
     check_bag: Callable | None = None
     package: str = ""
+    remeasure: Callable | None = None
 
 
 def register_plant(plant: Plant) -> Plant:

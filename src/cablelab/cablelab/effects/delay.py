@@ -6,6 +6,11 @@ signals shifted to ``t - tau`` (linear interpolation of every time-indexed signa
 velocity and map); samples whose shifted time leaves the record or crosses a gap of the time axis
 are marked invalid. The measurement itself is never interpolated: interpolating a noisy signal
 at a fractional shift averages neighbouring samples and would "explain" white noise as a delay.
+When a plant's output channels are raw measurements mapped through a motion-dependent matrix
+(the CDPR's wrench ``W(pose(t)) t_meas(t)``), shifting the motion alone would also shift that
+map: the plant's ``remeasure`` hook (:class:`cablelab.registry.Plant`) then keeps the raw
+measurement unshifted and re-forms ``y = W(pose(t - tau)) t_meas(t)``, the wrench the measured
+tensions exert at the pose they belong to (the measured tensions are not interpolated either).
 tau < 0 means the measurement leads the motion (typical when the "effort" is a controller
 command). tau is found by a bounded outer search around the linear least squares (separable least
 squares, see :mod:`cablelab.fit.identify`).
@@ -61,8 +66,21 @@ def _transform(ds: Dataset, values: Mapping[str, float]) -> Dataset:
             return shift_array(v, i, w)
         return v
 
-    return ds.replace(signals={k: sh(v) for k, v in ds.signals.items()}, act_vel=sh(ds.act_vel),
-                      act_map=sh(ds.act_map), valid=ds.valid & ok)
+    shifted = ds.replace(signals={k: sh(v) for k, v in ds.signals.items()}, act_vel=sh(ds.act_vel),
+                         act_map=sh(ds.act_map), valid=ds.valid & ok)
+    hook = _remeasure_hook(ds.plant)
+    return shifted if hook is None else hook(ds, shifted)
+
+
+def _remeasure_hook(plant: str):
+    """The plant's ``remeasure`` hook, or None (also for a dataset of an unregistered plant)."""
+    from ..errors import CablelabError
+    from ..registry import get_plant
+
+    try:
+        return get_plant(plant).remeasure
+    except CablelabError:
+        return None
 
 
 TIME_DELAY = register(Effect(

@@ -184,13 +184,14 @@ def dataset_from_arrays(arr: CdprArrays, description, source: str = "data",
     y = np.einsum("tij,tj->ti", W, t)
     r_ref = c.pulley_radius if c.pulley_radius > 0 else 0.15
     W2 = wrench_matrix(cable_geometry(c.exit_points, c.anchor_points, pos, R, r_ref, c.swivel_axes))
-    slope = np.einsum("tij,tj->ti", W2 - W, t) / r_ref
+    S = (W2 - W) / r_ref                               # d(W)/d(r_p), motion side
+    slope = np.einsum("tij,tj->ti", S, t)
     n = t.shape[1]
     act_scale = np.full(n, arr.scale if arr.source == "motor" else 1.0)
     unit = "N m" if arr.source == "motor" else "N"
     qd = arr.motor_velocity[sl]
     sig = {"tensions": t, "position": pos, "R": R, "acc": arr.acc[sl], "W": W, "pulley_slope": slope,
-           "act_scale": act_scale, "velocity": arr.velocity[sl]}
+           "pulley_S": S, "act_scale": act_scale, "velocity": arr.velocity[sl]}
     return Dataset(
         plant="cdpr", t=arr.t[sl], y=y, channels=CHANNELS, units=UNITS, signals=sig,
         actuators=tuple(f"winch_{i}" for i in range(1, n + 1)), act_vel=qd,
@@ -198,6 +199,16 @@ def dataset_from_arrays(arr: CdprArrays, description, source: str = "data",
         regimes={k2: v[sl] for k2, v in _regimes(arr).items()},
         inputs={"vertical acceleration": arr.acc[sl, 2], "speed": np.linalg.norm(arr.velocity[sl], axis=1)},
         description=description, source=source)
+
+
+def remeasure(ds: Dataset, shifted: Dataset) -> Dataset:
+    """``time_delay`` hook: the measured tensions at t belong to the pose at t - tau, so the wrench
+    they exert is ``W(p(t - tau)) t_meas(t)`` (001 eq. 4 at the shifted pose; the pulley slope
+    likewise). ``shifted`` holds W and the slope matrix at t - tau; the tensions stay unshifted."""
+    t = ds.signals["tensions"]
+    sig = dict(shifted.signals, tensions=t,
+               pulley_slope=np.einsum("tij,tj->ti", shifted.signals["pulley_S"], t))
+    return shifted.replace(y=np.einsum("tij,tj->ti", shifted.signals["W"], t), signals=sig)
 
 
 def dataset(bag, description, options: dict | None = None) -> Dataset:
@@ -223,7 +234,7 @@ def candidates(description) -> tuple[str, ...]:
     """Effects a diagnosis tries (the friction and offset ones only matter for the tension source
     that carries them; an effect without signal is simply not significant)."""
     return ("pulley_geometry", "platform_inertia", "winch_coulomb_friction",
-            "winch_viscous_friction", "tension_sensor_offset")
+            "winch_viscous_friction", "tension_sensor_offset", "time_delay")
 
 
 
@@ -360,6 +371,7 @@ CDPR = register_plant(Plant(
     dataset=dataset,
     baseline=baseline,
     candidates=candidates,
+    remeasure=remeasure,
     channels_doc="cable wrench W t at the desired pose: Fx, Fy, Fz (N), Mx, My, Mz (N m) about "
                  "the platform origin, world axes",
     section=parse_section,

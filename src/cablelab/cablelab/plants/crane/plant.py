@@ -217,7 +217,7 @@ def baseline(description) -> tuple[str, ...]:
 def candidates(description) -> tuple[str, ...]:
     """Effects a crane diagnosis tries (CONTRACT sec. 4)."""
     return ("counterbalance", "base_tilt", "joint_viscous_friction", "joint_coulomb_friction",
-            "torque_sensor_offset")
+            "torque_sensor_offset", "time_delay")
 
 
 def _check_joint_names(bag, series) -> list[str]:
