@@ -100,8 +100,9 @@ def test_lockstep_closed_loop_sim_estimator_controller_recorder(launcher, tmp_pa
     common, i_t, i_e = np.intersect1d(np.round(truth.t, 6), np.round(est.t, 6), return_indices=True)
     assert len(common) > 0.9 * len(t)
     # (yaw comes from the IMU, published with the pose: when DDS delivers the pose first, the
-    # previous IMU sample is carried 1 ms forward with its rate, a 1e-7-rad-level difference)
-    tol = np.array([1e-6 if n == "yaw" else 1e-9 for n in truth.names])
+    # newest IMU sample, one or on a loaded machine a few periods old (within imu_max_lag), is
+    # carried forward with its rate: 1e-7 rad per period idle, 1.8e-5 rad seen under load)
+    tol = np.array([1e-4 if n == "yaw" else 1e-9 for n in truth.names])
     assert np.all(np.abs(est.position[i_e] - truth.position[i_t]) <= tol), \
         np.abs(est.position[i_e] - truth.position[i_t]).max(axis=0)
     sx = truth.position[i_t, truth.names.index("swing_x")]
