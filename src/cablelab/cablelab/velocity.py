@@ -129,7 +129,7 @@ def quantization_aware_cutoff(q: np.ndarray, fs: float, default_hz: float, order
     :data:`QDD_NOISE_FRACTION` of the acceleration RMS, for every column of the raw position
     ``q`` (N,) or (N, k). White position noise (:func:`white_position_noise`) counts like
     quantization; clean, unquantized positions keep ``default_hz``."""
-    from .conditioning import lowpass
+    from .filters import lowpass
 
     q = np.asarray(q, dtype=float).reshape(len(q), -1)
     cut = float(default_hz)
@@ -164,7 +164,7 @@ def excitation_bandwidth(q: np.ndarray, fs: float, cutoff_hz: float, order: int 
     :data:`EXCITATION_POWER` of the power of the velocity (positions low-passed at ``cutoff_hz``
     and differentiated; every column of (N,) or (N, k) pooled) lies. Quantization noise carries
     a negligible share of the velocity's power, so the estimate needs no reference signal."""
-    from .conditioning import lowpass
+    from .filters import lowpass
 
     q = np.asarray(q, dtype=float).reshape(len(q), -1)
     q = q[:, np.all(np.isfinite(q), axis=0)]
