@@ -117,7 +117,11 @@ def test_sigterm_writes_every_finished_bag_then_rerun_does_only_the_rest(fleet, 
     """SIGTERM (a scheduler's job kill, `kill PID`) of the batch: the bags finished by then are
     gathered and written before it exits, so the re-run diagnoses exactly the others."""
     out = tmp_path / "out"
-    proc = subprocess.Popen(_cmd(fleet, out), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    # one worker: the 60 short bags take several seconds after the first part (with two workers
+    # on an idle machine the rest could finish before the signal arrived)
+    cmd = _cmd(fleet, out)
+    cmd[cmd.index("--workers") + 1] = "1"
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         _wait_parts(out, 3, proc)
         proc.send_signal(signal.SIGTERM)
