@@ -114,25 +114,38 @@ def drain(*subscriptions) -> int:
     """Take every queued sample of ``subscriptions`` and call each one's callback, one sample per
     subscription per round in the given order (so two streams published in step, e.g. a pose and
     a tension of the same stamp, keep their interleaving). Returns the number of samples taken."""
+    with ExitStack() as stack:
+        for sub in subscriptions:
+            stack.enter_context(sub.handle)
+        return _take_all([_entry(sub) for sub in subscriptions])
+
+
+def _entry(sub) -> tuple:
+    """(handle, msg_type, raw, callback, with message info) of an rclpy subscription."""
     from rclpy.subscription import Subscription
 
-    info_type = Subscription.CallbackType.WithMessageInfo
-    ready = list(subscriptions)
+    return (sub.handle, sub.msg_type, sub.raw, sub.callback,
+            sub._callback_type is Subscription.CallbackType.WithMessageInfo)
+
+
+def _take_all(entries) -> int:
+    """Drain every queue of ``entries`` (:func:`_entry`), one sample per entry per round in the
+    given order, each sample straight to its callback; returns the number taken."""
     taken = 0
-    while ready:
+    while entries:
         still = []
-        for sub in ready:
-            with sub.handle:
-                info = sub.handle.take_message(sub.msg_type, sub.raw)
+        for entry in entries:
+            h, msg_type, raw, callback, with_info = entry
+            info = h.take_message(msg_type, raw)
             if info is None:
                 continue
             taken += 1
-            if sub._callback_type is info_type:
-                sub.callback(info[0], info[1])
+            if with_info:
+                callback(info[0], info[1])
             else:
-                sub.callback(info[0])
-            still.append(sub)
-        ready = still
+                callback(info[0])
+            still.append(entry)
+        entries = still
     return taken
 
 
@@ -191,11 +204,7 @@ class FastExecutor:
             self._stack.enter_context(ent.handle)
         self._stack.enter_context(self._context.handle)
         self._ws = _rclpy.WaitSet(len(subs), 0, len(timers), 0, len(services), 0, self._context.handle)
-        from rclpy.subscription import Subscription
-
-        info_type = Subscription.CallbackType.WithMessageInfo
-        self._subs = [(s, s.handle, s.handle.pointer, s.msg_type, s.raw, s.callback,
-                       s._callback_type is info_type) for s in subs]
+        self._subs = [(s.handle.pointer, _entry(s)) for s in subs]
         self._timers = [(t, t.handle, t.handle.pointer) for t in timers]
         self._services = [(v, v.handle, v.handle.pointer) for v in services]
         self._key = (subs, timers, services)
@@ -210,8 +219,8 @@ class FastExecutor:
             self._rebuild(*key)
         ws = self._ws
         ws.clear_entities()
-        for entry in self._subs:
-            ws.add_subscription(entry[1])
+        for _p, entry in self._subs:
+            ws.add_subscription(entry[0])
         for _t, h, _p in self._timers:
             ws.add_timer(h)
         for _v, h, _p in self._services:
@@ -233,21 +242,8 @@ class FastExecutor:
                 request, header = h.service_take_request(srv.srv_type.Request)
                 if header is not None:
                     srv.send_response(srv.callback(request, srv.srv_type.Response()), header)
-        ready = [e for e in self._subs if e[2] in subs_ready]
-        while ready:                          # drain every queue, one sample per topic per round
-            still = []
-            for entry in ready:
-                _s, h, _p, msg_type, raw, callback, with_info = entry
-                info = h.take_message(msg_type, raw)
-                if info is None:
-                    continue
-                self.taken += 1
-                if with_info:
-                    callback(info[0], info[1])
-                else:
-                    callback(info[0])
-                still.append(entry)
-            ready = still
+        # drain every queue, one sample per topic per round
+        self.taken += _take_all([e for p, e in self._subs if p in subs_ready])
 
     def spin_until(self, condition, timeout_sec: float = 0.1) -> None:
         """Spin until ``condition()`` is true (checked after every wake-up or ``timeout_sec``)."""
