@@ -25,7 +25,7 @@ import numpy as np
 from .. import cdr
 from . import convert
 
-__all__ = ["RawTemplate", "RawReader", "type_name", "joint_state_arrays", "multidof_arrays"]
+__all__ = ["RawTemplate", "RawReader", "type_name", "joint_state_arrays", "multidof_arrays", "command_arrays"]
 
 
 def type_name(cls) -> str:
@@ -206,3 +206,62 @@ def multidof_arrays(msg, reader: RawReader) -> dict:
             out[f"linear_{prefix}"] = vec(f"{_P0}{field}[0].linear")
             out[f"angular_{prefix}"] = vec(f"{_P0}{field}[0].angular")
     return out
+
+
+def command_arrays(msg) -> tuple[np.ndarray, float | None]:
+    """(data (n,) float64, stamp s of the state it answers or None) of an effort command
+    (std_msgs/Float64MultiArray, :func:`cablelab.ros.convert.command_msg`), as a message object or
+    its serialised bytes.
+
+    The command's label carries the answered stamp as text, so its bytes change with every
+    sample and a cached :class:`RawReader` layout would be re-parsed each time; the layout of
+    this one type is short, so it is read directly (XCDR1, either byte order: the 4-byte
+    encapsulation header, then ``layout.dim`` = uint32 count of {string label, uint32 size,
+    uint32 stride}, uint32 ``data_offset``, uint32 count of float64 ``data`` aligned to 8 from
+    the end of the header). Raises ValueError for bytes that are not such a message."""
+    if not _raw(msg):
+        return convert.float_array(msg), convert.command_stamp(msg)
+    b = bytes(msg)
+    n = len(b)
+    if n < 12 or b[0] != 0 or b[1] not in (0, 1):
+        raise ValueError("not a CDR-serialised Float64MultiArray")
+    order = "<" if b[1] == 1 else ">"
+    u32 = np.dtype(order + "u4")
+    pos = 4
+
+    def word() -> int:
+        nonlocal pos
+        pos += -(pos - 4) % 4
+        if pos + 4 > n:
+            raise ValueError("Float64MultiArray bytes end inside a field")
+        v = int(np.frombuffer(b, u32, 1, pos)[0])
+        pos += 4
+        return v
+
+    labels = []
+    ndim = word()
+    if ndim > 64:
+        raise ValueError(f"Float64MultiArray with {ndim} layout dimensions")
+    for _ in range(ndim):
+        length = word()
+        if length < 1 or pos + length > n:
+            raise ValueError("Float64MultiArray label runs past the end")
+        labels.append(b[pos:pos + length - 1].decode("utf-8", "replace"))
+        pos += length
+        word()
+        word()
+    word()                                          # data_offset
+    count = word()
+    pos += -(pos - 4) % 8
+    if pos + 8 * count > n:
+        raise ValueError("Float64MultiArray data runs past the end")
+    data = np.frombuffer(b, np.dtype(order + "f8"), count, pos).astype(np.float64)
+    stamp = None
+    if labels and "stamp=" in labels[0]:
+        try:
+            stamp = float(labels[0].split("stamp=", 1)[1])
+        except ValueError:
+            stamp = None
+        if stamp is not None and not np.isfinite(stamp):
+            stamp = None
+    return data, stamp

@@ -19,7 +19,7 @@ ROS parameters: ``description`` (YAML file or text; default CAROCA), ``payload_m
 (N m s/rad), ``motor_inertia`` (kg m^2), ``tension_noise`` (N), ``tension_bias`` [n] (N),
 ``torque_noise`` (N m), ``pose_noise`` (m), ``timestep`` (s; 0 = min(2 ms, 1/rate)), ``rate`` (Hz), ``real_time``,
 ``publish_reference``, ``reference_lead`` (s the published reference runs ahead of the state:
-default one period in real time, 0 in lock-step), ``publish_pose``, ``trajectory_speed`` (time scale of the s-curve),
+default two periods in real time, 0 in lock-step), ``publish_pose``, ``trajectory_speed`` (time scale of the s-curve),
 ``settle`` (s held at A before the trajectory starts), ``duration`` (s of simulated time after
 which the node exits; 0 = run until stopped), ``command_timeout`` (s wall, real time),
 ``lockstep_timeout`` (s wall, lock-step), ``extras_every`` (publish /clock, the measured pose and
@@ -50,6 +50,7 @@ from ....ros.inputs import WARN
 from ....ros.fastspin import drain, poll
 from ....ros.plant_node import PlantNode
 from ....ros.qos import stream_qos
+from ....ros import rawmsg
 from ....ros.rawmsg import RawTemplate
 from ..sim import CdprSim, CdprTruth, default_description_path
 
@@ -87,10 +88,11 @@ class CdprSimNode(PlantNode):
         self.settle = float(p("settle", 1.0).value)
         self.duration = float(p("duration", 0.0).value)
         self.extras_every = max(1, int(p("extras_every", 1).value))
-        # real time: the reference of the next step goes out right after the state (off the
-        # state -> command critical path; the consumers look it up by stamp)
+        # real time: the reference two steps ahead goes out right after the state (off the
+        # state -> command critical path; the consumers look it up by stamp, and a controller
+        # prepares the reference terms of the next stamp while the plant steps)
         lead = float(p("reference_lead", -1.0).value)
-        self.reference_lead = (1.0 / self.rate if self.real_time else 0.0) if lead < 0 else lead
+        self.reference_lead = (2.0 / self.rate if self.real_time else 0.0) if lead < 0 else lead
         self._ref_sent = None
         self.start_gate()
         self.command_timeout = float(p("command_timeout", 0.5).value)
@@ -146,7 +148,7 @@ class CdprSimNode(PlantNode):
             self.get_logger().warning("rt_priority ignored: lock-step mode runs as fast as possible")
         self.use_fast_executor()
         self._templates()
-        cmd = self.create_subscription(Float64MultiArray, "/cdpr/effort_commands", self.on_command, q)
+        cmd = self.create_subscription(Float64MultiArray, "/cdpr/effort_commands", self.on_command, q, raw=True)
         # real time: the commands wait queued until the step that applies them takes them (one
         # wake-up per step, the timer's); lock-step: a command wakes the node (it is the trigger)
         self.polled = [cmd] if self.real_time else []
@@ -195,17 +197,17 @@ class CdprSimNode(PlantNode):
             msg = extra if msg == "ok" else f"{msg}; {extra}"
         return level, msg, values
 
-    def on_command(self, msg: Float64MultiArray) -> None:
-        values = convert.float_array(msg)
+    def on_command(self, msg) -> None:
+        """An effort command (Float64MultiArray or its serialised bytes: the subscription takes
+        bytes, decoded by :func:`~cablelab.ros.rawmsg.command_arrays`)."""
+        try:
+            values, stamp = rawmsg.command_arrays(msg)
+        except ValueError:
+            values, stamp = None, None          # not a command: rejected and counted below
         if self.inputs.accept("effort_commands", values, time.monotonic()):
             self.u = values.copy()
             self.commands += 1
-            self.u_stamp = None
-            if msg.layout.dim and "stamp=" in msg.layout.dim[0].label:
-                try:
-                    self.u_stamp = float(msg.layout.dim[0].label.split("stamp=")[1])
-                except ValueError:
-                    pass
+            self.u_stamp = stamp
 
     def reference(self, t: float):
         """Desired pose/twist/acceleration of the s-curve at sim time t (held at A while
@@ -308,12 +310,12 @@ class CdprSimNode(PlantNode):
         sim, t = self.sim, self.sim.time
         ms = sim.measure()
         extra = self.k % self.extras_every == 0          # /clock, pose and truth: maybe decimated
-        if extra:
-            self.t_clock.stamp(t, "clock")
-            self.pub_clock.publish(self.t_clock.data())
         lead = self.reference_lead
-        if self.publish_reference and (not lead or self._ref_sent is None):
+        if self.publish_reference and not lead:
             self._publish_reference(t)                 # before the state of its stamp
+        elif self.publish_reference and self._ref_sent is None:
+            for i in range(int(round(lead * self.rate))):   # start: every stamp up to the lead
+                self._publish_reference(t + i / self.rate)
         js = self.t_js
         js.stamp(t)
         js["position"][:] = ms["motor_angle"]
@@ -327,7 +329,9 @@ class CdprSimNode(PlantNode):
         self.pub_ten.publish(ten.data())
         if self.publish_reference and lead:
             self._publish_reference(t + lead)          # ahead: waits for the next state
-        if extra:
+        if extra:                                      # after the state: off the controller's path
+            self.t_clock.stamp(t, "clock")
+            self.pub_clock.publish(self.t_clock.data())
             if self.publish_pose:
                 self._pose(self.t_pose, t, ms["position"], ms["quat"])
                 self.pub_pose.publish(self.t_pose.data())
