@@ -176,5 +176,41 @@ def test_stamped_buffer_looks_up_the_newest_sample_not_newer_than_t():
     assert b.at(3e-3) == (pytest.approx(3e-3), 3)          # exact stamp (float rounding tolerated)
     assert b.at(3.5e-3)[1] == 3 and b.at(9.0)[1] == 5        # the newest not newer than t
     assert b.at(0.0)[1] == 2                                 # older than kept: the oldest kept
+    assert b.after(3e-3)[1] == 4 and b.after(3.5e-3)[1] == 4   # the next one after t
+    assert b.after(5e-3) is None and b.after(-1.0)[1] == 2
     b.push(1e-3, 99)                                         # went back in time: restarted
     assert b.newest == pytest.approx(1e-3) and b.at(9.0)[1] == 99
+
+
+def test_scheduling_helpers_apply_to_every_thread():
+    """set_idle_class and set_latency_slice (no privilege) act on every thread of the process
+    they run in, as the kernel reports it in /proc (policy field of stat; se.slice of sched):
+    run in a child process so that this one keeps its scheduling."""
+    import subprocess
+    import sys
+
+    code = r"""
+import os, threading, time
+from cablelab.ros.fastspin import set_idle_class, set_latency_slice
+ev = threading.Event()
+t = threading.Thread(target=ev.wait); t.start()           # a second thread, like DDS's
+print(set_latency_slice(0.0002))
+slices = []
+for tid in os.listdir("/proc/self/task"):
+    for line in open(f"/proc/self/task/{tid}/sched"):
+        if line.startswith("se.slice"):
+            slices.append(int(line.split(":")[1]))
+print("SLICES", slices)
+print(set_idle_class())
+print("POLICY", [int(open(f"/proc/self/task/{tid}/stat").read().rsplit(")", 1)[1].split()[38])
+                 for tid in os.listdir("/proc/self/task")])
+ev.set(); t.join()
+"""
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60).stdout
+    lines = dict(line.split(" ", 1) for line in out.splitlines() if line.startswith(("SLICES", "POLICY")))
+    assert "threads" in out, out
+    assert set(eval(lines["POLICY"])) == {5}          # SCHED_IDLE on every thread
+    if "time slice 0.2 ms on" in out:                 # kernel >= 6.12 (EEVDF custom slices)
+        assert set(eval(lines["SLICES"])) == {200000}
+    else:
+        assert "not available" in out, out

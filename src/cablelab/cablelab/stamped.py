@@ -48,3 +48,11 @@ class StampedBuffer:
             if item[0] <= t + self.tol:
                 return item
         return self._items[0]
+
+    def after(self, t: float):
+        """(stamp, value) of the oldest sample with stamp > t (the next one after t), None when
+        there is none yet."""
+        for item in self._items:
+            if item[0] > t + self.tol:
+                return item
+        return None

@@ -48,6 +48,10 @@ def test_live_controller_equals_batch_law(desc, model):
                             c.drum_radius, c.gear_ratio, cfg.gains)
         got = ctl.update(0.0, q, qd, P[k], quat, v, a)
         np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-9)
+        # the reference terms prepared ahead (before the state is known) + the state part
+        ref = ctl.prepare(0.0, P[k], quat, v, a)
+        np.testing.assert_allclose(ctl.law(ref, q, qd), want, rtol=1e-9, atol=1e-9)
+        assert ctl.law(ref, np.full(8, np.nan), qd) is None and "motor angles" in ctl.status[-1][1]
         W = wrench_matrix(geom)
         got2 = ctl.update(0.0, q, qd, P[k], quat, v, a, geometry=geom, pinv=np.linalg.pinv(W), wrench=W[0])
         np.testing.assert_allclose(got2, want, rtol=1e-7, atol=1e-7)

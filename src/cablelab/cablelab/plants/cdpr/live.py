@@ -251,6 +251,19 @@ class ControllerConfig:
     use_com: bool = True
 
 
+@dataclass(frozen=True)
+class ReferenceTerms:
+    """What :meth:`LiveController.prepare` computed for the reference of stamp ``t``: desired
+    motor angles ``q_des`` (rad) and rates ``qd_des`` (rad/s), feedforward tensions
+    ``tensions_ff`` (N, None for PD) and the status lines of the preparation."""
+
+    t: float
+    q_des: np.ndarray
+    qd_des: np.ndarray
+    tensions_ff: np.ndarray | None
+    status: list
+
+
 @dataclass
 class LiveController:
     """Motor torques from the latest motor state, reference and (optional) live estimate."""
@@ -288,15 +301,24 @@ class LiveController:
         (``geometry``/``pinv``/``wrench``: optional precomputed geometry (one sample), W^+ (1, n, 6)
         and W (6, n) of this reference pose).
 
-        One sample, no batch axis: the IGM q_d = -(R/r) l, the rates q_d' = (R/r) d . v (001
-        eq. 5), the feedforward of 001 eq. 14 and the PD of Fig. 6 (:func:`~.control.pdff_torques`)."""
-        cfg, n, d = self.config, len(self.desc.cables), self.desc
+        One sample, no batch axis: :meth:`prepare` (the reference terms) then :meth:`law` (the
+        motor state terms)."""
+        ref = self.prepare(t, position, quat, velocity, acceleration, geometry, pinv, wrench)
+        return None if ref is None else self.law(ref, q, qdot)
+
+    def prepare(self, t: float, position, quat=None, velocity=None, acceleration=None,
+                geometry=None, pinv=None, wrench=None) -> "ReferenceTerms | None":
+        """The terms of the law that depend on the reference of stamp ``t`` and the live estimate
+        only, not on the measured motor state: the IGM q_d = -(R/r) l, the rates q_d' = (R/r) d . v
+        (001 eq. 5) and the feedforward tensions of 001 eq. 14. A node computes them as soon as
+        the reference of the next stamp is known, off the state -> command path, and :meth:`law`
+        finishes the command when the state arrives. None when the reference is unusable
+        (:attr:`status` says why)."""
+        cfg, d = self.config, self.desc
         self.status = []
-        q, e1 = _finite_vector(q, n, "motor angles")
-        qdot, e2 = _finite_vector(qdot, n, "motor velocities")
         p, e3 = _finite_vector(position, 3, "reference position")
-        if e1 or e2 or e3:
-            self.status.append((ERROR, e1 or e2 or e3))
+        if e3:
+            self.status.append((ERROR, e3))
             return None
         v = _zero_if_bad(velocity)
         a = _zero_if_bad(acceleration)
@@ -325,7 +347,21 @@ class LiveController:
             W = wrench if wrench is not None else _wrench_one(dirs, b)
             t_ff = _feedforward_one(W, m, a, self.gravity, c3, cfg.gains.preload, cfg.gains.min_tension,
                                     None if pinv is None else pinv[0])
-        tau = pdff_torques(q, qdot, q_des, qd_des, t_ff, d.drum_radius, d.gear_ratio, cfg.gains)
+        return ReferenceTerms(t, q_des, qd_des, t_ff, list(self.status))
+
+    def law(self, ref: "ReferenceTerms", q, qdot):
+        """Torques (n,) N m of 001 Fig. 6 (PD on the motor angles + the prepared feedforward and
+        friction compensation, :func:`~.control.pdff_torques`) for the measured motor state, or
+        None when it is unusable (:attr:`status` says why)."""
+        n, d = len(self.desc.cables), self.desc
+        self.status = list(ref.status)
+        q, e1 = _finite_vector(q, n, "motor angles")
+        qdot, e2 = _finite_vector(qdot, n, "motor velocities")
+        if e1 or e2:
+            self.status.append((ERROR, e1 or e2))
+            return None
+        tau = pdff_torques(q, qdot, ref.q_des, ref.qd_des, ref.tensions_ff, d.drum_radius, d.gear_ratio,
+                           self.config.gains)
         if not self.status:
-            self.status.append((OK, "PDFF" if cfg.feedforward else "PD"))
+            self.status.append((OK, "PDFF" if self.config.feedforward else "PD"))
         return tau

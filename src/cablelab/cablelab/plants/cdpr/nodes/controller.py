@@ -84,6 +84,8 @@ class CdprController(PlantNode):
         est_sub = self.create_subscription(InertiaStamped, "/cdpr/payload_estimate", self.on_estimate, q)
         self.create_subscription(JointState, "/cdpr/joint_states", self.on_state, q, raw=True)
         self.pending = None
+        self.prepared = None        # LiveController.ReferenceTerms of the next stamp (prepare_next)
+        self.prepared_used = 0      # commands whose reference terms were prepared ahead
         self.sync_wait = float(p("sync_wait", 0.005).value)
         self.estimate_wait = float(p("estimate_wait", 0.0).value)
         # only a state wakes the node: the reference (published before the state of its stamp)
@@ -128,21 +130,45 @@ class CdprController(PlantNode):
         if not self.inputs.accept("payload_estimate", [m], time.monotonic()):
             self.try_command()
             return
-        if self.controller is not None and not self.controller.estimate(t, m, com[:2]):
-            self.estimates_rejected += 1
+        if self.controller is not None:
+            if self.controller.estimate(t, m, com[:2]):
+                self.prepared = None        # prepared with the previous mass: prepare anew
+            else:
+                self.estimates_rejected += 1
         self.try_command()                  # a state may have been waiting for this estimate
 
     def on_state(self, msg: JointState) -> None:
         """Keep the state (JointState or its serialised bytes); command now if the reference of
         its stamp is here (else a little later, see :meth:`on_timer`: DDS does not order samples
-        across topics)."""
-        drain(*self.polled)         # the reference and estimate that came before it
+        across topics).
+
+        The state -> command path is kept short: when the reference terms of this stamp were
+        prepared after the previous command (:meth:`prepare_next`), the command is the motor-state
+        part of the law only, and the queued reference and estimate are taken afterwards."""
         try:
             state = rawmsg.joint_state_arrays(msg, self.readers["state"])
         except ValueError:
             state = (float("nan"), [], None, None, None)      # rejected by command()
+        ref = self.prepared
+        if ref is None or self.pending is not None or not abs(ref.t - state[0]) <= 1e-9:
+            drain(*self.polled)         # the reference and estimate that came before it
         self.pending = (state, time.monotonic())
         self.try_command()
+        self.prepare_next(state[0])
+
+    def prepare_next(self, t: float) -> None:
+        """Take the queued reference and estimate and prepare the reference terms of the next
+        stamp after ``t`` (:meth:`LiveController.prepare`), off the state -> command path. Not
+        with ``estimate_wait`` (a state waits for the estimate of its own stamp, which is not here
+        yet when the terms would be prepared)."""
+        drain(*self.polled)
+        if self.controller is None or self.estimate_wait > 0 or not np.isfinite(t):
+            return
+        nxt = self.refs.after(t)
+        if nxt is None or (self.prepared is not None and abs(self.prepared.t - nxt[0]) <= 1e-9):
+            return
+        stamp, (pos, quat, vel, acc) = nxt
+        self.prepared = self.controller.prepare(stamp, pos, quat, vel, acc)
 
     def _waiting_for(self, t: float) -> tuple[bool, bool]:
         """(reference of stamp t not here yet, estimate of stamp t awaited and not here yet)."""
@@ -189,8 +215,13 @@ class CdprController(PlantNode):
             self.last_skip = time.monotonic()
             self.last_problem = "no fresh reference: not commanding (brakes hold)"
             return
-        _, (pos, quat, vel, acc) = self.refs.at(t)
-        tau = self.controller.update(t, q, qd, pos, quat, vel, acc)
+        ref = self.prepared
+        stamp, (pos, quat, vel, acc) = self.refs.at(t)
+        if ref is None or not abs(ref.t - t) <= 1e-9 or not abs(stamp - t) <= 1e-9:
+            ref = self.controller.prepare(t, pos, quat, vel, acc)       # not prepared ahead
+        else:
+            self.prepared_used += 1
+        tau = None if ref is None else self.controller.law(ref, q, qd)
         if tau is None:
             self.skipped += 1
             self.last_skip = time.monotonic()
@@ -230,6 +261,7 @@ class CdprController(PlantNode):
             msg = self.last_problem if msg == "ok" else f"{msg}; {self.last_problem}"
         values.update({"mode": "PDFF" if self.feedforward else "PD", "commands": str(self.sent),
                        "skipped": str(self.skipped), "estimates rejected": str(self.estimates_rejected),
+                       "commands prepared ahead": str(self.prepared_used),
                        "feedforward mass kg": "-" if ctl is None or ctl.mass is None else f"{ctl.mass:.1f}"})
         if self.latency:
             values["latency p99 ms"] = f"{1000 * np.percentile(np.asarray(self.latency[-1000:]), 99):.3f}"
