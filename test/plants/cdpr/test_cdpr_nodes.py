@@ -190,3 +190,76 @@ def test_closed_loop_over_dds(launcher, tmp_path):
     sel = gt.t > 2.0
     assert np.abs(gt.position[sel, 2] - z_ref[sel]).max() < 0.005
     assert np.ptp(ref.position[:, 2]) > 0.1                     # it did lift (001 A -> B)
+
+
+def test_controller_prepares_ahead_and_estimator_batches(ros_context):
+    """The 1 kHz fast paths give the same outputs as the plain per-sample laws (the oracle:
+    LiveController.update / LiveEstimator.update on the same inputs): the controller's reference
+    terms prepared after the previous command (reference streamed two periods ahead), a new
+    estimate invalidating them; the estimator's batch mode estimating the newest sample of the
+    period."""
+    from geometry_msgs.msg import InertiaStamped
+    from std_msgs.msg import Float64MultiArray
+
+    from cablelab.plants.cdpr.live import LiveController, LiveEstimator
+    from cablelab.plants.cdpr.nodes.controller import CdprController
+    from cablelab.plants.cdpr.nodes.estimator import CdprPayloadEstimator
+    from cablelab.plants.cdpr.sim import default_description
+    from cablelab.plants.cdpr.trajectory import pick_and_place
+    from cablelab.ros import convert
+
+    desc = default_description()
+    ctl = CdprController()
+    est = CdprPayloadEstimator()
+    sent, estimates = [], []
+    ctl.pub_cmd.publish = _capture(sent, Float64MultiArray)
+    est.pub.publish = _capture(estimates, InertiaStamped)
+    ctl.polled = est.polled = []
+    try:
+        ctl.on_description(convert.string_msg(desc.to_yaml()))
+        est.on_description(convert.string_msg(desc.to_yaml()))
+        oracle = LiveController(desc.cdpr, desc.gravity, ctl.controller.config)
+        dt = 1e-3
+        tt = 2.0 + dt * np.arange(14)
+        tr = pick_and_place(tt)
+        refs = [convert.multidof_msg(t, p, [0, 0, 0, 1.0], v, None, a, None)
+                for t, p, v, a in zip(tt, tr.position, tr.velocity, tr.acceleration)]
+        rng = np.random.default_rng(4)
+        winches = [f"winch_{i}" for i in range(1, 9)]
+        want = []
+        ctl.on_reference(refs[0])
+        ctl.on_reference(refs[1])
+        for k in range(12):
+            if k == 6:      # a new estimate: the terms prepared with the old mass are not used
+                ctl.on_estimate(convert.inertia_msg(tt[k], 600.0, [0.05, -0.02, float("nan")]))
+                oracle.estimate(tt[k], 600.0, np.array([0.05, -0.02]))
+            q, qd = rng.normal(-4000, 30, 8), rng.normal(0, 3, 8)
+            ctl.on_state(convert.joint_state_msg(tt[k], winches, q, qd, np.zeros(8)))
+            ctl.on_reference(refs[k + 2])
+            want.append(oracle.update(tt[k], q, qd, tr.position[k], [1.0, 0, 0, 0], tr.velocity[k],
+                                      tr.acceleration[k]))
+        got = np.array([m.data for m in sent])
+        np.testing.assert_allclose(got, np.array(want), rtol=1e-12, atol=1e-9)
+        # every command but the first and the one after the new estimate used prepared terms
+        assert ctl.prepared_used == 10 and ctl.status()[2]["commands prepared ahead"] == "10"
+
+        # estimator, batch mode: one estimate per poll, of the newest tension sample
+        est.poll_period = 0.01
+        names = [f"cable_{i}" for i in range(1, 9)]
+        ten = rng.uniform(2000, 4000, (3, 8))
+        for k in range(3):
+            est.on_reference(refs[k])
+            est.on_tensions(convert.joint_state_msg(tt[k], names, None, None, ten[k]))
+        assert not estimates
+        est.on_poll()
+        assert len(estimates) == 1 and estimates[0].header.stamp == convert.to_stamp(tt[2])
+        m, com = LiveEstimator(desc.cdpr, desc.gravity, est.config).update(
+            tt[2], tensions=ten[2], position=tr.position[2], quat=np.array([1.0, 0, 0, 0]),
+            acceleration=tr.acceleration[2])
+        assert estimates[0].inertia.m == pytest.approx(m, rel=1e-12)
+        assert [estimates[0].inertia.com.x, estimates[0].inertia.com.y] == pytest.approx(list(com), abs=1e-12)
+        est.on_poll()
+        assert len(estimates) == 1          # nothing new: nothing published
+    finally:
+        ctl.destroy_node()
+        est.destroy_node()

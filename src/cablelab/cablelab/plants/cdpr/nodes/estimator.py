@@ -14,8 +14,9 @@ ROS parameters: ``description``, ``model`` ("II" | "I"), ``tensions`` ("dynamome
 ``viscous`` (friction compensation, N m, N m s/rad), ``pulley_radius`` (m, 0 = the
 description's), ``stale_after`` (s of stamps between tension and pose), ``input_timeout`` (s wall),
 ``poll_period`` (s, default 0: every input sample wakes the node and gives one estimate; > 0:
-batch mode for 1 kHz loops on small machines: the inputs are taken every ``poll_period`` s, every
-sample is estimated and the newest estimate is published, one per period),
+batch mode for 1 kHz loops on small machines: every ``poll_period`` s the newest tension sample
+(its queue keeps only that one) is checked, estimated and published: a ``1/poll_period`` Hz
+estimator on the 1 kHz stream),
 ``fast_executor`` (default true: :class:`cablelab.ros.fastspin.FastExecutor`; false = rclpy's
 SingleThreadedExecutor), ``rt_priority`` (0 = normal scheduling; 1-99 = SCHED_FIFO, see
 :func:`cablelab.ros.fastspin.set_realtime_priority`). The estimate goes out as a pre-serialised message
@@ -76,23 +77,29 @@ class CdprPayloadEstimator(PlantNode):
         self.pub = self.create_publisher(InertiaStamped, "/cdpr/payload_estimate", q)
         self.keep_first_description = True   # the first valid description configures the law
         self.listen_for_description(p("description", "").value)
-        # the pose first: when both wait in one wake-up, a tension sample meets the pose of its
-        # stamp (FastExecutor and rclpy's executor take ready topics in creation order)
-        if self.config.pose == "desired":
-            subs = [self.create_subscription(MultiDOFJointTrajectory, "/cdpr/reference", self.on_reference, q,
-                                             raw=True)]
-        else:
-            subs = [self.create_subscription(PoseStamped, "/cdpr/platform_pose", self.on_pose, q)]
-        if self.config.tensions == "motor":        # (1 kHz of traffic nobody reads otherwise)
-            subs.append(self.create_subscription(JointState, "/cdpr/joint_states", self.on_joints, q, raw=True))
-        else:
-            subs.append(self.create_subscription(JointState, "/cdpr/cable_tensions", self.on_tensions, q, raw=True))
-        # batch mode: the inputs wake nobody; a timer takes what queued every poll_period s,
-        # estimates every sample and publishes the newest estimate (one per period)
+        # batch mode: the inputs wake nobody; a timer takes what queued every poll_period s and
+        # estimates the newest tension sample, one estimate per period. The tension queue keeps
+        # only that newest sample (keep-last 1: the samples in between are overwritten inside
+        # DDS, never decoded in Python) and the pose queue the few stamps around it
         self.poll_period = float(p("poll_period", 0.0).value)
         if self.poll_period < 0 or self.poll_period > 0.1:
             raise CablelabError("payload_estimator: parameter poll_period must be in [0, 0.1] s")
+        q_pose, q_tension = (stream_qos(8), stream_qos(1)) if self.poll_period > 0 else (q, q)
+        # the pose first: when both wait in one wake-up, a tension sample meets the pose of its
+        # stamp (FastExecutor and rclpy's executor take ready topics in creation order)
+        if self.config.pose == "desired":
+            subs = [self.create_subscription(MultiDOFJointTrajectory, "/cdpr/reference", self.on_reference,
+                                             q_pose, raw=True)]
+        else:
+            subs = [self.create_subscription(PoseStamped, "/cdpr/platform_pose", self.on_pose, q_pose)]
+        if self.config.tensions == "motor":        # (1 kHz of traffic nobody reads otherwise)
+            subs.append(self.create_subscription(JointState, "/cdpr/joint_states", self.on_joints, q_tension,
+                                                 raw=True))
+        else:
+            subs.append(self.create_subscription(JointState, "/cdpr/cable_tensions", self.on_tensions, q_tension,
+                                                 raw=True))
         self.newest = None          # (t, m, com) not published yet (batch mode)
+        self.batch_newest = None    # (t, tensions) of the newest input sample of the period (batch mode)
         if self.poll_period > 0:
             for sub in subs:
                 poll(self, sub)
@@ -147,7 +154,7 @@ class CdprPayloadEstimator(PlantNode):
         t, _names, _q, qd, eff = js
         if self.inputs.accept("joint_states", eff, time.monotonic()) and qd is not None:
             self.motor = (t, qd, eff)
-            self.estimate(t, None)
+            self.sample(t, None)
 
     def on_tensions(self, msg: JointState) -> None:
         if self.config.tensions != "dynamometer":
@@ -158,7 +165,16 @@ class CdprPayloadEstimator(PlantNode):
             return
         t, _names, _q, _qd, eff = js
         self.inputs.accept("tensions", eff, time.monotonic())
-        self.estimate(t, eff)
+        self.sample(t, eff)
+
+    def sample(self, t: float, tensions) -> None:
+        """A new input sample: estimated at once, or in batch mode kept as the newest of the
+        period (:meth:`on_poll` estimates that one: the estimate is per sample, 001 eq. 13, so
+        the newest sample alone gives the estimate the period publishes)."""
+        if self.poll_period > 0:
+            self.batch_newest = (t, tensions)
+        else:
+            self.estimate(t, tensions)
 
     # ------------------------------------------------------------------ estimate
     def estimate(self, t: float, tensions) -> None:
@@ -203,8 +219,12 @@ class CdprPayloadEstimator(PlantNode):
         self.published += 1
 
     def on_poll(self) -> None:
-        """Batch mode: estimate every queued sample, publish the newest estimate."""
+        """Batch mode: take every queued sample (each one checked by the input monitor), estimate
+        the newest and publish it."""
         drain(*self.polled)
+        if self.batch_newest is not None:
+            self.estimate(*self.batch_newest)
+            self.batch_newest = None
         if self.newest is not None:
             self.publish_estimate(*self.newest)
             self.newest = None
