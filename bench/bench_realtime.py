@@ -26,6 +26,10 @@ Run it on a quiet machine: ``./run python bench/bench_realtime.py --seconds 60 -
 10-minute soak: ``--seconds 600``). ``--py-spy PATH`` samples the three node processes with
 py-spy and prints each one's share of samples by innermost function (where the time goes);
 ``--publication-mode asynchronous`` runs the nodes with Fast DDS asynchronous publishing.
+Placement without privileges: ``--idle-estimator`` (the estimator in the SCHED_IDLE class),
+``--pin`` (that, plus simulator and estimator on CPU 0, controller on CPU 1), ``--node-params
+JSON`` (any node parameters, e.g. ``'{"sim": {"sched_slice": 0.0001}}'``); the JSON's
+``placement`` says what was used.
 """
 from __future__ import annotations
 
@@ -110,13 +114,17 @@ def profile_summary(path: Path, top: int = 8) -> list[tuple[str, float]]:
 
 #: ``--pin``: the placement a 2-core deployment gives the loop without privileges: the simulator
 #: and the controller on a core each, the estimator (off the state -> command path) beside the
-#: simulator at the lowest priority (nice 19), so that it only takes what the simulator leaves
+#: simulator in the SCHED_IDLE class, so that it only takes what the simulator leaves
 PINNED = {"sim": {"cpu_affinity": [0]}, "controller": {"cpu_affinity": [1]},
-          "estimator": {"cpu_affinity": [0], "niceness": 19}}
+          "estimator": {"cpu_affinity": [0], "sched_idle": True}}
+
+#: ``--idle-estimator``: the estimator (off the state -> command path, its output low-pass
+#: filtered by the controller) in the SCHED_IDLE class, no CPU placement
+IDLE_ESTIMATOR = {"estimator": {"sched_idle": True}}
 
 
 def closed_loop(seconds: float, log, env: dict | None = None, py_spy: str | None = None,
-                pin: bool = False) -> dict:
+                pin: bool = False, extra: dict | None = None, idle_estimator: bool = False) -> dict:
     from bench_cdpr import run_closed_loop
 
     from cablelab.ros.launch import Launcher
@@ -127,7 +135,10 @@ def closed_loop(seconds: float, log, env: dict | None = None, py_spy: str | None
         hook, spies = _py_spy_profiles(py_spy, tmp, max(1.0, min(seconds - 3.0, 30.0)), log)
     with Launcher(log_dir=tmp / "logs", env=env) as launch:
         log(f"ROS_DOMAIN_ID {launch.domain_id}, logs in {launch.log_dir}")
-        r = run_closed_loop(launch, seconds, {}, log, on_started=hook, node_params=PINNED if pin else None)
+        placement = {k: dict(v) for k, v in (PINNED if pin else IDLE_ESTIMATOR if idle_estimator else {}).items()}
+        for k, v in (extra or {}).items():
+            placement.setdefault(k, {}).update(v)
+        r = run_closed_loop(launch, seconds, {}, log, on_started=hook, node_params=placement or None)
     for name, proc in spies:
         proc.wait(timeout=60)
         f = tmp / f"{name}.txt"
@@ -138,7 +149,7 @@ def closed_loop(seconds: float, log, env: dict | None = None, py_spy: str | None
         raise SystemExit("bench_realtime: the simulator never reported on /diagnostics (see the logs)")
     r["rate_hz"] = 1000
     r["rt_priority"] = False
-    r["placement"] = PINNED if pin else None
+    r["placement"] = placement or None
     return r
 
 
@@ -148,8 +159,12 @@ def main(argv=None) -> int:
     bench.parser.add_argument("--repeat", type=int, default=3, help="offline tries, best of (3)")
     bench.parser.add_argument("--skip-loop", action="store_true", help="offline part only")
     bench.parser.add_argument("--pin", action="store_true",
-                              help="place the nodes (no privilege): sim and estimator (nice 19) on CPU 0, "
+                              help="place the nodes (no privilege): sim and estimator (SCHED_IDLE) on CPU 0, "
                                    "controller on CPU 1 (needs >= 2 CPUs)")
+    bench.parser.add_argument("--idle-estimator", action="store_true",
+                              help="run the estimator in the SCHED_IDLE class (no privilege; no CPU placement)")
+    bench.parser.add_argument("--node-params", default=None, metavar="JSON",
+                              help='extra node parameters, e.g. \'{"sim": {"sched_slice": 0.0001}}\'')
     bench.parser.add_argument("--skip-offline", action="store_true", help="closed loop only")
     bench.parser.add_argument("--publication-mode", choices=("synchronous", "asynchronous"), default=None,
                               help="RMW_FASTRTPS_PUBLICATION_MODE for the three nodes (default: rmw's)")
@@ -169,7 +184,8 @@ def main(argv=None) -> int:
             env["RMW_FASTRTPS_PUBLICATION_MODE"] = args.publication_mode.upper()
         if args.transports:
             env["FASTDDS_BUILTIN_TRANSPORTS"] = args.transports
-        r = closed_loop(args.seconds, bench.log, env, args.py_spy, args.pin)
+        r = closed_loop(args.seconds, bench.log, env, args.py_spy, args.pin,
+                        json.loads(args.node_params) if args.node_params else None, args.idle_estimator)
         out["closed_loop"] = {"rate_hz": r["rate_hz"], "seconds": r["seconds"],
                               "realtime_factor": r["realtime_factor"], "missed_cycles": r["missed_cycles"],
                               "p99_ms": r["p99_ms"], "rt_priority": r["rt_priority"],
@@ -188,7 +204,10 @@ def main(argv=None) -> int:
                       unit="", target="<= 3")]
     if "closed_loop" in out:
         c = out["closed_loop"]
-        where = "sim + estimator (nice 19) on CPU 0, controller on CPU 1" if args.pin else "no CPU placement"
+        where = ("sim + estimator (SCHED_IDLE) on CPU 0, controller on CPU 1" if args.pin else
+                 "estimator SCHED_IDLE, no CPU placement" if args.idle_estimator else "no CPU placement")
+        if args.node_params:
+            where += f", node parameters {args.node_params}"
         rows += [dict(case=f"closed loop 1 kHz, 3 processes, no RT priority, {where}, {c['seconds']:.0f} s steady state",
                       value=c["realtime_factor"], unit="x real time", target=">= 0.99"),
                  dict(case="missed cycles (steps braked, late or with a stale command, + dropped)",

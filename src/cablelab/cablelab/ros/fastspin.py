@@ -31,7 +31,7 @@ from __future__ import annotations
 from contextlib import ExitStack
 
 __all__ = ["FastExecutor", "supports", "set_realtime_priority", "set_cpu_affinity", "set_background",
-           "poll", "drain"]
+           "set_latency_slice", "set_idle_class", "poll", "drain"]
 
 
 def set_realtime_priority(priority: int) -> str:
@@ -97,6 +97,65 @@ def set_background(niceness: int) -> str:
     except OSError:
         pass
     return ", ".join(done)
+
+
+def set_idle_class() -> str:
+    """Run every thread of this process (and the threads it starts later) in Linux's SCHED_IDLE
+    class: the scheduler's class for background work, which gets the CPU only when no ordinary
+    task wants it and is preempted at once when one wakes up (a nice-19 task, by contrast, still
+    finishes its time slice first, ~1-4 ms on a 250 Hz kernel). For a node off a 1 kHz loop's
+    critical path, e.g. an estimator whose output is low-pass filtered by its consumer. No
+    privilege is needed. The kernel weighs processes of different sessions as groups
+    (autogroup), so this acts against the loop's processes when they run in one session, as
+    ``ros2 launch`` and :class:`cablelab.ros.launch.Launcher` start them. Returns a one-line
+    result for the log."""
+    import os
+
+    try:
+        tids = [int(t) for t in os.listdir("/proc/self/task")]
+        for tid in tids:
+            os.sched_setscheduler(tid, os.SCHED_IDLE, os.sched_param(0))
+    except (OSError, AttributeError) as exc:
+        return f"SCHED_IDLE not available ({exc})"
+    return f"SCHED_IDLE on {len(tids)} threads"
+
+
+def set_latency_slice(seconds: float) -> str:
+    """Ask Linux's EEVDF scheduler (kernel >= 6.12) for a short time slice, ``seconds`` (0.1-100
+    ms), on every thread of this process (threads started later inherit it). EEVDF gives each
+    runnable task a virtual deadline one slice after it became eligible and runs the earliest
+    deadline first; a task that asks for a short slice gets an early deadline when it wakes and
+    preempts a task running a long (default ~1-3 ms) slice at once, instead of waiting for that
+    slice to end. That is the latency knob of ordinary (SCHED_OTHER) scheduling: no privilege,
+    the task's CPU share (its nice weight) unchanged. For the threads of a 1 kHz loop that wake,
+    work ~0.1-0.3 ms and sleep. Returns a one-line result for the log (or why not: older kernel,
+    not Linux)."""
+    import ctypes
+    import os
+    import platform
+    import struct
+
+    ns = int(round(float(seconds) * 1e9))
+    if ns <= 0:
+        return "default time slice"
+    ns = min(max(ns, 100_000), 100_000_000)
+    nr = {"x86_64": 314, "aarch64": 274}.get(platform.machine())
+    if nr is None or not hasattr(os, "getpriority"):
+        return f"time slice not available on {platform.machine() or platform.system()}"
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        tids = [int(t) for t in os.listdir("/proc/self/task")]
+        for tid in tids:
+            nice = os.getpriority(os.PRIO_PROCESS, tid)
+            # struct sched_attr (VER1, 56 bytes): size, policy SCHED_OTHER, flags, nice, priority,
+            # runtime = the requested slice, deadline, period, util_min, util_max
+            attr = ctypes.create_string_buffer(struct.pack("IIQiIQQQII", 56, 0, 0, nice, 0, ns, 0, 0, 0, 0), 56)
+            if libc.syscall(nr, tid, attr, 0) != 0:
+                err = ctypes.get_errno()
+                return f"time slice not available ({os.strerror(err)})"
+    except (OSError, AttributeError) as exc:
+        return f"time slice not available ({exc})"
+    return f"time slice {ns / 1e6:g} ms on {len(tids)} threads"
 
 
 def poll(node, subscription) -> None:

@@ -150,7 +150,7 @@ class Launcher:
         log_path = self.log_dir / f"{name}.log"
         fh = open(log_path, "wb")
         popen = subprocess.Popen([str(a) for a in argv], stdout=fh, stderr=subprocess.STDOUT,
-                                 env={**self.env, **(env or {})}, start_new_session=True,
+                                 env={**self.env, **(env or {})}, process_group=0,
                                  preexec_fn=_die_with_parent if sys.platform.startswith("linux") else None)
         proc = Process(name, list(argv), popen, log_path, fh)
         self.procs[name] = proc

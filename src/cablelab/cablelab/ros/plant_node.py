@@ -58,9 +58,13 @@ class PlantNode(Node):
         """Parameters ``fast_executor`` (spin with :class:`~cablelab.ros.fastspin.FastExecutor`),
         ``rt_priority`` (SCHED_FIFO priority, 0 = off; needs the privilege), and the placement a
         deployment gives a 1 kHz loop without privileges: ``cpu_affinity`` (CPU numbers the
-        node's threads run on, [] = any) and ``niceness`` (0-19: lower priority for a node off
-        the critical path)."""
-        from .fastspin import set_background, set_cpu_affinity, set_realtime_priority
+        node's threads run on, [] = any), ``niceness`` (0-19: lower priority for a node off
+        the critical path), ``sched_idle`` (run in the SCHED_IDLE class: only on otherwise idle
+        CPU, preempted at once, :func:`~cablelab.ros.fastspin.set_idle_class`) and ``sched_slice``
+        (s, 0 = the kernel's default: a short EEVDF time slice for a node on the critical path,
+        :func:`~cablelab.ros.fastspin.set_latency_slice`)."""
+        from .fastspin import (set_background, set_cpu_affinity, set_idle_class, set_latency_slice,
+                               set_realtime_priority)
 
         self.fast = bool(self.param("fast_executor", default))
         cpus = [int(c) for c in self.param("cpu_affinity", [-1]) if int(c) >= 0]
@@ -69,6 +73,11 @@ class PlantNode(Node):
         nice = int(self.param("niceness", 0))
         if nice > 0:
             self.get_logger().info(f"niceness: {set_background(nice)}")
+        if bool(self.param("sched_idle", False)):
+            self.get_logger().info(f"sched_idle: {set_idle_class()}")
+        slice_s = float(self.param("sched_slice", 0.0))
+        if slice_s > 0:
+            self.get_logger().info(f"sched_slice: {set_latency_slice(slice_s)}")
         rt = int(self.param("rt_priority", 0))
         if rt > 0:
             self.get_logger().info(f"rt_priority: {set_realtime_priority(rt)}")
