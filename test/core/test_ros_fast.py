@@ -136,7 +136,7 @@ def test_polled_subscription_wakes_nobody_and_drains_in_step(ros_context):
     from rclpy.node import Node
     from std_msgs.msg import Float64MultiArray
 
-    from cablelab.ros.fastspin import FastExecutor, drain, poll
+    from cablelab.ros.fastspin import FastExecutor, drain, poll, take_newest
     from cablelab.ros.qos import stream_qos
 
     node = Node("poll_test", start_parameter_services=False)
@@ -162,6 +162,18 @@ def test_polled_subscription_wakes_nobody_and_drains_in_step(ros_context):
     assert drain(*subs) == 40
     assert got == [(k, float(i)) for i in range(20) for k in ("a", "b")]
     assert drain(*subs) == 0
+    # take_newest on a keep-last-1 queue: one take gets the newest sample, then nothing
+    last = []
+    one = node.create_subscription(Float64MultiArray, "/p/a", lambda m: last.append(m.data[0]), stream_qos(1))
+    poll(node, one)
+    while pubs["a"].get_subscription_count() < 2:
+        assert time.monotonic() < deadline, "no intra-process match"
+        time.sleep(0.05)
+    for i in range(5):
+        pubs["a"].publish(Float64MultiArray(data=[float(i)]))
+    time.sleep(0.2)
+    assert take_newest(one) and last == [4.0]
+    assert not take_newest(one) and last == [4.0]
     node.destroy_node()
 
 

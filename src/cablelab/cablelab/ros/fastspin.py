@@ -31,7 +31,7 @@ from __future__ import annotations
 from contextlib import ExitStack
 
 __all__ = ["FastExecutor", "supports", "set_realtime_priority", "set_cpu_affinity", "set_background",
-           "set_latency_slice", "set_idle_class", "poll", "drain"]
+           "set_latency_slice", "set_idle_class", "poll", "drain", "take_newest"]
 
 
 def set_realtime_priority(priority: int) -> str:
@@ -177,6 +177,23 @@ def drain(*subscriptions) -> int:
         for sub in subscriptions:
             stack.enter_context(sub.handle)
         return _take_all([_entry(sub) for sub in subscriptions])
+
+
+def take_newest(subscription) -> bool:
+    """Take one sample of a keep-last-1 ``subscription`` (its queue holds at most the newest
+    sample) and call its callback; True if there was one. One take instead of :func:`drain`'s
+    take-until-empty: each rclpy take costs ~30 us of CPU, an empty one too, which a 1 kHz loop
+    pays on its critical path."""
+    with subscription.handle:
+        h, msg_type, raw, callback, with_info = _entry(subscription)
+        info = h.take_message(msg_type, raw)
+        if info is None:
+            return False
+        if with_info:
+            callback(info[0], info[1])
+        else:
+            callback(info[0])
+        return True
 
 
 def _entry(sub) -> tuple:

@@ -47,7 +47,7 @@ from ..trajectory import pick_and_place
 from ....ros import convert
 from ....rotations import wxyz_to_xyzw
 from ....ros.inputs import WARN
-from ....ros.fastspin import drain, poll
+from ....ros.fastspin import poll, take_newest
 from ....ros.plant_node import PlantNode
 from ....ros.qos import stream_qos
 from ....ros import rawmsg
@@ -148,9 +148,11 @@ class CdprSimNode(PlantNode):
             self.get_logger().warning("rt_priority ignored: lock-step mode runs as fast as possible")
         self.use_fast_executor()
         self._templates()
-        cmd = self.create_subscription(Float64MultiArray, "/cdpr/effort_commands", self.on_command, q, raw=True)
-        # real time: the commands wait queued until the step that applies them takes them (one
-        # wake-up per step, the timer's); lock-step: a command wakes the node (it is the trigger)
+        # real time: the commands wait queued until the step that applies them takes the newest
+        # (one wake-up per step, the timer's; a keep-last-1 queue, so one take); lock-step: a
+        # command wakes the node (it is the trigger)
+        cmd = self.create_subscription(Float64MultiArray, "/cdpr/effort_commands", self.on_command,
+                                       stream_qos(1) if self.real_time else q, raw=True)
         self.polled = [cmd] if self.real_time else []
         for sub in self.polled:
             poll(self, sub)
@@ -235,7 +237,8 @@ class CdprSimNode(PlantNode):
         if not self.real_time:
             self.step_once()
             return
-        drain(*self.polled)
+        for sub in self.polled:
+            take_newest(sub)
         now = time.monotonic()
         if self._wall0 is None:
             self._wall0 = now - self.k / self.rate
