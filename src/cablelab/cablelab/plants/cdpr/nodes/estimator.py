@@ -80,11 +80,12 @@ class CdprPayloadEstimator(PlantNode):
         # batch mode: the inputs wake nobody; a timer takes what queued every poll_period s and
         # estimates the newest tension sample, one estimate per period. The tension queue keeps
         # only that newest sample (keep-last 1: the samples in between are overwritten inside
-        # DDS, never decoded in Python) and the pose queue the few stamps around it
+        # DDS, never decoded in Python) and the pose queue the stamps around it (the newest
+        # tension's and a reference lead of two periods)
         self.poll_period = float(p("poll_period", 0.0).value)
         if self.poll_period < 0 or self.poll_period > 0.1:
             raise CablelabError("payload_estimator: parameter poll_period must be in [0, 0.1] s")
-        q_pose, q_tension = (stream_qos(8), stream_qos(1)) if self.poll_period > 0 else (q, q)
+        q_pose, q_tension = (stream_qos(4), stream_qos(1)) if self.poll_period > 0 else (q, q)
         # the pose first: when both wait in one wake-up, a tension sample meets the pose of its
         # stamp (FastExecutor and rclpy's executor take ready topics in creation order)
         if self.config.pose == "desired":
