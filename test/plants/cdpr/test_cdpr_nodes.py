@@ -52,6 +52,14 @@ def test_adapters_survive_bad_input(ros_context):
             sim.step_once()
         assert np.linalg.norm(sim.sim.truth_pose()[0] - p0) < 0.02 and sim.fallbacks == 100
 
+        # the tabulated reference equals the s-curve, also long after the trajectory ended
+        from cablelab.plants.cdpr.trajectory import pick_and_place
+        for tq in (0.5, 1.0 + 12.345, sim.settle + 60.0 / sim.speed + 0.5, 300.0, 10000.0):
+            tr = pick_and_place(np.array([max(0.0, tq - sim.settle) * sim.speed]))
+            got = sim.reference(tq)
+            np.testing.assert_allclose(got[0], tr.position[0], atol=1e-12)
+            np.testing.assert_allclose(got[1], tr.velocity[0] * sim.speed, atol=1e-12)
+            np.testing.assert_allclose(got[2], tr.acceleration[0] * sim.speed ** 2, atol=1e-12)
         ms, t = sim.sim.measure(), sim.sim.time
         names = [f"cable_{i}" for i in range(1, 9)]
         ref = convert.multidof_msg(t, sim.reference(t)[0], [0, 0, 0, 1.0], [0, 0, 0], None, [0, 0, 0], None)
