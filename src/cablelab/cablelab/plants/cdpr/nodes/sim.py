@@ -199,7 +199,7 @@ class CdprSimNode(PlantNode):
             msg = extra if msg == "ok" else f"{msg}; {extra}"
         return level, msg, values
 
-    def on_command(self, msg) -> None:
+    def on_command(self, msg: Float64MultiArray) -> None:
         """An effort command (Float64MultiArray or its serialised bytes: the subscription takes
         bytes, decoded by :func:`~cablelab.ros.rawmsg.command_arrays`)."""
         try:
