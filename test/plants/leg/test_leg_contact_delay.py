@@ -119,3 +119,16 @@ def test_bag_and_contract_json(delayed, tmp_path):
     top = out["ranking"][0]
     assert top["effect"] == "contact_delay" and top["significant"]
     assert top["params"]["tau_c"] == pytest.approx(DELAY, abs=1e-3)
+
+
+def test_greedy_from_the_no_impact_baseline(delayed):
+    """From 003's model without the impact map (the plant's default baseline) greedy adds the impact
+    map, then contact_delay, and no proxy (README, 'Effect contact_delay')."""
+    from cablelab.workbench import diagnose
+
+    _, ds = delayed
+    out = diagnose(ds, Model("leg", effects.BASELINE), effects.BASELINE + effects.CANDIDATES,
+                   greedy_mode=True).to_json()
+    assert [s["added"] for s in out["greedy"][1:]] == ["impact_restitution", "contact_delay"]
+    assert out["final"]["params"]["tau_c"] == pytest.approx(DELAY, abs=1e-3)
+    assert out["greedy"][-1]["error"] < 0.3 * out["greedy"][0]["error"]

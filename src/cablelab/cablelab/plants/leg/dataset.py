@@ -9,7 +9,11 @@ moved to one side. With s = contact (1 stance), f = 1 - s:
 
 The velocity jump of eq. 24 is an impulse in the measured acceleration; its regressor is the
 event's pre-impact velocity as a step, passed through the same filter and derivative as the
-height (exact by linearity). Every signal (y and all regressor bases) goes through the same
+height (exact by linearity). The stance acceleration ``zdd s`` (effect ``phase_effective_mass``:
+stance inertia m_s against the weighed mass m_f, ``m_s zdd + m_f g`` in stance) is the second
+derivative of the height gained in stance ``D = int zdot s dt`` (the same filter and derivatives
+as the height) less the jumps of ``zdot s`` at the edges (post-impact velocity at touch-down,
+pre-lift-off velocity at lift-off, as steps): no impact impulse is counted as stance inertia. Every signal (y and all regressor bases) goes through the same
 zero-phase low-pass ("parallel filtering"), so the switched terms and the impulses are smeared
 identically on both sides. Regimes: phase (stance / flight) and time to the nearest transition.
 """
@@ -45,7 +49,7 @@ def _event_steps(t, z, contact, adv: float, vcache: dict) -> dict[str, np.ndarra
     interpolation of the switch in :meth:`LegRecords.build`). The pre-impact velocity is fitted
     on the 12 samples before the moved edge (cached by that sample in ``vcache``)."""
     n_idx = np.arange(len(z), dtype=float)
-    steps = {"touchdown": np.zeros_like(z), "liftoff": np.zeros_like(z)}
+    steps = {"touchdown": np.zeros_like(z), "liftoff": np.zeros_like(z), "touchdown_post": np.zeros_like(z)}
     for a, _, ph in phase_runs(contact)[1:]:
         a_true = a - adv                       # first sample at or after the true transition
         j = int(np.ceil(a_true - 1e-9)) - 1    # last sample before it
@@ -53,7 +57,13 @@ def _event_steps(t, z, contact, adv: float, vcache: dict) -> dict[str, np.ndarra
             continue
         if j not in vcache:
             vcache[j] = start_state(t, z, j, 12, 2, forward=False)[1]
-        steps["touchdown" if ph == 1 else "liftoff"] += vcache[j] * np.clip(n_idx - (a_true - 1.0), 0.0, 1.0)
+        ramp = np.clip(n_idx - (a_true - 1.0), 0.0, 1.0)
+        steps["touchdown" if ph == 1 else "liftoff"] += vcache[j] * ramp
+        if ph == 1 and j + 13 <= len(z):       # post-impact velocity: fit on the 12 samples after
+            key = ("post", j)
+            if key not in vcache:
+                vcache[key] = start_state(t, z, j + 1, 12, 2, forward=True)[1]
+            steps["touchdown_post"] += vcache[key] * ramp
     return steps
 
 
@@ -125,16 +135,23 @@ class LegRecords:
             f_in = s * b["tau_over"]
             ev = _event_steps(t, z, s_raw.astype(int), adv, b["vcache"])
             e = b["e"]
+            # height gained in stance, D = int zdot s dt (an edge interval counts half)
+            dz = np.diff(np.asarray(z, float)) * 0.5 * (s[1:] + s[:-1])
+            d_st = np.concatenate([[0.0], np.cumsum(dz)])
             # every phase-dependent basis through the same zero-phase low-pass in one call
             raw_cols = np.stack([f_in + s * b["k"] * e, b["zd_raw"] * s, b["zd_raw"] * (1 - s), s,
                                  1 - s, b["k"] * e**2 * s, b["k"] * e**3 * s, np.sign(b["zd"]),
-                                 ev["touchdown"], ev["liftoff"]], axis=1)
+                                 ev["touchdown"], ev["liftoff"], d_st,
+                                 ev["touchdown_post"] - ev["liftoff"]], axis=1)
             f = lowpass(raw_cols, fs, cut, ORDER)
             acc = b["zdd"] + g
+            dt = 1.0 / fs
+            # zdd s: d2/dt2 of the filtered D minus the filtered jumps of zdot s at the edges
+            acc_stance = np.gradient(np.gradient(f[:, 10], dt) - f[:, 11], dt)
             parts.append({
                 "y": f[:, 0], "acc": acc, "zd_stance": f[:, 1], "zd_flight": f[:, 2], "stance": f[:, 3],
                 "flight": f[:, 4], "e2": f[:, 5], "e3": f[:, 6], "sign": f[:, 7],
-                "acc_flight": acc * (1 - s), "impulse_td": np.gradient(f[:, 8], 1.0 / fs),
+                "acc_stance": acc_stance, "impulse_td": np.gradient(f[:, 8], 1.0 / fs),
                 "impulse_lo": np.gradient(f[:, 9], 1.0 / fs), "z": np.asarray(z, float), "zd": b["zd"],
                 "contact": s, "f_in": f_in, "phase": np.where(s > 0.5, "stance", "flight"),
                 "transition": np.where(_time_to_edge(s, fs) < 0.02, "within 20 ms of a transition",

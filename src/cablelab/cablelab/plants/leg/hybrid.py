@@ -2,11 +2,15 @@
 
 State x = [z, zdot]: body (CoM) height above the ground (m) and its rate (m/s).
 
-* Stance (003 eq. 1): ``m zdd = F_in + F_s(z) - d_s zdot - m g`` with the spring force
+* Stance (003 eq. 1): ``m zdd = F_in + F_s(z) - d_s zdot - m_f g`` with the spring force
   ``F_s = k (z_0 - z) (1 + k_2 (z_0 - z) + k_3 (z_0 - z)^2) + F_0`` (003 eq. 1 is ``k (z_0 - z)``;
   ``F_0``, ``k_2``, ``k_3`` are the candidate effects ``spring_preload`` / ``spring_nonlinearity``,
   zero in the nominal model).
 * Flight (003 eq. 23): ``m_f zdd = -d_f zdot - m_f g`` (``m_f = m`` unless ``phase_effective_mass``).
+  ``m_f`` is the leg's mass (what a scale weighs: gravity acts on it in both phases); ``m`` is
+  the stance inertia, which the link rotation raises above ``m_f`` (003 sec. 3.4, E9). Flight
+  alone only sees ``d_f / m_f``; the two masses differ visibly in stance, where the inertia
+  ``m`` multiplies zdd and the weight ``m_f g`` does not.
 * Input (003 eq. 3): ``F_in = tau / (2 L sin theta)`` with ``cos theta = z / 2L`` (eq. 2), i.e.
   ``F_in = tau / sqrt(4 L^2 - z^2)``.
 * Ground reaction force (003 eq. 25): ``F_GRF = F_in + F_s(z) - d_s zdot``.
@@ -39,12 +43,12 @@ class LegParams:
     """Hybrid model parameters (SI). Defaults: 003 Table 2, k = 605 N/m (sec. 3.3), spec 003 sec. 2.
 
     Args:
-        m: lumped mass (stance), kg. k: equivalent vertical stiffness, N/m.
+        m: lumped mass (stance inertia), kg. k: equivalent vertical stiffness, N/m.
         d_s, d_f: stance / flight damping, N s/m. beta_td, beta_lo: velocity ratios (eq. 24).
         g: gravity, m/s^2. L: link length, m (spec E2). theta0: free-length half angle, rad.
         z0: spring rest position, m (None = z_td). F0: spring preload at z0, N.
         k2, k3: cam nonlinearity, 1/m and 1/m^2. Fc: guide Coulomb friction, N.
-        m_f: flight mass, kg (None = m).
+        m_f: the leg's (weighed) mass: flight inertia and weight in both phases, kg (None = m).
     """
 
     m: float = 1.55
@@ -98,8 +102,8 @@ def stance_zeta(p: LegParams) -> float:
 
 
 def static_deflection(p: LegParams) -> float:
-    """Static spring deflection m g / k, m (stance equilibrium ``z_eq = z_0 - m g / k`` at F_0 = 0)."""
-    return p.m * p.g / p.k
+    """Static spring deflection m_f g / k, m (stance equilibrium ``z_eq = z_0 - m_f g / k`` at F_0 = 0)."""
+    return p.flight_mass * p.g / p.k
 
 
 # ----------------------------------------------------------------------------- forces
@@ -129,8 +133,8 @@ def grf(z, zd, f_in, p: LegParams):
 
 
 def stance_accel(z, zd, f_in, p: LegParams):
-    """zdd in stance (003 eq. 1), m/s^2."""
-    return (grf(z, zd, f_in, p) - p.Fc * _sign(zd)) / p.m - p.g
+    """zdd in stance (003 eq. 1; the weight ``m_f g`` over the stance inertia ``m``), m/s^2."""
+    return (grf(z, zd, f_in, p) - p.Fc * _sign(zd)) / p.m - p.g * (p.flight_mass / p.m)
 
 
 def flight_accel(zd, p: LegParams):

@@ -87,7 +87,8 @@ def run_reference(p: LegParams, z0: float, zd0: float, duration: float, T: float
 
             def rhs(tt, y):
                 fi = f_in(tt, y[0], td)
-                return [y[1], (fi + spring(y[0]) - p.d_s * y[1] - p.Fc * np.sign(y[1])) / m - g]
+                # stance inertia m, weight m_f g (the link rotation adds inertia, not weight)
+                return [y[1], (fi + spring(y[0]) - p.d_s * y[1] - p.Fc * np.sign(y[1]) - mf * g) / m]
 
             def lo_grf(tt, y):
                 return f_in(tt, y[0], td) + spring(y[0]) - p.d_s * y[1]
@@ -144,7 +145,7 @@ def sampled_trajectory(p: LegParams, z0: float, zd0: float, duration: float, T: 
     sampled; 0.09 mm encoder, differentiated velocity, contact switch ``contact_delay`` s late) as
     a :class:`~cablelab.plants.leg.sim.Trajectory`: data for tests that the MuJoCo code did not
     generate. ``schedule``, ``block_s``: as :func:`run_reference`."""
-    from .sim import Trajectory, measure
+    from .sim import Event, Trajectory, measure
 
     ref = run_reference(p, z0, zd0, duration, T, P, schedule=schedule, block_s=block_s)
     pair = schedule_lookup(schedule, block_s, T, P)
@@ -159,5 +160,7 @@ def sampled_trajectory(p: LegParams, z0: float, zd0: float, duration: float, T: 
     tau = np.where(ph == 1, Tn * np.sin(2 * np.pi * (t - t_d) / Pn), 0.0)
     f_in = np.where(ph == 1, tau / np.sqrt(np.maximum(4 * p.L**2 - z * z, 1e-12)), 0.0)
     g = np.where(ph == 1, f_in + p.k * (p.spring_rest - z) + p.F0 - p.d_s * zd, 0.0)
-    traj = Trajectory(t, z, zd, ph, tau, f_in, g, [])
+    events = [Event(float(e[0]), e[1], float(e[2]), float(e[3]), float(e[4]))
+              for e in ref.events if e[1] != "apex"]
+    traj = Trajectory(t, z, zd, ph, tau, f_in, g, events)
     return measure(traj, resolution=resolution, contact_delay=contact_delay, seed=seed)

@@ -125,7 +125,8 @@ class LegSim:
     def _phase_force(self, z: float, zd: float) -> float:
         p = self.p
         if self.phase == STANCE:
-            return spring_force(z, p) - p.d_s * zd - (p.Fc * ((zd > 0) - (zd < 0)) if p.Fc else 0.0)
+            return spring_force(z, p) - p.d_s * zd - (p.Fc * ((zd > 0) - (zd < 0)) if p.Fc else 0.0) \
+                + (p.m - p.flight_mass) * p.g   # MuJoCo's weight is m g; the leg's is m_f g
         # flight: MuJoCo applies -m g with the stance mass m; this force gives the zdd of eq. 23
         return p.m * (flight_accel(zd, p) + p.g)
 
@@ -174,7 +175,8 @@ class LegSim:
                 stance, zd0 = False, float(v[0])
         if stance:
             d.ctrl[0] = f_in
-            d.qfrc_applied[0] = base - (p.Fc * ((zd0 > 0) - (zd0 < 0)) if p.Fc else 0.0)
+            d.qfrc_applied[0] = base - (p.Fc * ((zd0 > 0) - (zd0 < 0)) if p.Fc else 0.0) \
+                + (p.m - p.flight_mass) * p.g   # weight m_f g, not MuJoCo's m g
         else:
             self.f_in = 0.0
             g0 = z0 - self.l_fl                               # touch-down guard
