@@ -50,7 +50,7 @@ TWO = [("joint_coulomb_friction", "torque_sensor_offset"), ("joint_coulomb_frict
        ("counterbalance", "joint_coulomb_friction"), ("base_tilt", "torque_sensor_offset"),
        ("joint_coulomb_friction", "time_delay")]
 #: joint ranges of the reference moves: slew rad, luff rad, rope length m
-LIMITS = ((-1.2, 1.2), (0.15, 1.1), (0.4, 0.9))
+LIMITS = ((-1.2, 1.2), (0.15, 1.1), (0.3, 1.2))
 KP, KD = np.array([30.0, 40.0, 400.0]), np.array([10.0, 12.0, 40.0])
 
 
