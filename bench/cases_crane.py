@@ -29,8 +29,8 @@ The payload is a weighed calibration mass in every case (``--fix m=..``, the des
 the hoist force ``m (g cos.. - d_ddot) + OF[hoist]`` is nearly collinear with m (hoist accelerations
 are a few % of g) and m carries into the luff gravity torque, so OF[luff], OF[hoist] came out up to
 110 % wrong with the ranking flagging them "confounded with m" (correlation -0.99). The hoist
-chirps reach 0.15 m (0.06 m before: about 0.1 m/s, where the hoist's viscous and Coulomb terms
-are below its force noise). ``base_tilt`` is scored on its two angles (tilt_x = -g_y / g,
+moves over 0.3-1.2 m of rope and its chirps reach 0.15 m (before: 0.4-0.9 m and 0.06 m, about
+0.1 m/s in the chirps, where the hoist's viscous and Coulomb terms are below its force noise). ``base_tilt`` is scored on its two angles (tilt_x = -g_y / g,
 tilt_y = g_x / g of gravity in the base frame).
 ``time_delay``: the recorded efforts are the motor commands of ``tau`` earlier (10-30 ms at
 100/200 Hz): the 1 kHz command sequence is interpolated at ``t - tau`` here, the joint positions
