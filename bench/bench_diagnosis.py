@@ -108,12 +108,17 @@ def run_plant_case(case, gen, workdir: str) -> dict:
     final = out["final"]["params"]
     perr = {h: (rel_param_error(final, case.true_params[h]) if h in added else np.inf)
             for h in case.hidden if h in case.true_params}
+    # |fitted - true| / quoted standard error per true parameter (coverage of the stderr)
+    se = out["final"].get("stderr") or {}
+    zerr = {h: [abs(final[k] - v) / se[k] for k, v in case.true_params[h].items()
+                if k in final and se.get(k) and np.isfinite(se[k]) and se[k] > 0]
+            for h in perr if h in added}
     # hidden effects whose parameters the diagnosis itself flags as confounded with another
     # parameter (step-0 ranking, "identifiability"): their values are not determined by the record
     conf = {r["effect"] for r in out["ranking"] if (r.get("identifiability") or {}).get("confounded")}
     return {**fields, "top": first["effect"] if first else "none", "confounded": conf,
             "top_sig": first["effect"] if first and first.get("significant") else "none",
-            "added": added, "perr": perr, "seconds": secs, "n": ds.n,
+            "added": added, "perr": perr, "zerr": zerr, "seconds": secs, "n": ds.n,
             "candidates": tuple(plant.candidates(desc))}
 
 
@@ -261,10 +266,12 @@ def summarise(bench, results) -> None:
                   and h in r.get("confounded", ())]
             clear = np.array([r["perr"][h] for r in ok if r["plant"] == p and h in r["perr"]
                               and np.isfinite(r["perr"][h]) and h not in r.get("confounded", ())])
+            z = np.array([v for r in ok if r["plant"] == p for v in r.get("zerr", {}).get(h, [])])
             bench.row(plant=p, effect=h, cases=e.size, median=f"{100 * np.median(e):.2f} %",
                       p95=f"{100 * np.percentile(e, 95):.2f} %", max=f"{100 * np.max(e):.1f} %",
                       flagged_confounded=len(fl) if p != "axis" else "-",
-                      p95_not_flagged=f"{100 * np.percentile(clear, 95):.2f} %" if clear.size and p != "axis" else "-")
+                      p95_not_flagged=f"{100 * np.percentile(clear, 95):.2f} %" if clear.size and p != "axis" else "-",
+                      **{"|err| < 2 stderr": f"{100 * np.mean(z < 2):.0f} % of {z.size}" if z.size else "-"})
     # by case family
     bench.section("top-1 / exact greedy set by case family")
     fam = Counter(r["family"] for r in ok)

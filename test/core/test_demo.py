@@ -50,12 +50,13 @@ def test_tilt_for_rest_torque_gives_002_offset_in_mujoco(params):
 
 @pytest.mark.parametrize("alpha,beta", [(0.0, 0.5), (0.7, 0.3), (-2.0, -0.2)])
 def test_rest_torque_of_fitted_tilt_matches_mujoco(params, alpha, beta):
-    """The rest torque the demo reads off the fitted base_tilt parameters (K g_x, K g_y) equals the
-    torque MuJoCo needs to hold the tilted crane, for a tilt about both axes and any pose."""
+    """The rest torque the demo reads off the fitted base_tilt angles (tilt_x = -g_y / g,
+    tilt_y = g_x / g) equals the torque MuJoCo needs to hold the tilted crane, for a tilt about
+    both axes and any pose."""
     truth = CraneTruth(params=params, base_tilt=(-0.04, 0.03))
     g = gravity_in_base(truth)
-    fitted = {"tilt_a": params.first_moment * g[0], "tilt_b": params.first_moment * g[1]}
-    assert demo_crane.rest_torque(fitted, alpha, beta) == pytest.approx(
+    fitted = {"tilt_x": -g[1] / params.gravity, "tilt_y": g[0] / params.gravity}
+    assert demo_crane.rest_torque(fitted, params.first_moment, params.gravity, alpha, beta) == pytest.approx(
         slew_torque_at_rest(truth, alpha, beta), abs=1e-9)
 
 

@@ -52,10 +52,10 @@ def test_diagnose_ranks_base_tilt_first(tilted):
     best = d.ranking[0]
     assert best["effect"] == "base_tilt" and best["significant"]
     assert best["error_after"] < 0.1 * best["error_before"]
-    # its parameters are the tilt's gravity moments: K g_y and m g_y (002 sec. 6.5)
+    # its parameters are the tilt angles: tilt_x = -g_y / g, tilt_y = g_x / g = 0 (002 sec. 6.5)
     g = gravity_in_base(CraneTruth(params=P, base_tilt=(TILT_X, 0.0)))
-    assert best["params"]["tilt_b"] == pytest.approx(P.first_moment * g[1], rel=0.05)
-    assert best["params"]["tilt_pb"] == pytest.approx(P.payload_mass * g[1], rel=0.05)
+    assert best["params"]["tilt_x"] == pytest.approx(-g[1] / P.gravity, rel=0.02)
+    assert abs(best["params"]["tilt_y"]) < 0.02 * abs(TILT_X)
 
 
 def test_base_tilt_makes_identified_parameters_physical_again(tilted):

@@ -35,9 +35,13 @@ def tilt_for_rest_torque(first_moment: float, gravity: float, torque: float = PA
     return -float(np.arcsin(-torque / np.cos(beta) / first_moment / gravity))
 
 
-def rest_torque(params: dict, alpha: float = 0.0, beta: float = REST_LUFF) -> float:
-    """Slew torque at rest (N m) implied by fitted ``base_tilt`` parameters tilt_a, tilt_b (N m)."""
-    return float(np.cos(beta) * (params["tilt_a"] * np.sin(alpha) - params["tilt_b"] * np.cos(alpha)))
+def rest_torque(params: dict, first_moment: float, gravity: float, alpha: float = 0.0,
+                beta: float = REST_LUFF) -> float:
+    """Slew torque at rest (N m) implied by fitted ``base_tilt`` angles tilt_x, tilt_y (rad) of a
+    crane with boom-side first moment K (kg m): cos(beta) K g (tilt_y sin(alpha) + tilt_x cos(alpha))
+    (002 sec. 6.5; g_x = g tilt_y, g_y = -g tilt_x)."""
+    return float(np.cos(beta) * first_moment * gravity
+                 * (params["tilt_y"] * np.sin(alpha) + params["tilt_x"] * np.cos(alpha)))
 
 
 def run_nodes(out: Path, duration: float, domain: int, tilt: float) -> Path:
@@ -184,8 +188,9 @@ def analyse(out: Path, bag_dir: Path, *, folds: int = 5) -> PartResult:
     steps = rep["steps"]
     ranking = steps[0]["ranking"]
     tilt_step = next((s for s in steps if s["added"] == "base_tilt"), None)
-    fitted = rest_torque(tilt_step["params"]) if tilt_step else float("nan")
-    true_rest = rest_torque({"tilt_a": 0.0, "tilt_b": params.first_moment * params.gravity * np.sin(-tilt)})
+    K, g = params.first_moment, params.gravity
+    fitted = rest_torque(tilt_step["params"], K, g) if tilt_step else float("nan")
+    true_rest = rest_torque({"tilt_x": np.sin(tilt), "tilt_y": 0.0}, K, g)
     final, nominal, nan = steps[-1]["params"], steps[0]["params"], float("nan")
     deg = np.degrees
     rows = [

@@ -12,12 +12,17 @@ parameters:
   separable least squares) behind the luff pivot (002 sec. 3.1, 6.4): ``l_c^2 Y_lc2mc + l_c Y_lcmc``.
   With m_b free, (m_b, m_c, l_c) has one unidentifiable direction (002 sec. 5.3.2: rank 6):
   fix m_b or l_c (``--fix``) to read m_c and l_c; the fit itself is unaffected.
-* ``base_tilt``: the slew axis tilted from the vertical (002 sec. 6.5). Gravity in the base frame
-  has horizontal components (g_x, g_y); the weight of the boom side (moment K = l_b m + l_b m_b/2
-  - l_c m_c) and of the swinging payload then load the slew joint (and luff, hoist), see
-  :func:`tilt_columns`: ``slew = cos(beta) (a sin(alpha) - b cos(alpha)) + payload terms``, linear
-  in a = K g_x, b = K g_y (N m) and m g_x, m g_y (N); tilt angle ~ hypot(g_x, g_y) / g. At rest
-  it is the slew torque offset 002 measured (-0.2 N m). The vertical-gravity change is second order.
+* ``base_tilt``: the slew axis tilted from the vertical (002 sec. 6.5), parameters the two small
+  rotations of the base about world x and y, ``tilt_x``, ``tilt_y`` (rad; exactly -g_y / g and
+  g_x / g of gravity in the base frame, the first-order tilt angles). Gravity in the base frame
+  then has horizontal components (g_x, g_y) = g (tilt_y, -tilt_x); the weight of the boom side
+  (moment K = l_b m + l_b m_b/2 - l_c m_c) and of the swinging payload load the slew joint (and
+  luff, hoist), see :func:`tilt_columns`: ``slew = cos(beta) (K g_x sin(alpha) - K g_y cos(alpha))
+  + payload terms``. K and m are the KNOWN masses of the description (:func:`tilt_masses`): the
+  tilt is two angles, not four free loads, because the payload's load ``m g_x`` alone is barely
+  excited (swing angles of a few degrees) and as a free parameter it carried 10-20 % standard
+  errors on the diagnosis benchmark (bench/cases_crane.py). At rest it is the slew torque offset
+  002 measured (-0.2 N m). The vertical-gravity change is second order.
 """
 from __future__ import annotations
 
@@ -111,16 +116,44 @@ COUNTERBALANCE = register(Effect(
     regressor=_cb,
 ))
 
+
+def tilt_masses(desc) -> tuple[float, float, float]:
+    """(K kg m, m kg, g m/s^2) that scale the base tilt: the boom-side first moment
+    K = l_b m + l_b m_b / 2 - l_c m_c and the payload mass m of the description (missing masses:
+    :class:`CraneParams` defaults; no counterbalance: m_c = 0). The description's, not the fitted
+    ones: the regressor must not change between the fit and the prediction (a weighed payload and
+    the described boom are what a tilt calibration uses; a wrong described K scales the angles)."""
+    from .model import CraneParams
+
+    p = CraneParams.from_description(desc) if desc is not None else CraneParams()
+    return p.first_moment, p.payload_mass, p.gravity
+
+
+def tilt_angle_columns(q: np.ndarray, first_moment: float, payload_mass: float,
+                       gravity: float = 9.81) -> np.ndarray:
+    """(N, 3, 2) base-tilt regressor in the angles [tilt_x, tilt_y] (rad, rotation of the base
+    about world x, y): g_x = g tilt_y, g_y = -g tilt_x in :func:`tilt_columns` weighted by K and m."""
+    c = tilt_columns(q)
+    gx = first_moment * c[:, :, 0] + payload_mass * c[:, :, 2]     # per unit g_x
+    gy = first_moment * c[:, :, 1] + payload_mass * c[:, :, 3]     # per unit g_y
+    return gravity * np.stack([-gy, gx], axis=2)
+
+
+def _tilt(ds: Dataset) -> np.ndarray:
+    K, m, g = tilt_masses(ds.description)
+    return tilt_angle_columns(ds.require_signal("q"), K, m, g)
+
+
 BASE_TILT = register(Effect(
     id="base_tilt",
     plants=("crane",),
-    params=(Param("tilt_a", "N m", 0.0, -np.inf, np.inf, "K g_x: boom-side moment x horizontal gravity along x"),
-            Param("tilt_b", "N m", 0.0, -np.inf, np.inf, "K g_y: boom-side moment x horizontal gravity along y"),
-            Param("tilt_pa", "N", 0.0, -np.inf, np.inf, "m g_x: payload weight along x in the base frame"),
-            Param("tilt_pb", "N", 0.0, -np.inf, np.inf, "m g_y: payload weight along y in the base frame")),
+    params=(Param("tilt_x", "rad", 0.0, -np.inf, np.inf,
+                  "base rotation about world x (= -g_y / g in the base frame)"),
+            Param("tilt_y", "rad", 0.0, -np.inf, np.inf,
+                  "base rotation about world y (= g_x / g in the base frame)")),
     explanation="the slew axis is not vertical, so the weight of the boom side loads the slew "
                 "joint with a torque that depends on the slew angle",
     signature="slew torque offset at rest that changes with alpha like cos/sin(alpha)",
-    reference="002 sec. 6.5 (-0.2 N m at rest)",
-    regressor=lambda ds: tilt_columns(ds.require_signal("q")),
+    reference="002 sec. 6.5 (-0.2 N m at rest); K, m: the described masses",
+    regressor=_tilt,
 ))

@@ -30,7 +30,7 @@ _COORDS = ("alpha", "beta", "d", "theta1", "theta2")
 
 def truth_from_params(params: dict, description) -> "object":
     """A :class:`cablelab.plants.crane.sim.CraneTruth` from identified workbench parameters by name
-    (``I_tot, I_b, m, m_b, m_c, l_c, tilt_pa, tilt_pb, Fv[...], Fc[...]``; missing = description
+    (``I_tot, I_b, m, m_b, m_c, l_c, tilt_x, tilt_y, Fv[...], Fc[...]``; missing = description
     or 0)."""
     from .sim import CraneTruth
 
@@ -43,11 +43,9 @@ def truth_from_params(params: dict, description) -> "object":
                     gravity=base.gravity)
     if p.boom_mass + p.counterbalance_mass <= 0:
         p = p.replace(boom_mass=1e-6)
-    g = p.gravity
-    gx = float(params.get("tilt_pa", 0.0)) / p.payload_mass
-    gy = float(params.get("tilt_pb", 0.0)) / p.payload_mass
-    ey = float(np.arcsin(np.clip(gx / g, -0.5, 0.5)))
-    ex = -float(np.arcsin(np.clip(gy / (g * np.cos(ey)), -0.5, 0.5)))
+    # base_tilt: tilt_y = g_x / g = sin(ey), tilt_x = -g_y / g = cos(ey) sin(ex) (sim.gravity_in_base)
+    ey = float(np.arcsin(np.clip(float(params.get("tilt_y", 0.0)), -0.5, 0.5)))
+    ex = float(np.arcsin(np.clip(float(params.get("tilt_x", 0.0)) / np.cos(ey), -0.5, 0.5)))
     visc = tuple(pos(f"Fv[{j}]", 0.0) for j in JOINTS)
     coul = tuple(pos(f"Fc[{j}]", 0.0) for j in JOINTS)
     return CraneTruth(params=p, base_tilt=(ex, ey), viscous=visc, coulomb=coul, timestep=1e-3)

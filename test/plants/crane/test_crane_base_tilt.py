@@ -1,0 +1,103 @@
+"""``base_tilt`` as two angles (002 sec. 6.5) against two oracles that are not its columns:
+the potential of the horizontal gravity differentiated numerically through the crane kinematics,
+and the MuJoCo crane on a tilted base holding still with the payload at its equilibrium."""
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+import pytest
+from scipy.optimize import root
+
+from cablelab.description import load_description
+from cablelab.model import Dataset
+from cablelab.plants.crane import kinematics as kin
+from cablelab.plants.crane import plant as C
+from cablelab.plants.crane.effects import BASE_TILT, tilt_masses
+from cablelab.plants.crane.model import CraneParams, gravity_vector
+from cablelab.plants.crane.sim import CraneTruth, build_model, gravity_in_base, set_state
+
+DESC = load_description(C.__file__.replace("plant.py", "data/crane.yaml"))
+P = CraneParams.from_description(DESC)
+
+
+def _effect(q: np.ndarray, tilt_x: float, tilt_y: float) -> np.ndarray:
+    """(N, 3) slew, luff, hoist contribution of base_tilt at the angles, through the registered effect."""
+    ds = Dataset(plant="crane", t=np.arange(len(q), dtype=float), y=np.zeros((len(q), 3)),
+                 channels=("slew", "luff", "hoist"), units=("N m", "N m", "N"),
+                 signals={"q": q}, description=DESC)
+    return BASE_TILT.regressor(ds) @ np.array([tilt_x, tilt_y])
+
+
+def _horizontal_potential(q: np.ndarray, gx: float, gy: float) -> np.ndarray:
+    """V = -(g_x, g_y) . sum_i m_i r_i over boom (centre l_b / 2), counterbalance (-l_c) and payload."""
+    tip = kin.boom_tip(q[:, 0], q[:, 1], P.boom_length)
+    pay = kin.payload_position(q[:, 0], q[:, 1], q[:, 2], q[:, 3], q[:, 4], P.boom_length)
+    r = (P.boom_mass * 0.5 - P.counterbalance_mass * P.counterbalance_distance / P.boom_length) * tip \
+        + P.payload_mass * pay
+    return -(gx * r[:, 0] + gy * r[:, 1])
+
+
+def test_tilt_masses_are_the_described_first_moment_and_payload():
+    K, m, g = tilt_masses(DESC)
+    assert K == pytest.approx(P.boom_length * (P.payload_mass + P.boom_mass / 2)
+                              - P.counterbalance_distance * P.counterbalance_mass, rel=1e-12)
+    assert (m, g) == (P.payload_mass, P.gravity)
+
+
+def test_columns_are_the_gradient_of_the_horizontal_gravity_potential():
+    """Effort to hold = dV/dq for slew, luff, hoist at random poses with swing (central differences
+    of the kinematics' positions; g_x = g tilt_y, g_y = -g tilt_x)."""
+    rng = np.random.default_rng(3)
+    q = np.column_stack([rng.uniform(-3, 3, 20), rng.uniform(-0.2, 1.2, 20), rng.uniform(0.3, 1.5, 20),
+                         rng.uniform(-0.3, 0.3, 20), rng.uniform(-0.3, 0.3, 20)])
+    tx, ty = 0.031, -0.022
+    gx, gy = P.gravity * ty, -P.gravity * tx
+    h = 1e-6
+    grad = np.empty((20, 3))
+    for j in range(3):
+        e = np.zeros(5)
+        e[j] = h
+        grad[:, j] = (_horizontal_potential(q + e, gx, gy) - _horizontal_potential(q - e, gx, gy)) / (2 * h)
+    np.testing.assert_allclose(_effect(q, tx, ty), grad, atol=1e-7 * np.abs(grad).max())
+
+
+@pytest.mark.parametrize("tilt,alpha,beta", [((-0.04, 0.03), 0.0, 0.5), ((0.02, -0.05), 1.1, 0.2),
+                                             ((0.035, 0.0), -2.3, 0.9)])
+def test_mujoco_tilted_crane_at_rest_matches_the_angles(tilt, alpha, beta):
+    """The MuJoCo crane on a base rotated by ``tilt`` (about world x, y), held at rest with the
+    payload in its equilibrium: slew torque = the effect at tilt_x = -g_y / g, tilt_y = g_x / g
+    exactly (the vertical gravity gives no slew torque); luff torque = vertical-gravity model +
+    effect up to the second-order change of the vertical gravity."""
+    truth = CraneTruth(params=P, base_tilt=tilt)
+    model = build_model(truth)
+    data = mujoco.MjData(model)
+    d = 0.6
+
+    def bias(sw):
+        set_state(model, data, [alpha, beta, d, sw[0], sw[1]])
+        return data.qfrc_bias.copy()
+
+    sw = root(lambda s: bias(s)[2:4], [0.0, 0.0], tol=1e-14).x
+    b = bias(sw)
+    assert np.abs(b[2:4]).max() < 1e-10
+    g = gravity_in_base(truth)
+    tx, ty = -g[1] / P.gravity, g[0] / P.gravity
+    q = np.array([[alpha, beta, d, sw[0], sw[1]]])
+    pred = gravity_vector(q, P)[0, :3] + _effect(q, tx, ty)[0]
+    assert abs(b[0]) > 0.05                         # the tilt really loads the slew joint
+    assert pred[0] == pytest.approx(b[0], abs=1e-9)
+    second_order = (P.payload_mass + P.boom_mass + P.counterbalance_mass) * P.gravity * np.hypot(*tilt) ** 2
+    assert abs(pred[1] - b[1]) < second_order
+    # the untilted model misses the whole (first-order) slew torque
+    assert abs(gravity_vector(q, P)[0, 0] - b[0]) > 100 * abs(pred[0] - b[0])
+
+
+def test_free_run_truth_takes_the_fitted_angles():
+    """The free-run simulator built from fitted parameters (freerun.truth_from_params) gets back the
+    base rotation whose gravity the angles describe."""
+    from cablelab.plants.crane.freerun import truth_from_params
+
+    tilt = (0.045, -0.03)
+    g = gravity_in_base(CraneTruth(params=P, base_tilt=tilt))
+    truth = truth_from_params({"tilt_x": -g[1] / P.gravity, "tilt_y": g[0] / P.gravity}, DESC)
+    np.testing.assert_allclose(truth.base_tilt, tilt, atol=1e-12)
