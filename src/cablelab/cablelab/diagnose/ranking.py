@@ -34,7 +34,7 @@ from ..fit.threads import blas_single
 from ..model import Dataset, Model
 from .localise import derived_regimes, residual_by_regime
 from .metrics import nrmse  # noqa: F401  (re-exported name used by older callers)
-from .score import channel_nrmse, heldout_error, lr_significance
+from .score import channel_nrmse, heldout_error, lr_significance, significant as _significant
 
 #: default number of folds, significance level, guard band (fraction of samples per side)
 FOLDS = 5
@@ -224,7 +224,8 @@ def rank_candidates(model: Model, ds: Dataset, candidates, *, folds: int = FOLDS
     fold_indices(ds.n, folds)  # fail early on too few samples
     prog = _Progress(len(cands) + 1, "diagnose", quiet)
     base_full = identify(model, ds)
-    err0, _, _ = cv_error(model, ds, folds, start=base_full.params)
+    err0, ym0, yh0 = cv_error(model, ds, folds, start=base_full.params)
+    nrmse0 = channel_nrmse(ym0, yh0)
     regimes = derived_regimes(ds)
     y_ref = base_full.residual + base_full.y_hat
     by_regime0 = residual_by_regime(base_full.residual, y_ref, regimes, ds.channels)
@@ -241,14 +242,19 @@ def rank_candidates(model: Model, ds: Dataset, candidates, *, folds: int = FOLDS
             prog.step(c)
             continue
         sig = lr_significance(base_full, full, len(cands), alpha)
-        significant = bool(sig["passes"] and err1 < (1.0 - min_gain) * err0)
+        nrmse1 = channel_nrmse(ym1, yh1)
+        significant, rule = _significant(sig, nrmse0, nrmse1, len(cands), alpha, min_gain)
         own = full.effect_params(c, ds)
         row = {"effect": c, "error_before": err0, "error_after": err1, "params": own,
                "stderr": {k: full.stderr.get(k, 0.0) for k in own},
                "units": {k: full.units.get(k, "") for k in own},
                "significant": significant, "p_value": sig["p_value"], "delta_bic": sig["delta_bic"],
                "n_eff": sig["n_eff"], "gain": 1.0 - err1 / err0 if err0 > 0 else 0.0,
-               "channels": dict(zip(ds.channels, map(float, channel_nrmse(ym1, yh1))))}
+               "channels": dict(zip(ds.channels, map(float, nrmse1))),
+               "channel_gain": dict(zip(ds.channels, map(float, rule["channel_gain"]))),
+               "channel_p": dict(zip(ds.channels, map(float, sig["channel_p"]))),
+               "significant_by": (None if rule["by"] is None else "geometric mean"
+                                  if rule["by"] == "mean" else ds.channels[rule["best_channel"]])}
         from .identifiability import confounding, describe
 
         row["identifiability"] = confounding(full, list(own))
@@ -257,6 +263,11 @@ def rank_candidates(model: Model, ds: Dataset, candidates, *, folds: int = FOLDS
         row["evidence"] = _evidence(by_regime0, residual_by_regime(full.residual, y_ref, regimes,
                                                                   ds.channels))
         row["explanation"] = explain(c, own, row["stderr"], row["units"], err0, err1, significant)
+        if significant and rule["by"] == "channel":
+            ch = rule["best_channel"]
+            row["explanation"] += (f"; significant on {ds.channels[ch]} by its own evidence: "
+                                   f"{100 * rule['channel_gain'][ch]:.0f} % of its held-out NRMSE, "
+                                   f"p = {sig['channel_p'][ch]:.2g}")
         if significant and row["evidence"]:
             ev = row["evidence"]
             row["explanation"] += (f"; largest drop where {ev['regime']} is {ev['label']} "
