@@ -7,12 +7,15 @@ held-out error. A candidate is *significant* when
 
 1. it removes at least ``MIN_GAIN`` (5 %) of the model's held-out error (practical
    significance: smaller gains are reported with their p-value but not worth a new physical
-   effect; on EMPS a -0.3 ms "delay", a third of a sample, gains 3 % and is left out), and
-2. a nested-model F-test on the full-data fits rejects "no gain" at ``alpha / m`` (Bonferroni over
-   the m candidates), with the sample count replaced by the effective number of independent
-   samples ``n_eff = n (1 - r1) / (1 + r1)`` (r1 = lag-1 autocorrelation of the residual; a
-   filtered, oversampled residual is far from white and would otherwise make every effect
+   effect; on EMPS a -0.3 ms "delay", a third of a sample, gains 3 % and is left out), in the
+   geometric mean over channels or on one channel by that channel's own likelihood-ratio test
+   at ``alpha / (m C)``, and
+2. the per-channel likelihood-ratio test on the full-data fits rejects "no gain" at ``alpha / m``
+   (Bonferroni over the m candidates), each channel's sample count replaced by its effective
+   number of independent samples (spectral, :func:`~cablelab.diagnose.score.effective_sample_size`;
+   a filtered, oversampled residual is far from white and would otherwise make every effect
    "significant"). The BIC difference on ``n_eff`` is reported alongside.
+   :func:`~cablelab.diagnose.score.significant` is the rule.
 
 The greedy mode adds the best significant candidate, re-ranks, and stops when none is
 significant; its steps are the waterfall baseline -> +effect 1 -> +effect 2.
