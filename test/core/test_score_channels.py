@@ -119,3 +119,30 @@ def test_coloured_noise_control_on_six_channels_is_not_significant():
     # the spectral n_eff keeps the LR test near its level on 2 Hz-filtered noise, neither
     # anti-conservative (naive n) nor useless (AR(1): p < 0.05 would almost never happen)
     assert 0.01 <= small_p / len(seeds) <= 0.10
+
+
+def _sig(channel_p, passes=True):
+    return {"passes": passes, "channel_p": np.asarray(channel_p, float)}
+
+
+def test_rule_needs_the_joint_test_the_channel_level_and_no_channel_much_worse():
+    before = np.array([0.10, 0.10, 0.10, 0.10, 0.10, 0.10])
+    after = np.array([0.08, 0.10, 0.10, 0.10, 0.10, 0.10])       # 20 % on one channel, 3.7 % mean
+    p = [1e-6, 0.5, 0.5, 0.5, 0.5, 0.5]
+    ok, d = significant(_sig(p), before, after, n_candidates=5)
+    assert ok and d["by"] == "channel" and d["best_channel"] == 0
+    assert d["gain"] == pytest.approx(1 - 0.8 ** (1 / 6))
+    assert not significant(_sig(p, passes=False), before, after, n_candidates=5)[0]
+    # the channel's own p must pass alpha / (m C) = 0.01 / 30, not only alpha / m
+    assert not significant(_sig([1e-3] + p[1:]), before, after, n_candidates=5)[0]
+    # another channel 10 % worse on held-out data: not significant
+    worse = after.copy()
+    worse[3] = 0.11
+    assert not significant(_sig(p), before, worse, n_candidates=5)[0]
+    # a channel without a signal (NaN) does not count, neither as evidence nor as a channel
+    ok, d = significant(_sig([1e-6, 0.5, 0.5, 0.5, 0.5, np.nan]), np.r_[before[:5], np.nan],
+                        np.r_[after[:5], np.nan], n_candidates=5)
+    assert ok and d["gain"] == pytest.approx(1 - 0.8 ** (1 / 5))
+    # one channel: the rule is the plain 5 % of its NRMSE
+    assert not significant(_sig([1e-9]), [0.1], [0.0960])[0]
+    assert significant(_sig([1e-9]), [0.1], [0.0940])[0]
