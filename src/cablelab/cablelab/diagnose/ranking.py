@@ -255,14 +255,16 @@ def rank_candidates(model: Model, ds: Dataset, candidates, *, folds: int = FOLDS
                "n_eff": sig["n_eff"], "gain": 1.0 - err1 / err0 if err0 > 0 else 0.0,
                "channels": dict(zip(ds.channels, map(float, nrmse1))),
                "channel_gain": dict(zip(ds.channels, map(float, rule["channel_gain"]))),
-               "channel_p": dict(zip(ds.channels, map(float, sig["channel_p"]))),
-               "significant_by": (None if rule["by"] is None else "geometric mean"
-                                  if rule["by"] == "mean" else ds.channels[rule["best_channel"]])}
+               "channel_p": dict(zip(ds.channels, map(float, sig["channel_p"])))}
+        if rule["by"] is not None:
+            row["significant_by"] = ("geometric mean" if rule["by"] == "mean"
+                                     else ds.channels[rule["best_channel"]])
         from .identifiability import confounding, describe
 
         row["identifiability"] = confounding(full, list(own))
         if not row["identifiability"]["identifiable"]:
             significant = row["significant"] = False
+            row.pop("significant_by", None)
         row["evidence"] = _evidence(by_regime0, residual_by_regime(full.residual, y_ref, regimes,
                                                                   ds.channels))
         row["explanation"] = explain(c, own, row["stderr"], row["units"], err0, err1, significant)
