@@ -176,6 +176,14 @@ def _regimes(arr: CdprArrays) -> dict:
     return {"motion": lab}
 
 
+def model_wrench_matrix(W: np.ndarray, S: np.ndarray, description) -> np.ndarray:
+    """The wrench matrix of the nominal model, (N, 6, n): Model II at the described sheave radius
+    ``W_I + r_p S`` (exact at r_p = the description's, 001 eq. 6-9), else Model I. Cable-side
+    terms (dynamometer offsets, winch friction) reach the wrench through it."""
+    r = description.cdpr.pulley_radius if description is not None and description.cdpr is not None else 0.0
+    return W + r * S if r > 0 else W
+
+
 def torque_balance(arr: CdprArrays) -> np.ndarray:
     """(N, n) per-winch torque balance, N: ``(R/r) tau_i - d_i``, the motor torque tau_i (N m)
     brought to the cable side minus the dynamometer reading d_i (N).
@@ -220,6 +228,7 @@ def dataset_from_arrays(arr: CdprArrays, description, source: str = "data",
     W2 = wrench_matrix(cable_geometry(c.exit_points, c.anchor_points, pos, R, r_ref, c.swivel_axes))
     S = (W2 - W) / r_ref                               # d(W)/d(r_p), motion side
     slope = np.einsum("tij,tj->ti", S, t)
+    W_model = model_wrench_matrix(W, S, description)
     n = t.shape[1]
     act_scale = np.full(n, arr.scale if arr.source in ("motor", "both") else 1.0)
     unit = "N m" if arr.source in ("motor", "both") else "N"
@@ -227,7 +236,7 @@ def dataset_from_arrays(arr: CdprArrays, description, source: str = "data",
     sig = {"tensions": t, "position": pos, "R": R, "acc": arr.acc[sl], "W": W, "pulley_slope": slope,
            "pulley_S": S, "act_scale": act_scale, "velocity": arr.velocity[sl]}
     channels, units = CHANNELS, UNITS
-    act_map = W * act_scale[None, None, :]
+    act_map = W_model * act_scale[None, None, :]
     if arr.source == "both":
         mask = balance_mask(qd)
         bal = torque_balance(arr)[sl] * mask
