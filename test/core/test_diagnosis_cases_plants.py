@@ -65,8 +65,8 @@ def test_crane_control_nothing_significant(tmp_path):
     _assert_control(_diagnose(cases_crane, case, tmp_path))
 
 
-# CDPR: dynamometers + torque balance with the sheaves left out of the description; motor torques
-# alone with winch friction
+# CDPR: dynamometers + torque balance (--tensions both): sheaves left out of the description, winch
+# friction
 def test_cdpr_hidden_pulleys_found_with_the_sheave_radius(tmp_path):
     case = _case(cases_cdpr, 11, "one", duration=30.0)
     assert case.hidden == ("pulley_geometry",) and case.options["tensions"] == "both"
@@ -74,11 +74,13 @@ def test_cdpr_hidden_pulleys_found_with_the_sheave_radius(tmp_path):
 
 
 def test_cdpr_hidden_winch_coulomb_from_motor_torques(tmp_path):
+    # motor torques against the dynamometers (--tensions both, as the benchmark reads them); the
+    # motor torques alone see the friction through W only (its internal-force null space is
+    # invisible): on this seed 17 % with the exact Model II columns, test_cdpr_torque_balance.py
     case = _case(cases_cdpr, 1, "one", duration=30.0)
     case.fs = 100.0
-    assert case.hidden == ("winch_coulomb_friction",)
-    case.options = {"tensions": "motor"}        # the motor torques alone (the cases read both)
-    _assert_found(_diagnose(cases_cdpr, case, tmp_path), case, rel=0.10)
+    assert case.hidden == ("winch_coulomb_friction",) and case.options["tensions"] == "both"
+    _assert_found(_diagnose(cases_cdpr, case, tmp_path), case, rel=0.03)
 
 
 def test_cdpr_control_nothing_significant(tmp_path):

@@ -99,3 +99,17 @@ def test_both_needs_the_motor_torques(tmp_path):
     cases_cdpr.write_bag(case, tmp_path / "nomotor", rec)
     with pytest.raises(CablelabError, match="--tensions both.*no motor torques"):
         workbench.load(tmp_path / "nomotor", None, {"tensions": "both"})
+
+
+def test_motor_tension_friction_goes_through_the_model_ii_matrix(tmp_path):
+    """--tensions motor, noise-free benchmark case 3014 (Coulomb winch friction, described sheaves):
+    the friction acts on the cables, so it reaches the wrench through W_II = W_I + r_p S like the
+    tensions do. With the Model I matrix (the old columns) F_c came out 6 % off on exact data."""
+    case = cases_cdpr.draw_case(3014)
+    assert case.hidden == ("winch_coulomb_friction",) and "r_p" in case.fixed
+    case.truth.update(duration=20.0, noise_rel=np.full(8, 1e-7), outlier_rate=0.0)
+    cases_cdpr.write_bag(case, tmp_path / "motor")
+    plant, desc, ds = workbench.load(tmp_path / "motor", None, {"tensions": "motor"})
+    model = workbench.build_model(plant, desc, case.effects + ("winch_coulomb_friction",), fixed=case.fixed)
+    fit = identify(model, ds)
+    assert rel_param_error(fit.params, case.true_params["winch_coulomb_friction"]) < 0.005
