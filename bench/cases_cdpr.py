@@ -17,10 +17,16 @@
   cable; the reference topic carries the platform pose, twist and acceleration (the platform is
   assumed to track it); 100 Hz (CAROCA) or 200 Hz.
 
+Every bag carries both tension measurements (dynamometers and motor torques), and every case is
+diagnosed with ``--tensions both``: the six wrench channels from the dynamometers plus the
+per-winch torque balance ``(R/r) tau_i - d_i`` (``cablelab.plants.cdpr.plant.torque_balance``),
+where each dynamometer offset and each winch's friction has a channel of its own (with the wrench
+alone the offsets' two-dimensional internal-force component is invisible at each pose).
+
 Hidden effects (from ``cablelab.plants.cdpr.plant.candidates``): ``pulley_geometry`` (sheaves in
 the truth, not in the description), ``tension_sensor_offset``, ``winch_coulomb_friction`` and
-``winch_viscous_friction`` (these two are read from the motor torques, ``--tensions motor``, where
-friction is visible; dynamometers do not see it), ``platform_inertia`` (not in the nominal model),
+``winch_viscous_friction`` (seen by the motor torques, not by the dynamometers),
+``platform_inertia`` (not in the nominal model),
 ``time_delay`` (dynamometers and motor torques read the truth of ``tau`` = 10-30 ms earlier: the
 whole chain reference -> tensions -> torques is evaluated at ``t - tau``, while the winch angles
 and the reference topic are not delayed);
@@ -61,8 +67,11 @@ def draw_case(seed: int, kind: str | None = None) -> PlantCase:
         kind = str(rng.choice(["control", "one", "two"], p=[0.2, 0.5, 0.3]))
     hidden = () if kind == "control" else (ONE[rng.integers(len(ONE))] if kind == "one"
                                            else TWO[rng.integers(len(TWO))])
-    source = "motor" if (any(h in MOTOR for h in hidden) or (kind == "control" and rng.random() < 0.4)) \
-        else "dynamometer"
+    # (drawn as in the first version of this generator so the seeds keep their cases; every bag
+    # carries both sensors and every case is now diagnosed with --tensions both, see the docstring)
+    if not any(h in MOTOR for h in hidden) and kind == "control":
+        rng.random()
+    source = "both"
     m = rng.uniform(400.0, 900.0)
     r_p = rng.uniform(0.08, 0.22)
     t_mean = m * G / 8 / 0.6                     # mean cable tension, N (cables ~37 deg from vertical)

@@ -65,18 +65,22 @@ def test_crane_control_nothing_significant(tmp_path):
     _assert_control(_diagnose(cases_crane, case, tmp_path))
 
 
-# CDPR: dynamometers with the sheaves left out of the description; motor torques with winch friction
+# CDPR: dynamometers + torque balance (--tensions both): sheaves left out of the description, winch
+# friction
 def test_cdpr_hidden_pulleys_found_with_the_sheave_radius(tmp_path):
     case = _case(cases_cdpr, 11, "one", duration=30.0)
-    assert case.hidden == ("pulley_geometry",) and case.options["tensions"] == "dynamometer"
+    assert case.hidden == ("pulley_geometry",) and case.options["tensions"] == "both"
     _assert_found(_diagnose(cases_cdpr, case, tmp_path), case, rel=0.10)
 
 
 def test_cdpr_hidden_winch_coulomb_from_motor_torques(tmp_path):
+    # motor torques against the dynamometers (--tensions both, as the benchmark reads them); the
+    # motor torques alone see the friction through W only (its internal-force null space is
+    # invisible): on this seed 17 % with the exact Model II columns, test_cdpr_torque_balance.py
     case = _case(cases_cdpr, 1, "one", duration=30.0)
     case.fs = 100.0
-    assert case.hidden == ("winch_coulomb_friction",) and case.options["tensions"] == "motor"
-    _assert_found(_diagnose(cases_cdpr, case, tmp_path), case, rel=0.10)
+    assert case.hidden == ("winch_coulomb_friction",) and case.options["tensions"] == "both"
+    _assert_found(_diagnose(cases_cdpr, case, tmp_path), case, rel=0.03)
 
 
 def test_cdpr_control_nothing_significant(tmp_path):
@@ -135,5 +139,6 @@ def test_crane_hidden_time_delay_found_with_tau_and_its_stderr(tmp_path):
 
 def test_cdpr_hidden_time_delay_found_with_tau_and_its_stderr(tmp_path):
     case = _case(cases_cdpr, 55, "one", duration=30.0)
-    assert case.hidden == ("time_delay",) and case.fs == 200.0 and case.options["tensions"] == "dynamometer"
+    assert case.hidden == ("time_delay",) and case.fs == 200.0
+    case.options = {"tensions": "dynamometer"}  # the dynamometers alone (the cases read both)
     _assert_delay(_diagnose(cases_cdpr, case, tmp_path), case)

@@ -19,9 +19,10 @@ sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "..", "be
 import cases_cdpr  # noqa: E402
 
 
-def _fit_tau(tmp_path, monkeypatch=None, hook=True):
+def _fit_tau(tmp_path, monkeypatch=None, hook=True, tensions="dynamometer"):
     case = cases_cdpr.draw_case(13, "one")            # point-to-point moves, 200 Hz, dynamometers
-    assert case.hidden == ("time_delay",) and case.family == "ptp dynamometer"
+    assert case.hidden == ("time_delay",) and case.family == "ptp both"
+    case.options = {"tensions": tensions}
     case.truth.update(duration=20.0, noise_rel=np.full(8, 1e-5), outlier_rate=0.0)
     path = tmp_path / "cdpr_delay"
     cases_cdpr.write_bag(case, path)
@@ -43,3 +44,11 @@ def test_cdpr_delay_recovered_sub_sample_with_remeasure(tmp_path):
 def test_cdpr_delay_biased_when_w_is_shifted_with_the_motion(tmp_path, monkeypatch):
     tau, _, true, _ = _fit_tau(tmp_path, monkeypatch, hook=False)
     assert abs(tau - true) > 0.2 * true, (tau, true)
+
+
+def test_cdpr_delay_recovered_with_the_torque_balance_channels(tmp_path):
+    """--tensions both: the balance channels (measured against measured, both delayed alike) keep
+    their samples and rest mask under the shift; the wrench is re-formed at t - tau as above."""
+    tau, se, true, dt = _fit_tau(tmp_path, tensions="both")
+    assert abs(tau - true) < 0.02 * true, (tau, true)
+    assert 0.0 < se < 0.02 * true

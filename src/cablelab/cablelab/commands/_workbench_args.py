@@ -26,8 +26,9 @@ def add_overwrite(p) -> None:
 
 
 def add_tensions(p) -> None:
-    p.add_argument("--tensions", choices=("dynamometer", "motor"), default="dynamometer",
-                   help="CDPR: cable tensions from the dynamometers or from the motor torques")
+    p.add_argument("--tensions", choices=("dynamometer", "motor", "both"), default="dynamometer",
+                   help="CDPR: cable tensions from the dynamometers, from the motor torques, or both "
+                        "(dynamometer wrench + per-winch torque balance against the motor torques)")
 
 
 def add_json(p) -> None:

@@ -9,6 +9,20 @@ wrench matrix W at the desired (or measured) pose. The model explains it as (001
           + W (R/r) (F_c sign(qdot) + F_v qdot)             (winch friction, motor tensions only)
           + W b                                             (tension_sensor_offset, dynamometers)
 
+The friction and offset terms act on the cables, so they reach the wrench through the model's
+wrench matrix: W_II(r_p) = W_I + r_p S (below) with pulleys. Their columns use the described sheave
+radius (:func:`cablelab.plants.cdpr.plant.model_wrench_matrix`, exact when the model's r_p is the described one); when r_p is
+fitted (pulleys not described) the second-order term (r_p - r_desc) S b is left out.
+
+With ``--tensions both`` (dynamometers and motor torques in the bag) the dataset adds one
+torque-balance channel per winch, ``(R/r) tau_i - d_i`` (N; tau_i the motor torque, d_i the
+dynamometer reading), modelled as (001 eq. 15 minus the dynamometer reading t_i + b_i)
+
+    (R/r) tau_i - d_i = (R/r) (F_c,i sign(qdot_i) + F_v,i qdot_i) - b_i
+
+while winch i moves (zeroed in its zero-speed zone); the wrench channels then come from the
+dynamometers and carry no friction. The weight, inertia and sheave terms are 0 on these channels.
+
 ``pulley_geometry`` is the switch from Model I (point exits, the dataset's W) to Model II (001
 eq. 6-9). The measured channels stay W_I t (so every candidate is scored on the same data) and the
 pulleys enter as W_I t = w_model - r_p S t, S = (W_II(r_ref) - W_I) / r_ref the secant slope of
@@ -28,6 +42,15 @@ from ...effects.friction import coulomb_regressor, stribeck_effect, viscous_regr
 PULLEY_BOUNDS = (0.0, 0.4)
 
 
+def _wrench_only(ds: Dataset, blk: np.ndarray) -> np.ndarray:
+    """A (N, 6, p) wrench-channel block padded with zeros for the torque-balance channels of a
+    ``--tensions both`` dataset (the weight, inertia and sheaves do not enter the balance)."""
+    extra = ds.n_channels - blk.shape[1]
+    if extra <= 0:
+        return blk
+    return np.concatenate([blk, np.zeros((blk.shape[0], extra, blk.shape[2]))], axis=1)
+
+
 def _gravity(ds: Dataset) -> np.ndarray:
     g = ds.gravity
     n = ds.n
@@ -40,24 +63,36 @@ def _gravity(ds: Dataset) -> np.ndarray:
     out[:, :3, 0] = up
     out[:, 3:, 1] = cross(ex, up)
     out[:, 3:, 2] = cross(ey, up)
-    return out
+    return _wrench_only(ds, out)
 
 
 def _inertia(ds: Dataset) -> np.ndarray:
     a = ds.require_signal("acc")
     out = np.zeros((ds.n, 6, 1))
     out[:, :3, 0] = a
-    return out
+    return _wrench_only(ds, out)
 
 
 def _pulley(ds: Dataset) -> np.ndarray:
     # W_I t = w_model - r_p S t with S = (W(r_ref) - W(0)) / r_ref (the dataset's "pulley_slope"):
     # exact at r_p = r_ref, second order in (r_p - r_ref) elsewhere
-    return -ds.require_signal("pulley_slope")[:, :, None]
+    return _wrench_only(ds, -ds.require_signal("pulley_slope")[:, :, None])
 
 
 def _tension_offset(ds: Dataset) -> np.ndarray:
-    return ds.require_signal("W")
+    # wrench channels: W b; torque-balance channels ((R/r) tau_i - d_i, --tensions both): -b_i
+    # while winch i moves (the channel is zeroed at rest, see plants.cdpr.plant.balance_mask)
+    from .plant import model_wrench_matrix
+
+    W = model_wrench_matrix(ds.require_signal("W"), ds.require_signal("pulley_S"), ds.description)
+    mask = ds.signals.get("balance_mask")
+    if mask is None:
+        return W
+    n = mask.shape[1]
+    bal = np.zeros((ds.n, n, n))
+    idx = np.arange(n)
+    bal[:, idx, idx] = -mask
+    return np.concatenate([W, bal], axis=1)
 
 
 CDPR_GRAVITY = register(Effect(

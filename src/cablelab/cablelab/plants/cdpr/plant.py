@@ -44,7 +44,8 @@ class CdprArrays:
         t: (N,) s; tensions: (N, n) raw tensions, N (dynamometer, or R/r * motor torque);
         motor_velocity: (N, n) rad/s; position (N, 3), R (N, 3, 3) or None (level), acc (N, 3):
         the pose used for W and its acceleration; velocity (N, 3); truth_mass: kg or None;
-        truth_com: (2,) or None; source: "dynamometer" or "motor"; scale: R/r (1/m).
+        truth_com: (2,) or None; source: "dynamometer", "motor" or "both" (tensions from the
+        dynamometers, motor torques kept in ``motor_effort`` for the torque balance); scale: R/r (1/m).
     """
 
     t: np.ndarray
@@ -84,8 +85,9 @@ def load_arrays(bag, description, tensions: str = "dynamometer", pose: str = "de
     """Read a contract bag into :class:`CdprArrays` (one-line errors naming the topic).
 
     Args:
-        tensions: "dynamometer" (``/cdpr/cable_tensions`` effort) or "motor" (``/cdpr/joint_states``
-            effort times R/r, 001 sec. V-B).
+        tensions: "dynamometer" (``/cdpr/cable_tensions`` effort), "motor" (``/cdpr/joint_states``
+            effort times R/r, 001 sec. V-B) or "both" (dynamometers for the wrench, and the
+            per-winch torque balance against the motor torques, :func:`dataset_from_arrays`).
         pose: "desired" (``/cdpr/reference``; falls back to the measured pose when absent) or
             "measured" (``/cdpr/platform_pose``).
     """
@@ -94,12 +96,12 @@ def load_arrays(bag, description, tensions: str = "dynamometer", pose: str = "de
         raise CablelabError(f"{bag.path}: plant description has no 'cdpr' section")
     n = len(c.cables)
     scale = c.gear_ratio / c.drum_radius
-    if tensions not in ("dynamometer", "motor"):
-        raise CablelabError(f"--tensions {tensions!r}: expected dynamometer or motor")
+    if tensions not in ("dynamometer", "motor", "both"):
+        raise CablelabError(f"--tensions {tensions!r}: expected dynamometer, motor or both")
     if not bag.has(JOINTS):
         raise CablelabError(f"{bag.path}: topic {JOINTS} is not in the bag")
     js = bag.joint_state(JOINTS, [f"winch_{i}" for i in range(1, n + 1)])
-    if tensions == "dynamometer":
+    if tensions in ("dynamometer", "both"):
         if not bag.has(TENSIONS):
             raise CablelabError(f"{bag.path}: topic {TENSIONS} (dynamometers) is not in the bag; "
                                 "use --tensions motor")
@@ -125,6 +127,9 @@ def load_arrays(bag, description, tensions: str = "dynamometer", pose: str = "de
     motor_velocity = _interp(t, js.t[jok], qd)
     eok = jok & _finite_rows(js.effort)
     motor_effort = _interp(t, js.t[eok], js.effort[eok]) if eok.sum() > 1 else np.full_like(tens, np.nan)
+    if tensions == "both" and eok.sum() < 2:
+        raise CablelabError(f"{bag.path}: --tensions both: {JOINTS} has no motor torques (effort); "
+                            "use --tensions dynamometer")
     R = None
     if pose == "desired" and bag.has(REFERENCE):
         ref = bag.multidof_trajectory(REFERENCE)
@@ -171,9 +176,46 @@ def _regimes(arr: CdprArrays) -> dict:
     return {"motion": lab}
 
 
+def model_wrench_matrix(W: np.ndarray, S: np.ndarray, description) -> np.ndarray:
+    """The wrench matrix of the nominal model, (N, 6, n): Model II at the described sheave radius
+    ``W_I + r_p S`` (exact at r_p = the description's, 001 eq. 6-9), else Model I. Cable-side
+    terms (dynamometer offsets, winch friction) reach the wrench through it."""
+    r = description.cdpr.pulley_radius if description is not None and description.cdpr is not None else 0.0
+    return W + r * S if r > 0 else W
+
+
+def torque_balance(arr: CdprArrays) -> np.ndarray:
+    """(N, n) per-winch torque balance, N: ``(R/r) tau_i - d_i``, the motor torque tau_i (N m)
+    brought to the cable side minus the dynamometer reading d_i (N).
+
+    With 001 eq. 15 (motor torque = (r/R) t_i + winch friction, motor side) and a dynamometer
+    reading d_i = t_i + b_i, the unknown tension t_i cancels:
+    ``(R/r) tau_i - d_i = (R/r) (F_c,i sign(qdot_i) + F_v,i qdot_i) - b_i`` (+ noise): each
+    winch's friction and each dynamometer offset on a channel of its own."""
+    return arr.scale * arr.motor_effort - arr.tensions
+
+
+def balance_mask(qd: np.ndarray, floor: float | np.ndarray = 0.0) -> np.ndarray:
+    """(N, n) 1.0 where winch i is outside its zero-speed zone (:mod:`cablelab.velocity`), else
+    0.0: a stopped winch holds its cable with any torque inside its stiction band, and the sign
+    of its measured speed is noise there, so its torque balance says nothing at rest."""
+    from ...velocity import zero_speed_zone
+
+    zone = zero_speed_zone(qd, floor)
+    return (np.abs(qd) >= zone[None, :]).astype(float)
+
+
 def dataset_from_arrays(arr: CdprArrays, description, source: str = "data",
                         decimate: int = 1) -> Dataset:
-    """Workbench dataset (Model I wrench channels; see :mod:`cablelab.plants.cdpr.effects`)."""
+    """Workbench dataset (Model I wrench channels; see :mod:`cablelab.plants.cdpr.effects`).
+
+    ``arr.source == "both"`` (the bag has dynamometers and motor torques): the six wrench channels
+    W d from the dynamometers, plus one torque-balance channel per winch (:func:`torque_balance`,
+    N), set to 0 (measurement and every regressor) while that winch is in its zero-speed zone
+    (:func:`balance_mask`). The wrench alone sees eight dynamometer offsets only through W, whose
+    two-dimensional null space (internal forces) is invisible at each pose; the balance channels
+    see each offset and each winch's friction on its own channel. Whole samples are not left out
+    at rest (the wrench channels carry no friction)."""
     c = description.cdpr
     k = max(1, int(decimate))
     sl = slice(None, None, k)
@@ -186,19 +228,42 @@ def dataset_from_arrays(arr: CdprArrays, description, source: str = "data",
     W2 = wrench_matrix(cable_geometry(c.exit_points, c.anchor_points, pos, R, r_ref, c.swivel_axes))
     S = (W2 - W) / r_ref                               # d(W)/d(r_p), motion side
     slope = np.einsum("tij,tj->ti", S, t)
+    W_model = model_wrench_matrix(W, S, description)
     n = t.shape[1]
-    act_scale = np.full(n, arr.scale if arr.source == "motor" else 1.0)
-    unit = "N m" if arr.source == "motor" else "N"
+    act_scale = np.full(n, arr.scale if arr.source in ("motor", "both") else 1.0)
+    unit = "N m" if arr.source in ("motor", "both") else "N"
     qd = arr.motor_velocity[sl]
     sig = {"tensions": t, "position": pos, "R": R, "acc": arr.acc[sl], "W": W, "pulley_slope": slope,
            "pulley_S": S, "act_scale": act_scale, "velocity": arr.velocity[sl]}
+    channels, units = CHANNELS, UNITS
+    act_map = W_model * act_scale[None, None, :]
+    if arr.source == "both":
+        mask = balance_mask(qd)
+        bal = torque_balance(arr)[sl] * mask
+        y = np.concatenate([y, bal], axis=1)
+        channels = CHANNELS + tuple(f"balance_{i}" for i in range(1, n + 1))
+        units = UNITS + ("N",) * n
+        act_map = np.concatenate([np.zeros_like(W), _balance_map(mask, act_scale)], axis=1)
+        from ...velocity import zero_speed_zone
+
+        sig.update(balance_mask=mask, zero_speed_zone=zero_speed_zone(qd),
+                   rest_share=float(1.0 - mask.mean()))
     return Dataset(
-        plant="cdpr", t=arr.t[sl], y=y, channels=CHANNELS, units=UNITS, signals=sig,
+        plant="cdpr", t=arr.t[sl], y=y, channels=channels, units=units, signals=sig,
         actuators=tuple(f"winch_{i}" for i in range(1, n + 1)), act_vel=qd,
-        act_map=W * act_scale[None, None, :], act_units=((unit, "rad"),) * n,
+        act_map=act_map, act_units=((unit, "rad"),) * n,
         regimes={k2: v[sl] for k2, v in _regimes(arr).items()},
         inputs={"vertical acceleration": arr.acc[sl, 2], "speed": np.linalg.norm(arr.velocity[sl], axis=1)},
         description=description, source=source)
+
+
+def _balance_map(mask: np.ndarray, act_scale: np.ndarray) -> np.ndarray:
+    """(N, n, n) motor-side winch effort -> torque-balance channels: diag(mask_i R/r)."""
+    n = mask.shape[1]
+    out = np.zeros(mask.shape + (n,))
+    idx = np.arange(n)
+    out[:, idx, idx] = mask * act_scale[None, :]
+    return out
 
 
 def remeasure(ds: Dataset, shifted: Dataset) -> Dataset:
@@ -208,7 +273,17 @@ def remeasure(ds: Dataset, shifted: Dataset) -> Dataset:
     t = ds.signals["tensions"]
     sig = dict(shifted.signals, tensions=t,
                pulley_slope=np.einsum("tij,tj->ti", shifted.signals["pulley_S"], t))
-    return shifted.replace(y=np.einsum("tij,tj->ti", shifted.signals["W"], t), signals=sig)
+    y = np.einsum("tij,tj->ti", shifted.signals["W"], t)
+    if "balance_mask" in ds.signals:
+        # torque balance: measured against measured, no pose in it; its rest mask stays the
+        # measurement's (the winch speeds and the map follow t - tau)
+        mask = ds.signals["balance_mask"]
+        sig["balance_mask"] = mask
+        y = np.concatenate([y, ds.y[:, y.shape[1]:]], axis=1)
+        amap = shifted.act_map.copy()
+        amap[:, y.shape[1] - mask.shape[1]:, :] = _balance_map(mask, ds.signals["act_scale"])
+        return shifted.replace(y=y, signals=sig, act_map=amap)
+    return shifted.replace(y=y, signals=sig)
 
 
 def dataset(bag, description, options: dict | None = None) -> Dataset:
