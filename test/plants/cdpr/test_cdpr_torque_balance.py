@@ -46,11 +46,12 @@ def test_balance_channels_are_friction_minus_offset_in_closed_form(tmp_path):
     assert ds.t.size == truth.shape[0]
     # moving winches: the balance is the truth's friction minus offset (noise 1e-7 of a tension)
     np.testing.assert_allclose(ds.y[:, 6:][mask], truth[mask], atol=1e-3 * np.abs(tr["b"]).max())
-    # stopped winches (the platform at rest: every winch) are left out of the balance, the
-    # wrench channels keep every sample (no whole-sample zero-speed exclusion)
+    # stopped winches (the platform at rest: every winch) are left out of the balance, and the
+    # samples with a winch at rest out of the fit (whole-sample zero-speed exclusion, as with the
+    # dynamometers alone: static poses confound the sheave radius with the mass in the wrench)
     rest = np.all(np.abs(rec["omega"]) < 1e-9, axis=1)
     assert rest.mean() > 0.15 and not mask[rest].any() and np.all(ds.y[:, 6:][~mask] == 0.0)
-    assert ds.valid[rest].all()
+    assert not ds.valid[rest].any() and ds.valid[mask.all(axis=1)].mean() > 0.9
 
 
 def test_offsets_and_friction_identified_per_winch_from_the_balance(tmp_path):

@@ -214,8 +214,10 @@ def dataset_from_arrays(arr: CdprArrays, description, source: str = "data",
     N), set to 0 (measurement and every regressor) while that winch is in its zero-speed zone
     (:func:`balance_mask`). The wrench alone sees eight dynamometer offsets only through W, whose
     two-dimensional null space (internal forces) is invisible at each pose; the balance channels
-    see each offset and each winch's friction on its own channel. Whole samples are not left out
-    at rest (the wrench channels carry no friction)."""
+    see each offset and each winch's friction on its own channel. Samples with a winch at rest are
+    still left out by the workbench (:func:`cablelab.velocity.exclude_zero_speed`): kept, their
+    static poses made the sheave radius and the mass indistinguishable in the wrench (case 3016:
+    r_p fitted right but rejected as confounded with m, correlation 0.998)."""
     c = description.cdpr
     k = max(1, int(decimate))
     sl = slice(None, None, k)
@@ -244,10 +246,9 @@ def dataset_from_arrays(arr: CdprArrays, description, source: str = "data",
         channels = CHANNELS + tuple(f"balance_{i}" for i in range(1, n + 1))
         units = UNITS + ("N",) * n
         act_map = np.concatenate([np.zeros_like(W), _balance_map(mask, act_scale)], axis=1)
-        from ...velocity import zero_speed_zone
-
-        sig.update(balance_mask=mask, zero_speed_zone=zero_speed_zone(qd),
-                   rest_share=float(1.0 - mask.mean()))
+        # the workbench still leaves samples with a winch at rest out (as for the dynamometers
+        # alone): at static poses the sheave radius and the mass act alike on the wrench
+        sig.update(balance_mask=mask)
     return Dataset(
         plant="cdpr", t=arr.t[sl], y=y, channels=channels, units=units, signals=sig,
         actuators=tuple(f"winch_{i}" for i in range(1, n + 1)), act_vel=qd,
