@@ -7,15 +7,12 @@ held-out error. A candidate is *significant* when
 
 1. it removes at least ``MIN_GAIN`` (5 %) of the model's held-out error (practical
    significance: smaller gains are reported with their p-value but not worth a new physical
-   effect; on EMPS a -0.3 ms "delay", a third of a sample, gains 3 % and is left out), in the
-   geometric mean over channels or on one channel by that channel's own likelihood-ratio test
-   at ``alpha / (m C)``, and
-2. the per-channel likelihood-ratio test on the full-data fits rejects "no gain" at ``alpha / m``
-   (Bonferroni over the m candidates), each channel's sample count replaced by its effective
-   number of independent samples (spectral, :func:`~cablelab.diagnose.score.effective_sample_size`;
-   a filtered, oversampled residual is far from white and would otherwise make every effect
+   effect; on EMPS a -0.3 ms "delay", a third of a sample, gains 3 % and is left out), and
+2. a nested-model F-test on the full-data fits rejects "no gain" at ``alpha / m`` (Bonferroni over
+   the m candidates), with the sample count replaced by the effective number of independent
+   samples ``n_eff = n (1 - r1) / (1 + r1)`` (r1 = lag-1 autocorrelation of the residual; a
+   filtered, oversampled residual is far from white and would otherwise make every effect
    "significant"). The BIC difference on ``n_eff`` is reported alongside.
-   :func:`~cablelab.diagnose.score.significant` is the rule.
 
 The greedy mode adds the best significant candidate, re-ranks, and stops when none is
 significant; its steps are the waterfall baseline -> +effect 1 -> +effect 2.
@@ -37,7 +34,7 @@ from ..fit.threads import blas_single
 from ..model import Dataset, Model
 from .localise import derived_regimes, residual_by_regime
 from .metrics import nrmse  # noqa: F401  (re-exported name used by older callers)
-from .score import channel_nrmse, heldout_error, lr_significance, significant as _significant
+from .score import channel_nrmse, heldout_error, lr_significance
 
 #: default number of folds, significance level, guard band (fraction of samples per side)
 FOLDS = 5
@@ -227,8 +224,7 @@ def rank_candidates(model: Model, ds: Dataset, candidates, *, folds: int = FOLDS
     fold_indices(ds.n, folds)  # fail early on too few samples
     prog = _Progress(len(cands) + 1, "diagnose", quiet)
     base_full = identify(model, ds)
-    err0, ym0, yh0 = cv_error(model, ds, folds, start=base_full.params)
-    nrmse0 = channel_nrmse(ym0, yh0)
+    err0, _, _ = cv_error(model, ds, folds, start=base_full.params)
     regimes = derived_regimes(ds)
     y_ref = base_full.residual + base_full.y_hat
     by_regime0 = residual_by_regime(base_full.residual, y_ref, regimes, ds.channels)
@@ -245,34 +241,22 @@ def rank_candidates(model: Model, ds: Dataset, candidates, *, folds: int = FOLDS
             prog.step(c)
             continue
         sig = lr_significance(base_full, full, len(cands), alpha)
-        nrmse1 = channel_nrmse(ym1, yh1)
-        significant, rule = _significant(sig, nrmse0, nrmse1, len(cands), alpha, min_gain)
+        significant = bool(sig["passes"] and err1 < (1.0 - min_gain) * err0)
         own = full.effect_params(c, ds)
         row = {"effect": c, "error_before": err0, "error_after": err1, "params": own,
                "stderr": {k: full.stderr.get(k, 0.0) for k in own},
                "units": {k: full.units.get(k, "") for k in own},
                "significant": significant, "p_value": sig["p_value"], "delta_bic": sig["delta_bic"],
                "n_eff": sig["n_eff"], "gain": 1.0 - err1 / err0 if err0 > 0 else 0.0,
-               "channels": dict(zip(ds.channels, map(float, nrmse1))),
-               "channel_gain": dict(zip(ds.channels, map(float, rule["channel_gain"]))),
-               "channel_p": dict(zip(ds.channels, map(float, sig["channel_p"])))}
-        if rule["by"] is not None:
-            row["significant_by"] = ("geometric mean" if rule["by"] == "mean"
-                                     else ds.channels[rule["best_channel"]])
+               "channels": dict(zip(ds.channels, map(float, channel_nrmse(ym1, yh1))))}
         from .identifiability import confounding, describe
 
         row["identifiability"] = confounding(full, list(own))
         if not row["identifiability"]["identifiable"]:
             significant = row["significant"] = False
-            row.pop("significant_by", None)
         row["evidence"] = _evidence(by_regime0, residual_by_regime(full.residual, y_ref, regimes,
                                                                   ds.channels))
         row["explanation"] = explain(c, own, row["stderr"], row["units"], err0, err1, significant)
-        if significant and rule["by"] == "channel":
-            ch = rule["best_channel"]
-            row["explanation"] += (f"; significant on {ds.channels[ch]} by its own evidence: "
-                                   f"{100 * rule['channel_gain'][ch]:.0f} % of its held-out NRMSE, "
-                                   f"p = {sig['channel_p'][ch]:.2g}")
         if significant and row["evidence"]:
             ev = row["evidence"]
             row["explanation"] += (f"; largest drop where {ev['regime']} is {ev['label']} "

@@ -12,8 +12,8 @@ from dataclasses import dataclass, field
 
 #: keys of a ranking row that are part of the JSON, in order (contract keys first)
 ROW_KEYS = ("effect", "error_before", "error_after", "params", "significant", "stderr", "units",
-            "p_value", "delta_bic", "n_eff", "gain", "channels", "channel_gain", "channel_p",
-            "significant_by", "evidence", "identifiability", "explanation")
+            "p_value", "delta_bic", "n_eff", "gain", "channels", "evidence", "identifiability",
+            "explanation")
 
 
 @dataclass(frozen=True)
