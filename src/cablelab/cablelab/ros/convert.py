@@ -88,10 +88,16 @@ def command_msg(data, stamp: float | None = None, label: str = "command") -> Flo
 def command_stamp(msg: Float64MultiArray) -> float | None:
     """The stamp (s) of the state a command answers (see :func:`command_msg`), None if it does
     not say (a foreign controller) or says something unreadable."""
-    if not msg.layout.dim or "stamp=" not in msg.layout.dim[0].label:
+    return label_stamp(msg.layout.dim[0].label) if msg.layout.dim else None
+
+
+def label_stamp(label: str) -> float | None:
+    """The stamp in a command label ``'<label> stamp=<t>'`` (s), None if it has none or it is
+    unreadable or not finite."""
+    if "stamp=" not in label:
         return None
     try:
-        t = float(msg.layout.dim[0].label.split("stamp=", 1)[1])
+        t = float(label.split("stamp=", 1)[1])
     except ValueError:
         return None
     return t if np.isfinite(t) else None

@@ -256,12 +256,4 @@ def command_arrays(msg) -> tuple[np.ndarray, float | None]:
     if pos + 8 * count > n:
         raise ValueError("Float64MultiArray data runs past the end")
     data = np.frombuffer(b, np.dtype(order + "f8"), count, pos).astype(np.float64)
-    stamp = None
-    if labels and "stamp=" in labels[0]:
-        try:
-            stamp = float(labels[0].split("stamp=", 1)[1])
-        except ValueError:
-            stamp = None
-        if stamp is not None and not np.isfinite(stamp):
-            stamp = None
-    return data, stamp
+    return data, convert.label_stamp(labels[0]) if labels else None

@@ -149,8 +149,7 @@ class CdprController(PlantNode):
             state = rawmsg.joint_state_arrays(msg, self.readers["state"])
         except ValueError:
             state = (float("nan"), [], None, None, None)      # rejected by command()
-        ref = self.prepared
-        if ref is None or self.pending is not None or not abs(ref.t - state[0]) <= 1e-9:
+        if self.pending is not None or self._prepared_for(state[0]) is None:
             drain(*self.polled)         # the reference and estimate that came before it
         self.pending = (state, time.monotonic())
         self.try_command()
@@ -165,10 +164,15 @@ class CdprController(PlantNode):
         if self.controller is None or self.estimate_wait > 0 or not np.isfinite(t):
             return
         nxt = self.refs.after(t)
-        if nxt is None or (self.prepared is not None and abs(self.prepared.t - nxt[0]) <= 1e-9):
+        if nxt is None or self._prepared_for(nxt[0]) is not None:
             return
         stamp, (pos, quat, vel, acc) = nxt
         self.prepared = self.controller.prepare(stamp, pos, quat, vel, acc)
+
+    def _prepared_for(self, t: float):
+        """The reference terms prepared ahead if they are those of stamp ``t``, else None."""
+        ref = self.prepared
+        return ref if ref is not None and abs(ref.t - t) <= 1e-9 else None
 
     def _waiting_for(self, t: float) -> tuple[bool, bool]:
         """(reference of stamp t not here yet, estimate of stamp t awaited and not here yet)."""
@@ -215,9 +219,9 @@ class CdprController(PlantNode):
             self.last_skip = time.monotonic()
             self.last_problem = "no fresh reference: not commanding (brakes hold)"
             return
-        ref = self.prepared
         stamp, (pos, quat, vel, acc) = self.refs.at(t)
-        if ref is None or not abs(ref.t - t) <= 1e-9 or not abs(stamp - t) <= 1e-9:
+        ref = self._prepared_for(t) if abs(stamp - t) <= 1e-9 else None
+        if ref is None:
             ref = self.controller.prepare(t, pos, quat, vel, acc)       # not prepared ahead
         else:
             self.prepared_used += 1
