@@ -29,7 +29,11 @@ the truth, not in the description), ``tension_sensor_offset``, ``winch_coulomb_f
 ``platform_inertia`` (not in the nominal model),
 ``time_delay`` (dynamometers and motor torques read the truth of ``tau`` = 10-30 ms earlier: the
 whole chain reference -> tensions -> torques is evaluated at ``t - tau``, while the winch angles
-and the reference topic are not delayed);
+and the reference topic are not delayed; a delay only shows when the tensions change within tau,
+so a delay case is recorded with moves fast enough that the delay moves at least one wrench
+channel by its noise rms, :func:`delay_visibility`: the move time and tau are redrawn from a
+second stream until it does - with the 4 s moves of the other cases the delays were 3-21 % of the
+noise and no 5 % error gain could show them);
 one, or two, or none (control). The nominal model is the plant's (``cdpr_gravity`` [+
 ``pulley_geometry`` when the description gives a sheave radius]) + ``platform_inertia``
 (``--effects``), except when the inertia is the hidden effect. The described sheave radius is
@@ -99,8 +103,58 @@ def draw_case(seed: int, kind: str | None = None) -> PlantCase:
                  outlier_rate=float(rng.choice([0.0, 0.002])), quantum=2 * np.pi / 2 ** int(rng.integers(12, 16)))
     tau = float(rng.uniform(10e-3, 30e-3))          # drawn last: the other draws do not depend on it
     truth["tau"] = tau if "time_delay" in hidden else 0.0
+    truth["move_time"] = 4.0
+    if "time_delay" in hidden:
+        _make_delay_visible(case)
     case.true_params = _true_params(case)
     return case
+
+
+#: a hidden delay must move the strongest wrench channel by this share of its noise rms (moving samples)
+MIN_DELAY_VISIBILITY = 1.0
+
+
+def _make_delay_visible(case: PlantCase) -> None:
+    """Redraw the move time (1.5-4 s) and tau (10-30 ms) of a delay case from a second stream until
+    :func:`delay_visibility` reaches :data:`MIN_DELAY_VISIBILITY`; ``truth["redraws"]`` counts them."""
+    tr = case.truth
+    redraw = np.random.default_rng(case.seed + 104729)
+    for k in range(100):
+        try:
+            if delay_visibility(case) >= MIN_DELAY_VISIBILITY:
+                tr["redraws"] = k
+                return
+        except RuntimeError:                       # cable slack at this speed: draw again
+            pass
+        tr["move_time"], tr["tau"] = float(redraw.uniform(1.5, 4.0)), float(redraw.uniform(10e-3, 30e-3))
+    raise RuntimeError(f"case {case.seed}: no move time in 1.5-4 s makes a {tr['tau'] * 1e3:.0f} ms delay visible")
+
+
+def delay_visibility(case: PlantCase) -> float:
+    """How far the case's delay moves the recorded wrench, in noise units: the largest over the six
+    wrench channels of rms(W (t(t - tau) - t(t))) / rms(noise of W t) over the moving samples, from
+    this generator's own truth with and without tau (W its structure matrix at the pose at t, the
+    noise the dynamometers' independent per-cable sigmas mapped through W)."""
+    tr = case.truth
+    t, (p, v, a), ref = _motion(case, np.random.default_rng(case.seed + 7919))
+    ten = _winch_truth(tr, p, v, a, t)[2]
+    ten_late = _winch_truth(tr, *ref(t - tr["tau"]), t - tr["tau"])[2]
+    W = structure_matrix(cable_directions(p, tr["r_p"])[0])
+    sig = tr["noise_rel"] * tr["m"] * G / 8 / 0.6
+    moving = np.linalg.norm(v, axis=1) > 1e-3
+    s = np.einsum("nij,nj->ni", W, ten_late - ten)[moving]
+    noise = np.einsum("nij,j->ni", W ** 2, sig ** 2)[moving]
+    return float(np.max(np.sqrt((s ** 2).mean(0) / noise.mean(0))))
+
+
+def _motion(case: PlantCase, rng):
+    """Time grid, reference (p, v, a) on it and the reference function, drawn from ``rng``."""
+    tr = case.truth
+    ref, _ = moves_and_rests(rng, [0.0, 0.0, 0.85], LIMITS, tr["duration"], tr["rest_fraction"], tr["profile"],
+                             move_time=tr.get("move_time", 4.0), chirp_amp=[0.12, 0.06, 0.05],
+                             chirp_f0=(0.1, 0.2), chirp_f1=(0.4, 0.7))
+    t = np.arange(int(round(tr["duration"] * case.fs))) / case.fs
+    return t, ref(t), ref
 
 
 def _description(m: float, r_p: float) -> str:
@@ -194,12 +248,9 @@ def simulate(case: PlantCase) -> dict:
     """Reference motion -> wrench -> tensions -> winch motion and torques -> sensor readings."""
     rng = np.random.default_rng(case.seed + 7919)
     tr = case.truth
-    ref, _ = moves_and_rests(rng, [0.0, 0.0, 0.85], LIMITS, tr["duration"], tr["rest_fraction"], tr["profile"],
-                             move_time=4.0, chirp_amp=[0.12, 0.06, 0.05], chirp_f0=(0.1, 0.2), chirp_f1=(0.4, 0.7))
-    n = int(round(tr["duration"] * case.fs))
-    t = np.arange(n) / case.fs
-    p, v, a = ref(t)
-    theta, omega, ten, motor = _winch_truth(tr, *ref(t), t)
+    t, (p, v, a), ref = _motion(case, rng)
+    n = t.size
+    theta, omega, ten, motor = _winch_truth(tr, p, v, a, t)
     if tr.get("tau", 0.0) != 0.0:                          # sensors read the truth of t - tau
         td = t - tr["tau"]
         _, _, ten, motor = _winch_truth(tr, *ref(td), td)

@@ -7,6 +7,12 @@
   drop on the one channel an effect acts on (CDPR Fz and ``platform_inertia``) is not averaged
   away by five channels that do not care (issue 10, failure 4). One channel: the plain NRMSE.
   The per-channel NRMSE stays in the output for humans.
+* Practical gain (:func:`practical_gain`): the relative drop of that geometric mean over the
+  channels whose held-out prediction the candidate changes at all. A channel an effect cannot
+  touch (a CDPR winch's torque balance under ``pulley_geometry`` or ``time_delay``: its prediction
+  stays exactly what it was) neither helps nor dilutes it: with ``--tensions both`` eight such
+  noise channels beside the six wrench channels cut a wrench effect's gain to 6/14 of itself.
+  When a candidate changes every channel this is the plain relative drop of the held-out error.
 * Significance (:func:`lr_significance`): the Gaussian likelihood-ratio statistic with a variance
   per channel, ``LR = sum_c n_eff,c log(RSS0_c / RSS1_c)`` ~ chi^2(dp) under "no gain" (Wilks),
   where ``n_eff,c = n (1 - r1_c) / (1 + r1_c)`` is the AR(1) effective sample size of the
@@ -43,6 +49,37 @@ def heldout_error(y: np.ndarray, y_hat: np.ndarray, valid: np.ndarray | None = N
     c = channel_nrmse(y, y_hat, valid)
     c = c[np.isfinite(c)]
     return float(np.exp(np.mean(np.log(np.maximum(c, 1e-300))))) if c.size else 0.0
+
+
+#: a channel counts as changed by a candidate when its held-out prediction moves by more than this
+#: share of the channel's rms somewhere (refits leave untouched channels equal to round-off)
+CHANGE_TOL = 1e-6
+
+
+def changed_channels(y: np.ndarray, y_hat0: np.ndarray, y_hat1: np.ndarray) -> np.ndarray:
+    """(C,) bool: channels whose held-out prediction differs between two models (rows where
+    both predictions and the measurement are finite), beyond :data:`CHANGE_TOL` x rms(y_c)."""
+    y = np.asarray(y, float).reshape(len(y), -1)
+    y0, y1 = (np.asarray(a, float).reshape(y.shape) for a in (y_hat0, y_hat1))
+    ok = np.isfinite(y).all(axis=1) & np.isfinite(y0).all(axis=1) & np.isfinite(y1).all(axis=1)
+    if not ok.any():
+        return np.ones(y.shape[1], bool)
+    scale = np.sqrt(np.mean(y[ok] ** 2, axis=0))
+    return np.max(np.abs(y1[ok] - y0[ok]), axis=0) > CHANGE_TOL * scale
+
+
+def practical_gain(y0: np.ndarray, y_hat0: np.ndarray, y1: np.ndarray, y_hat1: np.ndarray
+                   ) -> tuple[float, np.ndarray]:
+    """Relative drop of the held-out error (:func:`heldout_error`) of a candidate (``y1``,
+    ``y_hat1``: its held-out measurements and predictions) against the model without it (``y0``,
+    ``y_hat0``), over the channels the candidate changes (:func:`changed_channels`; 0 if none),
+    and the (C,) bool mask of those channels."""
+    c0, c1 = channel_nrmse(y0, y_hat0), channel_nrmse(y1, y_hat1)
+    use = changed_channels(np.where(np.isfinite(y0), y0, y1), y_hat0, y_hat1)
+    use &= np.isfinite(c0) & np.isfinite(c1) & (c0 > 0)
+    if not use.any():
+        return 0.0, use
+    return float(1.0 - np.exp(np.mean(np.log(np.maximum(c1[use], 1e-300)) - np.log(c0[use])))), use
 
 
 def _n_free(ident) -> int:
