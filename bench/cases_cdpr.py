@@ -119,7 +119,7 @@ def _make_delay_visible(case: PlantCase) -> None:
     :func:`delay_visibility` reaches :data:`MIN_DELAY_VISIBILITY`; ``truth["redraws"]`` counts them."""
     tr = case.truth
     redraw = np.random.default_rng(case.seed + 104729)
-    for k in range(100):
+    for k in range(500):
         try:
             if delay_visibility(case) >= MIN_DELAY_VISIBILITY:
                 tr["redraws"] = k

@@ -142,3 +142,15 @@ def test_cdpr_hidden_time_delay_found_with_tau_and_its_stderr(tmp_path):
     assert case.hidden == ("time_delay",) and case.fs == 200.0
     case.options = {"tensions": "dynamometer"}  # the dynamometers alone (the cases read both)
     _assert_delay(_diagnose(cases_cdpr, case, tmp_path), case)
+
+
+def test_cdpr_pulleys_and_delay_both_found_with_both_tension_sources(tmp_path):
+    """Two hidden effects that act on the six wrench channels only, diagnosed with --tensions both
+    (8 torque-balance channels they cannot change): greedy adds exactly both, the sheave radius
+    within 10 % and tau within 15 % of the generator's truth."""
+    case = _case(cases_cdpr, 2, "two", duration=30.0)
+    assert set(case.hidden) == {"pulley_geometry", "time_delay"} and case.options["tensions"] == "both"
+    out = _diagnose(cases_cdpr, case, tmp_path)
+    assert sorted(g["added"] for g in out["greedy"][1:]) == sorted(case.hidden), out["ranking"][:3]
+    for effect, rel in (("pulley_geometry", 0.10), ("time_delay", 0.15)):
+        assert rel_param_error(out["final"]["params"], case.true_params[effect]) < rel, effect

@@ -144,3 +144,32 @@ def test_typed_diagnosis_is_the_ranking_once_reshaped():
     g = diagnose(ds, model, cands, folds=4, greedy_mode=True)
     assert g.final.effects[-1] == "joint_coulomb_friction" and g.to_json()["final"]["error"] == g.final.error
     assert g.lines()[0].startswith("plant axis: model axis_inertia + joint_viscous_friction")
+
+
+def test_practical_gain_counts_only_the_channels_a_candidate_changes():
+    """Closed form: the candidate changes channel 0 only; the practical gain is channel 0's own
+    relative NRMSE drop (not the geometric-mean drop over both, which is diluted to its square
+    root), a round-off change (1e-9 x rms) does not count as a change, a real one does."""
+    from cablelab.diagnose.score import changed_channels, channel_nrmse, heldout_error, practical_gain
+
+    rng = np.random.default_rng(4)
+    n = 2000
+    s = np.sin(np.linspace(0, 20, n))
+    y = np.column_stack([s + 0.1 * rng.standard_normal(n), 0.1 * rng.standard_normal(n)])
+    y0 = np.column_stack([0.7 * s, np.zeros(n)])            # misses 30 % of channel 0
+    y1 = np.column_stack([s, np.zeros(n)])                  # the candidate explains it
+    c0, c1 = channel_nrmse(y, y0), channel_nrmse(y, y1)
+    gain, changed = practical_gain(y, y0, y, y1)
+    assert changed.tolist() == [True, False]
+    assert gain == pytest.approx(1 - c1[0] / c0[0], rel=1e-12)
+    diluted = 1 - heldout_error(y, y1) / heldout_error(y, y0)
+    assert diluted == pytest.approx(1 - np.sqrt(c1[0] / c0[0]), rel=1e-12) and diluted < gain
+    y1r = y1.copy()
+    y1r[:, 1] += 1e-9 * np.sqrt(np.mean(y[:, 1] ** 2))
+    assert changed_channels(y, y0, y1r).tolist() == [True, False]
+    y1c = y1.copy()
+    y1c[:, 1] += 0.05 * np.sqrt(np.mean(y[:, 1] ** 2))     # a real change on channel 1
+    gain_c, changed_c = practical_gain(y, y0, y, y1c)
+    assert changed_c.tolist() == [True, True]
+    assert gain_c == pytest.approx(1 - heldout_error(y, y1c) / heldout_error(y, y0), rel=1e-12)
+    assert practical_gain(y, y0, y, y0)[0] == 0.0           # changes nothing: no gain
