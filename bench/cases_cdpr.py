@@ -41,6 +41,8 @@ known (``--fix r_p``).
 """
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
 from cases_common import PlantCase, coloured_noise, moves_and_rests, quantize
@@ -118,6 +120,7 @@ def _make_delay_visible(case: PlantCase) -> None:
     """Redraw the move time (1.5-4 s) and tau (10-30 ms) of a delay case from a second stream until
     :func:`delay_visibility` reaches :data:`MIN_DELAY_VISIBILITY`; ``truth["redraws"]`` counts them."""
     tr = case.truth
+    tr["first_draw"] = {"move_time": tr["move_time"], "tau": tr["tau"]}
     redraw = np.random.default_rng(case.seed + 104729)
     for k in range(500):
         try:
@@ -285,3 +288,22 @@ def write_bag(case: PlantCase, path, rec: dict | None = None) -> dict:
                                     angular_velocity=np.zeros((n, 3)), linear_acceleration=rec["a"],
                                     angular_acceleration=np.zeros((n, 3)))
     return rec
+
+
+def _visibility_table(first_seed: int = 3000, n: int = 60) -> None:
+    """Print the delay cases of the benchmark's CDPR seeds: the visibility of the first draw (4 s
+    moves) and of the recorded case, with its move time, tau and number of redraws."""
+    print("seed  hidden                        first: move_s  tau_ms  visibility   case: move_s  tau_ms  visibility  redraws")
+    for seed in range(first_seed, first_seed + n):
+        case = draw_case(seed)
+        if "time_delay" not in case.hidden:
+            continue
+        tr = case.truth
+        first = dataclasses.replace(case, truth={**tr, **tr["first_draw"]})
+        print(f"{seed}  {' + '.join(case.hidden):28s}  {tr['first_draw']['move_time']:13.2f}  "
+              f"{1e3 * tr['first_draw']['tau']:6.1f}  {delay_visibility(first):10.2f}   "
+              f"{tr['move_time']:12.2f}  {1e3 * tr['tau']:6.1f}  {delay_visibility(case):10.2f}  {tr['redraws']:7d}")
+
+
+if __name__ == "__main__":      # ./run python bench/cases_cdpr.py: the delay cases of bench_diagnosis
+    _visibility_table()
