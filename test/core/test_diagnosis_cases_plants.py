@@ -154,3 +154,12 @@ def test_cdpr_pulleys_and_delay_both_found_with_both_tension_sources(tmp_path):
     assert sorted(g["added"] for g in out["greedy"][1:]) == sorted(case.hidden), out["ranking"][:3]
     for effect, rel in (("pulley_geometry", 0.10), ("time_delay", 0.15)):
         assert rel_param_error(out["final"]["params"], case.true_params[effect]) < rel, effect
+
+
+def test_cdpr_control_with_the_fast_moves_of_the_delay_cases_nothing_significant(tmp_path):
+    """The delay cases are recorded with 1.5-2.4 s moves (bench/cases_cdpr.py redraw); a control
+    recorded with such moves (1.6 s, chirps, both tension sources) calls nothing significant,
+    time_delay included."""
+    case = _case(cases_cdpr, 4, "control", duration=30.0, move_time=1.6)
+    assert case.truth["tau"] == 0.0 and case.options["tensions"] == "both"
+    _assert_control(_diagnose(cases_cdpr, case, tmp_path))
