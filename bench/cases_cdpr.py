@@ -66,6 +66,12 @@ TWO = [("pulley_geometry", "tension_sensor_offset"), ("pulley_geometry", "platfo
 MOTOR = ("winch_coulomb_friction", "winch_viscous_friction")
 
 
+def mean_tension(m: float) -> float:
+    """Mean cable tension of a platform of mass ``m``, N (8 cables ~37 deg from vertical): the
+    pretension level of the tension distribution and the scale of the dynamometer noise."""
+    return m * G / 8 / 0.6
+
+
 def draw_case(seed: int, kind: str | None = None) -> PlantCase:
     """A random CDPR case. ``kind``: "control", "one", "two" (default drawn 20/50/30 %)."""
     rng = np.random.default_rng(seed)
@@ -80,7 +86,7 @@ def draw_case(seed: int, kind: str | None = None) -> PlantCase:
     source = "both"
     m = rng.uniform(400.0, 900.0)
     r_p = rng.uniform(0.08, 0.22)
-    t_mean = m * G / 8 / 0.6                     # mean cable tension, N (cables ~37 deg from vertical)
+    t_mean = mean_tension(m)
     tau_mean = t_mean * DRUM / GEAR              # mean motor torque, N m
     truth = {"m": m, "r_p": r_p, "described_r_p": "pulley_geometry" not in hidden,
              "b": np.zeros(8), "Fc": np.zeros(8), "Fv": np.zeros(8),
@@ -143,7 +149,7 @@ def delay_visibility(case: PlantCase) -> float:
     ten = _winch_truth(tr, p, v, a, t)[2]
     ten_late = _winch_truth(tr, *ref(t - tr["tau"]), t - tr["tau"])[2]
     W = structure_matrix(cable_directions(p, tr["r_p"])[0])
-    sig = tr["noise_rel"] * tr["m"] * G / 8 / 0.6
+    sig = tr["noise_rel"] * mean_tension(tr["m"])
     moving = np.linalg.norm(v, axis=1) > 1e-3
     s = np.einsum("nij,nj->ni", W, ten_late - ten)[moving]
     noise = np.einsum("nij,j->ni", W ** 2, sig ** 2)[moving]
@@ -234,7 +240,7 @@ def _winch_truth(tr: dict, p, v, a, t):
     W = structure_matrix(u)
     w = np.zeros((t.size, 6))
     w[:, :3] = tr["m"] * (a + [0.0, 0.0, G])              # m (a - g), g = (0, 0, -G)
-    t0 = np.full(8, tr["m"] * G / 8 / 0.6)
+    t0 = np.full(8, mean_tension(tr["m"]))
     Wp = np.linalg.pinv(W)                                 # (N, 8, 6)
     ten = t0 + np.einsum("nij,nj->ni", Wp, w - np.einsum("nij,j->ni", W, t0))
     if ten.min() <= 0.05 * t0[0]:
@@ -257,7 +263,7 @@ def simulate(case: PlantCase) -> dict:
     if tr.get("tau", 0.0) != 0.0:                          # sensors read the truth of t - tau
         td = t - tr["tau"]
         _, _, ten, motor = _winch_truth(tr, *ref(td), td)
-    t0 = np.full(8, tr["m"] * G / 8 / 0.6)
+    t0 = np.full(8, mean_tension(tr["m"]))
     scale = GEAR / DRUM
     dyn = ten + tr["b"]
     for i in range(8):
