@@ -32,8 +32,8 @@ whole chain reference -> tensions -> torques is evaluated at ``t - tau``, while 
 and the reference topic are not delayed; a delay only shows when the tensions change within tau,
 so a delay case is recorded with moves fast enough that the delay moves at least one wrench
 channel by its noise rms, :func:`delay_visibility`: the move time and tau are redrawn from a
-second stream until it does - with the 4 s moves of the other cases the delays were 3-21 % of the
-noise and no 5 % error gain could show them);
+second stream until it does - with the 4 s moves of the other cases the delays' visibility was
+0.08-0.41 and no 5 % error gain could show them; ``python bench/cases_cdpr.py`` prints it);
 one, or two, or none (control). The nominal model is the plant's (``cdpr_gravity`` [+
 ``pulley_geometry`` when the description gives a sheave radius]) + ``platform_inertia``
 (``--effects``), except when the inertia is the hidden effect. The described sheave radius is
