@@ -20,6 +20,8 @@ from .diagnostics import Diagnostics
 from .inputs import InputMonitor
 from .qos import DESCRIPTION_QOS
 
+PROBE_REPEAT = 5.0  # s wall: the start gate's probe state is published again (see waiting_for_subscribers)
+
 
 class PlantNode(Node):
     """Base of every plant node.
@@ -125,22 +127,57 @@ class PlantNode(Node):
         """Parameter ``wait_for_subscribers`` (simulators): before time starts, wait (at most
         60 s) until the state topic has that many subscribers, see :meth:`waiting_for_subscribers`."""
         self.wait_subs = int(self.param("wait_for_subscribers", 0))
+        self.probe_sent: float | None = None
         self.created = time.monotonic()
 
     def waiting_for_subscribers(self, publisher, last_publish: float, republish,
                                 every: float = 0.5) -> bool:
-        """True while time must not start yet: fewer than ``wait_for_subscribers`` subscribers of
-        ``publisher`` (for at most 60 s); meanwhile ``republish()`` the initial state every
-        ``every`` s (wall) after ``last_publish``, for late joiners."""
+        """True while time must not start yet (for at most 60 s): fewer than
+        ``wait_for_subscribers`` subscribers of ``publisher`` (meanwhile ``republish()`` the
+        initial state every ``every`` s wall after ``last_publish``, for late joiners), or a
+        reliable subscriber has not yet acknowledged the initial state published once more when
+        the count was reached.
+
+        The count is the writer's side of the match; the subscriber may match the writer much
+        later (seconds on a loaded machine) and drops every sample until then. A subscriber that
+        acknowledged a sample published after the count was reached has matched, so from the
+        first step on a recorder gets every sample. (Samples published before the writer matched
+        a volatile subscriber count as acknowledged, hence the one more; while waiting for the
+        acknowledgements nothing is published, since they come with the writer's periodic
+        heartbeat, every few seconds, and every new sample would need another one; the probe is
+        repeated every :data:`PROBE_REPEAT` s in case it was lost.)"""
         if not self.wait_subs:
             return False
         now = time.monotonic()
-        if publisher.get_subscription_count() < self.wait_subs and now - self.created < 60.0:
+        if now - self.created >= 60.0:
+            self.get_logger().warning(f"time starts without all {self.wait_subs} subscribers "
+                                      "matched and acknowledged after 60 s")
+            self.wait_subs = 0
+            return False
+        if publisher.get_subscription_count() < self.wait_subs:
+            self.probe_sent = None
             if now - last_publish > every:
                 republish()
             return True
-        self.wait_subs = 0
-        return False
+        if self.probe_sent is None or now - self.probe_sent > PROBE_REPEAT:
+            republish()
+            self.probe_sent = now
+            return True
+        if self.all_acknowledged():
+            self.get_logger().info(f"time starts: {self.wait_subs} subscribers matched and "
+                                   f"acknowledged after {now - self.created:.1f} s")
+            self.wait_subs = 0
+            return False
+        return True
+
+    def all_acknowledged(self) -> bool:
+        """Whether every matched reliable subscriber acknowledged every sample this node
+        published (checked without waiting; /diagnostics, published on a timer, not counted)."""
+        from rclpy.duration import Duration
+
+        diag = getattr(getattr(self, "diag", None), "pub", None)
+        return all(pub.wait_for_all_acked(Duration(seconds=0)) for pub in self.publishers
+                   if pub is not diag)
 
     # ------------------------------------------------------------------ diagnostics
     def start_diagnostics(self) -> None:
