@@ -45,24 +45,33 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from harness import Bench, table  # noqa: E402
 
 
-def offline_sim(duration: float = 60.0, repeat: int = 3) -> dict:
-    """Best-of-``repeat`` real-time factors of ``simulate`` and of bare mj_step on its model."""
-    import mujoco
-
+def cdpr_hold(timestep: float = 0.002):
+    """The CDPR simulator at the start pose of the test trajectory (615 kg) and the winch torques
+    (N m) that hold it there statically (eq. 14 feedforward at rest): ``(CdprSim, hold)``."""
     from cablelab.plants.cdpr.control import feedforward_tensions
     from cablelab.plants.cdpr.geometry import cable_geometry
-    from cablelab.plants.cdpr.sim import CdprSim, CdprTruth, default_description, simulate
+    from cablelab.plants.cdpr.sim import CdprSim, CdprTruth, default_description
     from cablelab.plants.cdpr.trajectory import sample_trajectory
 
     desc = default_description()
     c = desc.cdpr
-    truth = CdprTruth(payload_mass=249.0)
     start = sample_trajectory(1.0, 100.0).position[0]
-    sim = CdprSim(desc, truth, start)
-    model, data = sim.model, sim.data
+    sim = CdprSim(desc, CdprTruth(payload_mass=249.0, timestep=timestep), start)
     g = cable_geometry(c.exit_points, c.anchor_points, start[None], None, sim.truth.pulley_radius, c.swivel_axes)
     hold = (c.drum_radius / c.gear_ratio) * feedforward_tensions(g, sim.truth.total_mass, np.zeros((1, 3)),
                                                                   desc.gravity)[0]
+    return sim, hold
+
+
+def offline_sim(duration: float = 60.0, repeat: int = 3) -> dict:
+    """Best-of-``repeat`` real-time factors of ``simulate`` and of bare mj_step on its model."""
+    import mujoco
+
+    from cablelab.plants.cdpr.sim import CdprTruth, simulate
+
+    sim, hold = cdpr_hold()
+    desc, truth, start = sim.desc, CdprTruth(payload_mass=sim.truth.payload_mass), sim.position
+    model, data = sim.model, sim.data
     nsteps = int(round(duration / model.opt.timestep))
     best_sim = best_bare = float("inf")
     for _ in range(repeat):
@@ -148,7 +157,7 @@ def closed_loop(seconds: float, log, env: dict | None = None, py_spy: str | None
     if r is None:
         raise SystemExit("bench_realtime: the simulator never reported on /diagnostics (see the logs)")
     r["rate_hz"] = 1000
-    r["rt_priority"] = False
+    r["rt_priority"] = any(int(v.get("rt_priority", 0)) > 0 for v in placement.values())
     r["placement"] = placement or None
     return r
 
@@ -208,7 +217,8 @@ def main(argv=None) -> int:
                  "estimator SCHED_IDLE, no CPU placement" if args.idle_estimator else "no CPU placement")
         if args.node_params:
             where += f", node parameters {args.node_params}"
-        rows += [dict(case=f"closed loop 1 kHz, 3 processes, no RT priority, {where}, {c['seconds']:.0f} s steady state",
+        prio = "SCHED_FIFO (node parameter rt_priority)" if c["rt_priority"] else "no RT priority"
+        rows += [dict(case=f"closed loop 1 kHz, 3 processes, {prio}, {where}, {c['seconds']:.0f} s steady state",
                       value=c["realtime_factor"], unit="x real time", target=">= 0.99"),
                  dict(case="missed cycles (steps braked, late or with a stale command, + dropped)",
                       value=f"{c['missed_cycles']} (braked {r['braked']}, late {r['late']}, "
