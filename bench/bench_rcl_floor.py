@@ -19,8 +19,10 @@ the default executor (the load a Python estimator puts on the machine).
 Then, in the same run, ``--compare`` runs the cablelab nodes (``bench_realtime``'s closed loop,
 same seconds, same placement) so that the two are measured side by side.
 
-Builds with the C compiler in ``$CC`` (default ``cc``; e.g. ``CC="python -m ziglang cc"``) against
-the headers and libraries of the installed ros-jazzy and MuJoCo wheels.
+Builds with the C compiler in ``$CC`` (default ``cc``) against the headers and libraries of the
+installed ros-jazzy and MuJoCo wheels and libpython (the wheels' rmw libraries refer to it). A
+machine with Python only can use the ``ziglang`` wheel (0.17.0 tried):
+``CC="$PWD/.venv/bin/python -m ziglang cc"`` with ziglang on the venv's path.
 
     ./run python bench/bench_rcl_floor.py --seconds 60 [--listener] [--pin] [--compare] [--rt-timer 50] [--json]
 """
@@ -74,7 +76,7 @@ def build(out_dir: Path) -> Path:
         r = subprocess.run(cmd, capture_output=True, text=True)
     except FileNotFoundError:
         raise SystemExit(f"bench_rcl_floor: no C compiler '{cc[0]}': install one or set CC "
-                         "(e.g. CC=\"python -m ziglang cc\" after pip install ziglang)") from None
+                         "(e.g. CC=\"$PWD/.venv/bin/python -m ziglang cc\" with the ziglang wheel)") from None
     if r.returncode:
         raise SystemExit(f"bench_rcl_floor: compiling {SOURCE} failed:\n{r.stderr[-2000:]}")
     return exe
