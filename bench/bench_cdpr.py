@@ -237,7 +237,7 @@ def estimator_node(bench: Bench, launch, seconds: float, params: dict) -> None:
 
 
 def run_closed_loop(launch, seconds: float, params: dict, log=print, on_started=None,
-                    node_params: dict | None = None) -> dict | None:
+                    node_params: dict | None = None, controller_argv: list | None = None) -> dict | None:
     """Three node processes (estimator, controller, simulator in real-time mode at 1 kHz) on the
     launcher's domain for ``seconds`` of simulated time; measured from the simulator's and the
     nodes' own /diagnostics (1 Hz) and /proc CPU times, over the steady state (from 1 s of sim time,
@@ -252,13 +252,18 @@ def run_closed_loop(launch, seconds: float, params: dict, log=print, on_started=
     processing p99 any node reported over the steady state (each report is the p99 of its last
     1000 samples, so this is the worst 1 s window), ``load`` (before, after). ``node_params``
     {"sim"|"estimator"|"controller": {parameter: value}} adds parameters to one node (e.g. its
-    ``cpu_affinity`` and ``niceness``)."""
+    ``cpu_affinity`` and ``niceness``). ``controller_argv``: start that program as the controller
+    instead of ``pd_feedforward`` (e.g. bench_rcl_floor's C controller; it reports no p99)."""
     own = node_params or {}
     launch.node("estimator", "payload_estimator", "cdpr", {"poll_period": 0.01} | params | own.get("estimator", {}))
-    launch.node("controller", "pd_feedforward", "cdpr", params | own.get("controller", {}))
+    if controller_argv:
+        launch.start("controller", controller_argv)
+    else:
+        launch.node("controller", "pd_feedforward", "cdpr", params | own.get("controller", {}))
     cl = _Client(launch.domain_id)       # listens to /diagnostics only (1 Hz): no extra 1 kHz load
     deadline = time.monotonic() + 60
-    while time.monotonic() < deadline and not {"payload_estimator", "pd_feedforward"} <= set(cl.diag):
+    ready = {"payload_estimator"} | (set() if controller_argv else {"pd_feedforward"})
+    while time.monotonic() < deadline and not ready <= set(cl.diag):
         cl.spin(0.2)
     launch.node("sim", "cable_sim_node", "cdpr", {"rate": 1000.0, "real_time": True, "payload_mass": 249.0,
                                                   "duration": seconds + 1.0, "settle": 1.0,

@@ -17,7 +17,10 @@ first second). ``--listener`` adds a third process: rclpy subscribing to both st
 the default executor (the load a Python estimator puts on the machine).
 
 Then, in the same run, ``--compare`` runs the cablelab nodes (``bench_realtime``'s closed loop,
-same seconds, same placement) so that the two are measured side by side.
+same seconds, same placement) so that the two are measured side by side, and ``--mixed`` the
+cablelab simulator and estimator answered by the C controller (which holds the first state's
+torques instead of tracking: a timing measurement, not control), to split the misses between the
+Python simulator and the Python controller.
 
 Builds with the C compiler in ``$CC`` (default ``cc``) against the headers and libraries of the
 installed ros-jazzy and MuJoCo wheels and libpython (the wheels' rmw libraries refer to it). A
@@ -184,6 +187,9 @@ def main(argv=None) -> int:
     p.add_argument("--listener", action="store_true", help="a third process: an rclpy subscriber of both state topics")
     p.add_argument("--pin", action="store_true", help="sim (and listener) on CPU 0, controller on CPU 1")
     p.add_argument("--compare", action="store_true", help="then the cablelab nodes (bench_realtime's loop), same seconds")
+    p.add_argument("--mixed", action="store_true",
+                   help="then the cablelab simulator and estimator answered by the C controller (holding "
+                        "the start torques): how much of the loop's misses the Python controller adds")
     p.add_argument("--rt-timer", type=int, default=0, metavar="PRIO",
                    help="also the bare timer under SCHED_FIFO PRIO (chrt; needs the privilege)")
     args = bench.parse(argv)
@@ -198,11 +204,16 @@ def main(argv=None) -> int:
         result["bare timer, SCHED_FIFO"] = run_timer(exe, args.seconds, args.pin, args.rt_timer)
     log(f"rcl loop in C, {args.seconds:g} s ...")
     result["rcl loop in C"] = run_floor(exe, mjb, state, args.seconds, args.listener, args.pin, log)
-    if args.compare:
+    if args.compare or args.mixed:
         from bench_realtime import closed_loop
-
+    if args.compare:
         log(f"cablelab nodes, {args.seconds:g} s ...")
         result["cablelab nodes"] = closed_loop(args.seconds, log, pin=args.pin)
+    if args.mixed:
+        log(f"cablelab simulator and estimator with the C controller, {args.seconds:g} s ...")
+        argv = (["taskset", "-c", ",".join(map(str, PIN["ctrl"]))] if args.pin else []) + \
+            [str(exe), "ctrl", "/cdpr/joint_states", "/cdpr/effort_commands"]
+        result["cablelab sim + C controller"] = closed_loop(args.seconds, log, pin=args.pin, controller_argv=argv)
     if args.json:
         print(json.dumps(result))
         return 0

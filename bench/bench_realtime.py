@@ -133,7 +133,8 @@ IDLE_ESTIMATOR = {"estimator": {"sched_idle": True}}
 
 
 def closed_loop(seconds: float, log, env: dict | None = None, py_spy: str | None = None,
-                pin: bool = False, extra: dict | None = None, idle_estimator: bool = False) -> dict:
+                pin: bool = False, extra: dict | None = None, idle_estimator: bool = False,
+                controller_argv: list | None = None) -> dict:
     from bench_cdpr import run_closed_loop
 
     from cablelab.ros.launch import Launcher
@@ -147,7 +148,8 @@ def closed_loop(seconds: float, log, env: dict | None = None, py_spy: str | None
         placement = {k: dict(v) for k, v in (PINNED if pin else IDLE_ESTIMATOR if idle_estimator else {}).items()}
         for k, v in (extra or {}).items():
             placement.setdefault(k, {}).update(v)
-        r = run_closed_loop(launch, seconds, {}, log, on_started=hook, node_params=placement or None)
+        r = run_closed_loop(launch, seconds, {}, log, on_started=hook, node_params=placement or None,
+                            controller_argv=controller_argv)
     for name, proc in spies:
         proc.wait(timeout=60)
         f = tmp / f"{name}.txt"

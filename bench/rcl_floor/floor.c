@@ -4,7 +4,7 @@
  * node of cablelab (its physics is a bare mj_step holding the CDPR at its start pose).
  *
  *   floor sim  MODEL.mjb STATE.txt SECONDS RATE_HZ   (STATE.txt: nq qpos, nv qvel, nu ctrl)
- *   floor ctrl
+ *   floor ctrl [STATE_TOPIC COMMAND_TOPIC]   (default /floor/joint_states /floor/effort_commands)
  *   floor timer SECONDS RATE_HZ   (the bare timer: deadlines only)
  *
  * sim: publishes the state of sim time k/RATE on /floor/joint_states (sensor_msgs/JointState,
@@ -17,7 +17,9 @@
  *   late or stale, plus the dropped ones. In-loop latency: wake-up to the state published.
  * ctrl: waits on /floor/joint_states, takes the newest, answers with
  *   /floor/effort_commands (Float64MultiArray, layout label "winches stamp=<t>" as cablelab's
- *   controllers send, u = effort - 0.001 qvel); latency: take to published. Stops after 2 s
+ *   controllers send, u = the first state's effort - 0.001 qvel: it holds the start pose; with
+ *   /cdpr/joint_states /cdpr/effort_commands it answers cablelab's CDPR simulator); latency:
+ *   take to published. Stops after 2 s
  *   without states once started, or on SIGINT/SIGTERM.
  * Both print one JSON line of statistics on stdout at the end. */
 #define _GNU_SOURCE
@@ -303,7 +305,7 @@ static int run_timer(double seconds, double rate) {
 }
 
 /* ----------------------------------------------------------------------------- controller */
-static int run_ctrl(void) {
+static int run_ctrl(const char *state_topic, const char *command_topic) {
   Ros r;
   ros_init(&r, "floor_controller");
   const rosidl_message_type_support_t *ts_js = ROSIDL_GET_MSG_TYPE_SUPPORT(sensor_msgs, msg, JointState);
@@ -311,11 +313,11 @@ static int run_ctrl(void) {
   rcl_subscription_t sub = rcl_get_zero_initialized_subscription();
   rcl_subscription_options_t so = rcl_subscription_get_default_options();
   so.qos = stream_qos(1);
-  CHECK(rcl_subscription_init(&sub, &r.node, ts_js, "/floor/joint_states", &so));
+  CHECK(rcl_subscription_init(&sub, &r.node, ts_js, state_topic, &so));
   rcl_publisher_t pub = rcl_get_zero_initialized_publisher();
   rcl_publisher_options_t po = rcl_publisher_get_default_options();
   po.qos = stream_qos(100);
-  CHECK(rcl_publisher_init(&pub, &r.node, ts_arr, "/floor/effort_commands", &po));
+  CHECK(rcl_publisher_init(&pub, &r.node, ts_arr, command_topic, &po));
   rcl_wait_set_t ws = rcl_get_zero_initialized_wait_set();
   CHECK(rcl_wait_set_init(&ws, 1, 0, 0, 0, 0, 0, &r.context, rcl_get_default_allocator()));
 
@@ -325,7 +327,8 @@ static int run_ctrl(void) {
   array_msg_init(&cmd, "winches");
   size_t cap = 1 << 20, nlat = 0;
   double *lat = malloc(sizeof(double) * cap);
-  double last_state = -1.0, cpu0 = cpu_s();
+  double last_state = -1.0, cpu0 = cpu_s(), u0[N] = {0};
+  int have_u0 = 0;
   long answered = 0;
   while (!stop_requested) {
     CHECK(rcl_wait_set_clear(&ws));
@@ -342,8 +345,12 @@ static int run_ctrl(void) {
     if (!got) continue;
     double t_in = now_s();
     size_t n = js.effort.size < N ? js.effort.size : N;
+    if (!have_u0) {               /* hold the first state's torques (no random walk of noise) */
+      for (size_t i = 0; i < n; i++) u0[i] = js.effort.data[i];
+      have_u0 = 1;
+    }
     for (size_t i = 0; i < n && i < js.velocity.size; i++)
-      cmd.data.data[i] = js.effort.data[i] - 0.001 * js.velocity.data[i];
+      cmd.data.data[i] = u0[i] - 0.001 * js.velocity.data[i];
     char label[64];
     snprintf(label, sizeof label, "winches stamp=%.9f", stamp_of(&js.header.stamp));
     rosidl_runtime_c__String__assign(&cmd.layout.dim.data[0].label, label);
@@ -370,8 +377,10 @@ int main(int argc, char **argv) {
   signal(SIGTERM, on_signal);
   if (argc >= 6 && strcmp(argv[1], "sim") == 0)
     return run_sim(argv[2], argv[3], atof(argv[4]), atof(argv[5]));
-  if (argc >= 2 && strcmp(argv[1], "ctrl") == 0) return run_ctrl();
+  if (argc >= 2 && strcmp(argv[1], "ctrl") == 0)
+    return run_ctrl(argc >= 4 ? argv[2] : "/floor/joint_states", argc >= 4 ? argv[3] : "/floor/effort_commands");
   if (argc >= 4 && strcmp(argv[1], "timer") == 0) return run_timer(atof(argv[2]), atof(argv[3]));
-  fprintf(stderr, "usage: floor sim MODEL.mjb STATE.txt SECONDS RATE_HZ | floor ctrl | floor timer SECONDS RATE_HZ\n");
+  fprintf(stderr, "usage: floor sim MODEL.mjb STATE.txt SECONDS RATE_HZ | floor ctrl [STATE_TOPIC COMMAND_TOPIC] | "
+                  "floor timer SECONDS RATE_HZ\n");
   return 2;
 }
