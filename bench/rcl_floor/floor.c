@@ -141,7 +141,6 @@ static void set_stamp(builtin_interfaces__msg__Time *t, double s) {
 
 /* ------------------------------------------------------------------------------------ sim */
 static int run_sim(const char *model_path, const char *state_path, double seconds, double rate) {
-  char err[1000] = "";
   mjModel *m = mj_loadModel(model_path, NULL);
   if (!m) { fprintf(stderr, "floor: cannot load %s\n", model_path); return 2; }
   mjData *d = mj_makeData(m);
@@ -151,7 +150,6 @@ static int run_sim(const char *model_path, const char *state_path, double second
   for (int i = 0; i < m->nv; i++) if (fscanf(f, "%lf", &d->qvel[i]) != 1) { fprintf(stderr, "floor: %s: short qvel\n", state_path); return 2; }
   for (int i = 0; i < m->nu; i++) if (fscanf(f, "%lf", &d->ctrl[i]) != 1) { fprintf(stderr, "floor: %s: short ctrl\n", state_path); return 2; }
   fclose(f);
-  (void)err;
   mjtNum hold[64];
   int nu = m->nu < 64 ? m->nu : 64;
   for (int i = 0; i < nu; i++) hold[i] = d->ctrl[i];
