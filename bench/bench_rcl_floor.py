@@ -190,6 +190,7 @@ def main(argv=None) -> int:
     p.add_argument("--mixed", action="store_true",
                    help="then the cablelab simulator and estimator answered by the C controller (holding "
                         "the start torques): how much of the loop's misses the Python controller adds")
+    p.add_argument("--timers-only", action="store_true", help="only the bare timer(s): the machine's floor")
     p.add_argument("--rt-timer", type=int, default=0, metavar="PRIO",
                    help="also the bare timer under SCHED_FIFO PRIO (chrt; needs the privilege)")
     args = bench.parse(argv)
@@ -202,8 +203,9 @@ def main(argv=None) -> int:
     if args.rt_timer:
         log(f"bare timer under SCHED_FIFO {args.rt_timer}, {args.seconds:g} s ...")
         result["bare timer, SCHED_FIFO"] = run_timer(exe, args.seconds, args.pin, args.rt_timer)
-    log(f"rcl loop in C, {args.seconds:g} s ...")
-    result["rcl loop in C"] = run_floor(exe, mjb, state, args.seconds, args.listener, args.pin, log)
+    if not args.timers_only:
+        log(f"rcl loop in C, {args.seconds:g} s ...")
+        result["rcl loop in C"] = run_floor(exe, mjb, state, args.seconds, args.listener, args.pin, log)
     if args.compare or args.mixed:
         from bench_realtime import closed_loop
     if args.compare:
