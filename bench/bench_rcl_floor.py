@@ -164,7 +164,7 @@ def run_timer(exe: Path, seconds: float, pin: bool, rt: int) -> dict:
         argv = ["chrt", "-f", str(rt), *argv]
     if pin:
         argv = ["taskset", "-c", ",".join(map(str, PIN["sim"])), *argv]
-    r = subprocess.run(argv, capture_output=True, text=True, env=_ros_env())
+    r = subprocess.run(argv, capture_output=True, text=True)   # (no ROS: ./run's library path only)
     if r.returncode:
         raise SystemExit(f"bench_rcl_floor: the bare timer failed: {r.stderr.strip()[-500:]}")
     t = json.loads(r.stdout.strip().splitlines()[-1])
@@ -172,12 +172,6 @@ def run_timer(exe: Path, seconds: float, pin: bool, rt: int) -> dict:
             "missed_cycles": t["missed_cycles"], "late": t["late"], "stale": 0, "dropped": t["dropped"],
             "p99_ms": {"wake-up": t["wakeup_p99_ms"]}, "wakeup_max_ms": t["wakeup_max_ms"],
             "pinned": pin, "rt_priority": rt > 0}
-
-
-def _ros_env() -> dict:
-    from cablelab.ros.launch import ros_env, unique_domain_id
-
-    return ros_env(unique_domain_id())
 
 
 def main(argv=None) -> int:

@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import types
 
+import pytest
+
 from cablelab.ros import plant_node
 from cablelab.ros.plant_node import PROBE_REPEAT, PlantNode
 
@@ -39,6 +41,14 @@ class FakeLogger:
     warning = info
 
 
+@pytest.fixture
+def clock(monkeypatch):
+    """The gate's wall clock, set by the test: ``clock[0]`` s."""
+    now = [0.0]
+    monkeypatch.setattr(plant_node.time, "monotonic", lambda: now[0])
+    return now
+
+
 def make_gate(clock, wait_subs=2):
     state, other, diag = FakePublisher(), FakePublisher(), FakePublisher()
     published = []
@@ -59,9 +69,8 @@ def make_gate(clock, wait_subs=2):
     return node, state, other, published, waiting, log
 
 
-def test_gate_waits_for_the_acknowledgement_of_a_sample_published_after_the_count(monkeypatch):
-    clock = [100.0]
-    monkeypatch.setattr(plant_node.time, "monotonic", lambda: clock[0])
+def test_gate_waits_for_the_acknowledgement_of_a_sample_published_after_the_count(clock):
+    clock[0] = 100.0
     node, state, other, published, waiting, log = make_gate(clock)
 
     # too few subscribers: the start state is republished every 0.5 s for late joiners
@@ -96,9 +105,7 @@ def test_gate_waits_for_the_acknowledgement_of_a_sample_published_after_the_coun
     assert not waiting(published[-1])                # and stays started
 
 
-def test_gate_gives_up_after_60_s_with_a_warning(monkeypatch):
-    clock = [0.0]
-    monkeypatch.setattr(plant_node.time, "monotonic", lambda: clock[0])
+def test_gate_gives_up_after_60_s_with_a_warning(clock):
     node, state, other, published, waiting, log = make_gate(clock)
     state.count = 2
     clock[0] = 59.9
@@ -108,9 +115,7 @@ def test_gate_gives_up_after_60_s_with_a_warning(monkeypatch):
     assert "without" in log.lines[-1]
 
 
-def test_gate_restarts_the_probe_when_a_subscriber_leaves(monkeypatch):
-    clock = [0.0]
-    monkeypatch.setattr(plant_node.time, "monotonic", lambda: clock[0])
+def test_gate_restarts_the_probe_when_a_subscriber_leaves(clock):
     node, state, other, published, waiting, log = make_gate(clock)
     state.count = 2
     clock[0] = 1.0

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import time
 
+from rclpy.duration import Duration
 from rclpy.node import Node
 from std_msgs.msg import String
 
@@ -21,6 +22,7 @@ from .inputs import InputMonitor
 from .qos import DESCRIPTION_QOS
 
 PROBE_REPEAT = 5.0  # s wall: the start gate's probe state is published again (see waiting_for_subscribers)
+NO_WAIT = Duration(seconds=0)
 
 
 class PlantNode(Node):
@@ -173,11 +175,8 @@ class PlantNode(Node):
     def all_acknowledged(self) -> bool:
         """Whether every matched reliable subscriber acknowledged every sample this node
         published (checked without waiting; /diagnostics, published on a timer, not counted)."""
-        from rclpy.duration import Duration
-
         diag = getattr(getattr(self, "diag", None), "pub", None)
-        return all(pub.wait_for_all_acked(Duration(seconds=0)) for pub in self.publishers
-                   if pub is not diag)
+        return all(pub.wait_for_all_acked(NO_WAIT) for pub in self.publishers if pub is not diag)
 
     # ------------------------------------------------------------------ diagnostics
     def start_diagnostics(self) -> None:
