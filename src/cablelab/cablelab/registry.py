@@ -67,6 +67,9 @@ class Plant:
             ``shifted`` has every motion signal at ``t - tau``; the hook puts the raw
             measurement back unshifted and re-forms ``y`` and the signals computed from it
             with the map of the time the measurement belongs to. None: nothing to re-form.
+        markers: optional ``fn(bag, description) -> (t, frames) | None``: the machine in 3D along
+            a recording for the overlay bag (:mod:`cablelab.markers`; ``frames`` one list of
+            marker dicts per time), None when the bag lacks what it needs.
     """
 
     name: str
@@ -88,6 +91,7 @@ class Plant:
     check_bag: Callable | None = None
     package: str = ""
     remeasure: Callable | None = None
+    markers: Callable | None = None
 
 
 def register_plant(plant: Plant) -> Plant:

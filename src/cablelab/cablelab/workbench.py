@@ -132,6 +132,12 @@ def _fit_on_record(model: Model, ds: Dataset):
 def compare(ds: Dataset, model: Model, *, segments: int = 5) -> dict:
     """Inverse-model comparison: fit on the whole record, metrics per channel, worst segments,
     residual by regime and whiteness. JSON of CONTRACT section 5 (``compare``) + extras."""
+    return compare_fit(ds, model, segments=segments)[0]
+
+
+@blas_single
+def compare_fit(ds: Dataset, model: Model, *, segments: int = 5):
+    """:func:`compare` and the identification it reports on (for the overlay bag)."""
     ident, y_meas, mets = _fit_on_record(model, ds)
     out: dict = {"plant": ds.plant, "effects": list(model.effects), "samples": int(ident.valid.sum())}
     out["channels"] = {}
@@ -147,7 +153,7 @@ def compare(ds: Dataset, model: Model, *, segments: int = 5) -> dict:
     plant = _plant_of(ds)
     if plant is not None and plant.simulate is not None:
         out["free_run"] = plant.simulate(ds, ident.params)
-    return out
+    return out, ident
 
 
 def _plant_of(ds: Dataset):

@@ -83,11 +83,47 @@ def conditioning_from_args(args):
     return Conditioning(**kw)
 
 
-def load_from_args(args):
+def add_overlay_out(p, *, greedy: bool = False) -> None:
+    """``--out BAG2`` (the model overlay bag, :mod:`cablelab.overlay`) and ``--overwrite``."""
+    what = ("the nominal model and the model after each added effect (needs --greedy)" if greedy
+            else "the model")
+    p.add_argument("--out", metavar="BAG2",
+                   help=f"also write a bag with the input's topics plus the measured channels, the "
+                        f"prediction and the residual of {what} as /<plant>/model/... topics "
+                        f"(for Foxglove and PlotJuggler; see docs/interface.md)")
+    add_overwrite(p)
+
+
+def write_overlay_out(args, plant, ds, stages) -> None:
+    """Write the overlay bag of ``stages`` to ``args.out`` (if given) atomically: whole or not at
+    all, never into the input (:func:`cablelab.atomic.atomic_output`); its warnings join
+    ``args.warnings``."""
+    if not getattr(args, "out", None):
+        return
+    from ..atomic import atomic_output
+    from ..bags import open_bag
+    from ..overlay import write_overlay
+
+    bag = open_bag(args.bag, recover=getattr(args, "recover", False))
+    markers = None
+    if plant.markers is not None:
+        markers = plant.markers(bag, ds.description)
+    with atomic_output(args.out, overwrite=args.overwrite, inputs=[args.bag, args.description]) as tmp:
+        warnings = write_overlay(tmp, bag, ds.plant, stages, markers=markers)
+    args.warnings = list(getattr(args, "warnings", []) or []) + warnings
+
+
+def load_from_args(args, *, check_out: bool = False):
     """(plant, description, dataset, model) from the shared options; the input checks' warning
-    lines are kept in ``args.warnings`` (see :func:`with_warnings`)."""
+    lines are kept in ``args.warnings`` (see :func:`with_warnings`). ``check_out``: check the
+    ``--out`` target first (before any work: never over the input, never replaced unasked)."""
     from ..model import parse_effect_list, parse_fixed
     from ..workbench import build_model, load_checked
+
+    if check_out and getattr(args, "out", None):
+        from ..atomic import check_target
+
+        check_target(args.out, overwrite=args.overwrite, inputs=[args.bag, args.description])
 
     options = {"conditioning": conditioning_from_args(args), "tensions": args.tensions}
     plant, desc, ds, check = load_checked(args.bag, args.description, options,

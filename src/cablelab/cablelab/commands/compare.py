@@ -1,7 +1,8 @@
 """``cablelab compare BAG [--effects a,b] --json``: measured vs model per channel."""
 from __future__ import annotations
 
-from ._workbench_args import add_common, with_warnings, dump_json, load_from_args, param_line
+from ._workbench_args import (add_common, add_overlay_out, dump_json, load_from_args, param_line,
+                              with_warnings, write_overlay_out)
 
 HELP = "compare the model (nominal effects + --effects, fitted) with the measurement per channel"
 
@@ -9,13 +10,17 @@ HELP = "compare the model (nominal effects + --effects, fitted) with the measure
 def add_arguments(p) -> None:
     add_common(p)
     p.add_argument("--segments", type=int, default=5, help="number of worst segments to list")
+    add_overlay_out(p)
 
 
 def run(args) -> int:
-    from ..workbench import compare
+    from ..overlay import stage_from_fit
+    from ..workbench import compare_fit
 
-    _, _, ds, model = load_from_args(args)
-    out = with_warnings(args, compare(ds, model, segments=args.segments))
+    plant, _, ds, model = load_from_args(args, check_out=True)
+    out, ident = compare_fit(ds, model, segments=args.segments)
+    write_overlay_out(args, plant, ds, [stage_from_fit(None, ds, ident)])
+    out = with_warnings(args, out)
     if args.json:
         print(dump_json(out))
         return 0
@@ -33,4 +38,6 @@ def run(args) -> int:
     print("worst segments:")
     for s in out["worst_segments"]:
         print(f"  {s['channel']}: {s['t_start']:.3f}-{s['t_end']:.3f} s  NRMSE {100 * s['error']:.1f} %")
+    if args.out:
+        print(f"model overlay (measured, prediction, residual) written to {args.out}")
     return 0

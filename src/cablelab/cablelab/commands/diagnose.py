@@ -1,7 +1,8 @@
 """``cablelab diagnose BAG [--effects a,b] [--greedy] --json``: which effect is missing."""
 from __future__ import annotations
 
-from ._workbench_args import add_common, add_folds, check_alpha, dump_json, load_from_args, with_warnings
+from ._workbench_args import (add_common, add_folds, add_overlay_out, check_alpha, dump_json,
+                              load_from_args, with_warnings, write_overlay_out)
 
 HELP = "rank the missing physical effects by held-out error (blocked k-fold), --greedy adds them"
 
@@ -17,24 +18,35 @@ def add_arguments(p) -> None:
     p.add_argument("--min-gain", type=float, default=0.05,
                    help="minimum relative held-out error reduction of a significant effect, over the "
                         "channels it changes (default 0.05)")
+    add_overlay_out(p, greedy=True)
 
 
 def run(args) -> int:
+    from ..errors import CablelabError
     from ..model import parse_effect_list
     from ..workbench import diagnose
 
     check_alpha(args.alpha)
     if not args.min_gain >= 0:
-        from ..errors import CablelabError
-
         raise CablelabError(f"--min-gain {args.min_gain!r}: expected a relative gain >= 0 (e.g. 0.05)")
-    plant, desc, ds, model = load_from_args(args)
+    if args.out and not args.greedy:
+        raise CablelabError("--out: the overlay bag holds the greedy waterfall's models; add --greedy")
+    plant, desc, ds, model = load_from_args(args, check_out=True)
     cands = parse_effect_list(args.candidates) if args.candidates else plant.candidates(desc)
     out = diagnose(ds, model, cands, folds=args.folds, alpha=args.alpha, min_gain=args.min_gain,
                    greedy_mode=args.greedy, quiet=args.json)
+    if args.out:
+        from ..model import Model
+        from ..overlay import fit_stage, stage_name
+
+        stages = [fit_stage(stage_name(st.added), ds, Model(ds.plant, tuple(st.effects), model.fixed))
+                  for st in out.greedy]
+        write_overlay_out(args, plant, ds, stages)
     doc = with_warnings(args, out.to_json())
     if args.json:
         print(dump_json(doc))
         return 0
     print("\n".join(out.lines()))
+    if args.out:
+        print(f"model overlay (measured, prediction, residual per stage) written to {args.out}")
     return 0
