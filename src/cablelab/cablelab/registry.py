@@ -67,6 +67,10 @@ class Plant:
             ``shifted`` has every motion signal at ``t - tau``; the hook puts the raw
             measurement back unshifted and re-forms ``y`` and the signals computed from it
             with the map of the time the measurement belongs to. None: nothing to re-form.
+        channels: the output channel names of the plant's datasets (``Dataset.channels`` with the
+            default options), for layouts (:mod:`cablelab.layouts`).
+        topic_names: optional ``fn(description or None) -> {topic: element names}`` of the
+            plant's JointState topics whose names the contract fixes (None: the default machine).
         markers: optional ``fn(bag, description) -> (t, frames) | None``: the machine in 3D along
             a recording for the overlay bag (:mod:`cablelab.markers`; ``frames`` one list of
             marker dicts per time), None when the bag lacks what it needs.
@@ -92,6 +96,8 @@ class Plant:
     package: str = ""
     remeasure: Callable | None = None
     markers: Callable | None = None
+    channels: tuple[str, ...] = ()
+    topic_names: Callable | None = None
 
 
 def register_plant(plant: Plant) -> Plant:

@@ -225,4 +225,6 @@ AXIS = register_plant(Plant(
     joint_topic=TOPIC,
     joints=("joint",),
     capabilities=frozenset({"joint_actuators"}),
+    channels=("joint",),
+    topic_names=lambda desc: {TOPIC: ["joint"], "/axis/ground_truth/joint_states": ["joint"]},
 ))

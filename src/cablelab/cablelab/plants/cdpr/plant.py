@@ -468,4 +468,13 @@ CDPR = register_plant(Plant(
     estimate=estimate_bag,
     checked_topics=(TENSIONS, "/cdpr/reference", POSE),
     check_bag=check_bag,
+    channels=CHANNELS,
+    topic_names=lambda desc: _topic_names(desc),
 ))
+
+
+def _topic_names(desc) -> dict:
+    """Element names of the CDPR JointState topics (CONTRACT sec. 2) for ``desc``'s cables."""
+    n = len(desc.cdpr.cables) if desc is not None and desc.cdpr is not None else 8
+    return {JOINTS: [f"winch_{i}" for i in range(1, n + 1)],
+            TENSIONS: [f"cable_{i}" for i in range(1, n + 1)]}

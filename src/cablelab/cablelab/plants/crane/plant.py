@@ -253,4 +253,7 @@ CRANE = register_plant(Plant(
     capabilities=frozenset({"joint_actuators"}),
     estimate=estimate_bag,
     check_bag=lambda bag, desc, options, series: _check_joint_names(bag, series),
+    channels=JOINTS,
+    topic_names=lambda desc: {JOINT_STATES: list(JOINTS), **{t: ["theta1", "theta2", "rope_length"] for t in
+                                                          ("/crane/swing_estimate", "/crane/ground_truth/swing")}},
 ))

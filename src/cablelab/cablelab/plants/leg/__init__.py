@@ -43,6 +43,10 @@ LEG = register_plant(Plant(
     joints=("body", "motor"),
     checked_topics=("/leg/contact",),
     check_bag=check_bag,
+    channels=("body",),
+    topic_names=lambda desc: {"/leg/joint_states": ["body", "motor"], "/leg/contact": ["contact"],
+                              **{t: ["height", "phase", "apex_height", "grf"] for t in
+                                 ("/leg/hop_estimate", "/leg/ground_truth/state")}},
 ))
 
 PLANT = LEG

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 from ...registry import Plant, register_plant
 from . import effects as _effects  # noqa: F401  (registers the effect ids)
-from .dataset import POSE, POSE_TOPIC, SUSPENSION_TOPIC, dataset
+from .dataset import CHANNELS as _CHANNELS, POSE, POSE_TOPIC, SUSPENSION_TOPIC, dataset
 from .description import parse_section
 
 JOINT_STATE = "sensor_msgs/msg/JointState"
@@ -59,6 +59,9 @@ SUSPENDED = register_plant(Plant(
         "/suspended/ground_truth/virtual_joints": JOINT_STATE,
         SUSPENSION_TOPIC: POSE,                # optional, docs/contract-additions.md (suspension_motion)
     },
+    channels=_CHANNELS,
+    topic_names=lambda desc: {t: ["swing_x", "swing_y", "yaw", "r_x", "r_y"] for t in
+                              ("/suspended/swing_estimate", "/suspended/ground_truth/swing")},
 ))
 
 PLANT = SUSPENDED
