@@ -470,7 +470,14 @@ CDPR = register_plant(Plant(
     check_bag=check_bag,
     channels=CHANNELS,
     topic_names=lambda desc: _topic_names(desc),
+    markers=lambda bag, desc: _bag_markers(bag, desc),
 ))
+
+
+def _bag_markers(bag, desc):
+    from .markers import bag_markers
+
+    return bag_markers(bag, desc)
 
 
 def _topic_names(desc) -> dict:

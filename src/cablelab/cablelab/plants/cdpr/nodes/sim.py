@@ -22,7 +22,9 @@ ROS parameters: ``description`` (YAML file or text; default CAROCA), ``payload_m
 default two periods in real time, 0 in lock-step), ``publish_pose``, ``trajectory_speed`` (time scale of the s-curve),
 ``settle`` (s held at A before the trajectory starts), ``duration`` (s of simulated time after
 which the node exits; 0 = run until stopped), ``command_timeout`` (s wall, real time),
-``lockstep_timeout`` (s wall, lock-step), ``extras_every`` (publish /clock, the measured pose and
+``lockstep_timeout`` (s wall, lock-step), ``markers_rate`` (Hz of wall time of the 3D view
+``/cdpr/markers``, visualization_msgs/MarkerArray in ``world``: cables coloured by tension,
+platform, exit points and frame; 0 = off; on its own timer, after the state), ``extras_every`` (publish /clock, the measured pose and
 the ground truth every k-th step: lighter at 1 kHz), ``wait_for_subscribers`` (time starts only
 once /cdpr/joint_states has this many subscribers, max 60 s: no sample lost to discovery), ``seed``,
 ``fast_executor`` (default true: spun by :class:`cablelab.ros.fastspin.FastExecutor`; false = rclpy's
@@ -40,6 +42,7 @@ from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 from trajectory_msgs.msg import MultiDOFJointTrajectory
+from visualization_msgs.msg import MarkerArray
 
 from ....description import load_description
 from ....errors import CablelabError
@@ -158,7 +161,30 @@ class CdprSimNode(PlantNode):
             poll(self, sub)
         self.start_diagnostics()
         self.timer = self.create_timer(1.0 / self.rate if self.real_time else 0.0002, self.tick)
+        self._markers_timer(float(p("markers_rate", 30.0).value))
         self.publish_state()
+
+    def _markers_timer(self, rate: float) -> None:
+        """The 3D view: ``/cdpr/markers`` at ``rate`` Hz of wall time (0 = off), pre-encoded
+        (:class:`cablelab.markers.MarkerEncoder`); the platform at its true pose, the cables
+        coloured by their true tension."""
+        if not rate > 0:
+            return
+        from ....markers import MarkerEncoder
+
+        self._marker_enc = MarkerEncoder(self._marker_frame())
+        self.pub_markers = self.create_publisher(MarkerArray, "/cdpr/markers", stream_qos(1))
+        self.create_timer(1.0 / rate, self.publish_markers)
+
+    def _marker_frame(self):
+        from ..markers import cdpr_markers
+        from ....rotations import quat_to_matrix
+
+        p, q = self.sim.truth_pose()
+        return cdpr_markers(self.description, p, quat_to_matrix(q), self.sim.truth_state()["tension"])
+
+    def publish_markers(self) -> None:
+        self.pub_markers.publish(self._marker_enc.encode([self.sim.time], [self._marker_frame()])[0])
 
     def _templates(self) -> None:
         """Pre-serialised messages (fixed names and lengths): each step patches the numbers."""
