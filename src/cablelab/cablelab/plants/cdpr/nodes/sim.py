@@ -20,7 +20,9 @@ ROS parameters: ``description`` (YAML file or text; default CAROCA), ``payload_m
 ``torque_noise`` (N m), ``pose_noise`` (m), ``timestep`` (s; 0 = min(2 ms, 1/rate)), ``rate`` (Hz), ``real_time``,
 ``publish_reference``, ``reference_lead`` (s the published reference runs ahead of the state:
 default two periods in real time, 0 in lock-step), ``publish_pose``, ``trajectory_speed`` (time scale of the s-curve),
-``settle`` (s held at A before the trajectory starts), ``duration`` (s of simulated time after
+``settle`` (s held at A before the trajectory starts), ``mass_change`` (kg put on the platform at
+its centre of mass at sim time ``mass_change_time`` s, < 0 = never: a payload change while
+running, e.g. to test a model monitor; the ground truth follows), ``duration`` (s of simulated time after
 which the node exits; 0 = run until stopped), ``command_timeout`` (s wall, real time),
 ``lockstep_timeout`` (s wall, lock-step), ``markers_rate`` (Hz of wall time of the 3D view
 ``/cdpr/markers``, visualization_msgs/MarkerArray in ``world``: cables coloured by tension,
@@ -90,6 +92,8 @@ class CdprSimNode(PlantNode):
         self.speed = float(p("trajectory_speed", 1.0).value)
         self.settle = float(p("settle", 1.0).value)
         self.duration = float(p("duration", 0.0).value)
+        self.mass_change = float(p("mass_change", 0.0).value)
+        self.mass_change_time = float(p("mass_change_time", -1.0).value)
         self.extras_every = max(1, int(p("extras_every", 1).value))
         # real time: the reference two steps ahead goes out right after the state (off the
         # state -> command critical path; the consumers look it up by stamp, and a controller
@@ -316,6 +320,12 @@ class CdprSimNode(PlantNode):
                     missed = True
             self.sim.step(self.u, self.nstep)
         self.k += 1
+        if self.mass_change and 0 <= self.mass_change_time <= self.sim.time:
+            self.sim.add_mass(self.mass_change)
+            self.t_tpay["inertia.m"][0] = self.sim.truth.total_mass
+            self.t_tpay.vector("inertia.com")[:] = self.sim.truth.total_com
+            self.get_logger().info(f"{self.mass_change:g} kg put on the platform at t = {self.sim.time:.3f} s")
+            self.mass_change = 0.0
         if missed and self.commands and self.real_time:
             self.missed_steps += 1
         if self.sim.slack().any():

@@ -1,0 +1,157 @@
+"""``model_monitor --plant P``: the plant's identified model on the live topics (any plant).
+
+A thin adapter over :class:`cablelab.monitor.ResidualMonitor`: the plant's input topics (those
+its workbench dataset reads) are taken as serialised messages (no per-message decoding), the
+window is evaluated on a timer, and for every new sample ``/<plant>/model/{measured,prediction,
+residual}`` (sensor_msgs/JointState, names = the output channels, ``effort`` = the value,
+stamped like the inputs) is published, the same topics as the overlay bag of ``cablelab compare
+--out``. /diagnostics is OK while every channel's residual stays in its band, WARN (ERROR beyond
+``error_factor`` bands) with the channel, the residual's size and the stamps when one stays
+outside longer than ``hold`` s; published at once when the level changes.
+
+ROS parameters: ``identify_json`` (file written by ``cablelab identify BAG --json``: the model's
+effects, parameters and the residual RMS per channel; "" = identify the description's nominal
+model on the first ``calibrate`` s of the stream), ``description`` (YAML file or text; default:
+``/plant_description``), ``band_sigma`` (band = this x the residual RMS, default 4), ``hold`` (s
+outside the band before an alarm, default 0.5), ``window`` (s of stream conditioned per
+evaluation, default 3), ``period`` (s wall between evaluations, default 0.25), ``calibrate``
+(s, default 10), ``error_factor`` (default 3), ``tensions`` (CDPR: dynamometer or motor),
+``niceness`` and the other placement parameters of :meth:`PlantNode.use_fast_executor` (the
+monitor is off every critical path: run it with a positive niceness beside a 1 kHz loop).
+"""
+from __future__ import annotations
+
+import importlib
+import time
+from pathlib import Path
+
+import numpy as np
+from sensor_msgs.msg import JointState
+
+from ..errors import CablelabError
+from . import convert
+from .plant_node import PlantNode
+from .qos import stream_qos
+
+
+def _msg_class(msgtype: str):
+    pkg, _, name = msgtype.partition("/msg/")
+    return getattr(importlib.import_module(f"{pkg}.msg"), name)
+
+
+class ModelMonitorNode(PlantNode):
+    def __init__(self, plant: str):
+        super().__init__("model_monitor")
+        from ..monitor import MonitorModel
+        from ..registry import get_plant
+
+        self.plant_name = plant
+        self.plant = get_plant(plant)
+        self.band_sigma = float(self.param("band_sigma", 4.0))
+        self.hold = float(self.param("hold", 0.5))
+        self.window = float(self.param("window", 3.0))
+        self.period = float(self.param("period", 0.25))
+        self.calibrate = float(self.param("calibrate", 10.0))
+        self.error_factor = float(self.param("error_factor", 3.0))
+        self.tensions = self.choice("tensions", "dynamometer", ("dynamometer", "motor"))
+        for name, v in (("band_sigma", self.band_sigma), ("hold", self.hold), ("window", self.window),
+                        ("period", self.period), ("calibrate", self.calibrate),
+                        ("error_factor", self.error_factor)):
+            if not (np.isfinite(v) and v > 0):
+                raise CablelabError(f"model_monitor: parameter {name}: expected a number > 0, got {v!r}")
+        path = str(self.param("identify_json", ""))
+        if path:
+            try:
+                text = Path(path).read_text()
+            except OSError as exc:
+                raise CablelabError(f"model_monitor: parameter identify_json: {path}: {exc.strerror}") from None
+            self.spec = MonitorModel.from_identify_json(text, self.band_sigma, path)
+        else:
+            self.spec = MonitorModel(())
+        self.monitor = None
+        self.use_fast_executor(False)
+        q = stream_qos()
+        self.pubs = {k: self.create_publisher(JointState, f"/{plant}/model/{k}", q)
+                     for k in ("measured", "prediction", "residual")}
+        self.listen_for_description(str(self.param("description", "")))
+        from ..monitor import ResidualMonitor
+
+        topics = ResidualMonitor.input_topics(self.plant)
+        required = {t for t, _ in self.plant.topics}
+        for topic, msgtype in topics.items():
+            self.inputs.add(topic, timeout=max(2.0, 4 * self.period), required=topic in required)
+            self.create_subscription(_msg_class(msgtype), topic,
+                                     lambda data, topic=topic: self.on_message(topic, data), q, raw=True)
+        self.level = 0
+        self.start_diagnostics()
+        self.create_timer(self.period, self.evaluate)
+
+    def set_description(self, desc) -> None:
+        from ..monitor import ResidualMonitor
+
+        if desc.plant != self.plant_name:
+            self.description_problem = f"/plant_description is a {desc.plant} plant, not {self.plant_name}"
+            return
+        super().set_description(desc)
+        self.keep_first_description = True
+        self.monitor = ResidualMonitor(self.plant_name, desc, self.spec, window=self.window, hold=self.hold,
+                                       band_sigma=self.band_sigma, calibrate=self.calibrate,
+                                       error_factor=self.error_factor, options={"tensions": self.tensions})
+
+    def on_message(self, topic: str, data: bytes) -> None:
+        now = time.monotonic()
+        if self.monitor is not None and self.monitor.add(topic, data):
+            self.inputs.accept(topic, np.ones(1), now)
+        else:
+            self.inputs.accept(topic, None, now)
+
+    def evaluate(self) -> None:
+        if self.monitor is None:
+            return
+        s = self.monitor.step()
+        if s is None:
+            return
+        names = list(s.channels)
+        res = s.residual
+        for i, t in enumerate(s.t.tolist()):
+            for kind, vals in (("measured", s.measured), ("prediction", s.prediction), ("residual", res)):
+                self.pubs[kind].publish(convert.joint_state_msg(t, names, None, None, vals[i]))
+        for a in s.raised:
+            self.get_logger().warning(a.line())
+        level = self.monitor.check.level()
+        if level != self.level:
+            self.level = level
+            self.diag.publish()
+
+    def extend_status(self, level, msg, values):
+        if self.monitor is None:
+            return max(level, 1), "waiting for /plant_description" if msg == "ok" else msg, values
+        mlevel, mmsg, mvalues = self.monitor.status()
+        values.update(mvalues)
+        text = mmsg if msg == "ok" else f"{msg}; {mmsg}"
+        return max(level, mlevel), text, values
+
+
+def make_node(args) -> PlantNode:
+    return ModelMonitorNode(args.plant)
+
+
+def main(argv=None) -> int:
+    """``model_monitor --plant P [--ros-args ...]``."""
+    import argparse
+    import sys
+
+    from ..registry import available_plants
+    from .runner import run_node, split_ros_args
+
+    argv = list(sys.argv[1:] if argv is None else argv)
+    user, ros_args = split_ros_args(argv)
+    parser = argparse.ArgumentParser(
+        prog="model_monitor", description="Live model monitor: the plant's identified model on the live "
+        "topics; publishes /<plant>/model/{measured,prediction,residual} and raises WARN/ERROR on "
+        "/diagnostics when a channel's residual leaves its band for longer than a set time.",
+        epilog="ROS parameters: identify_json, description, band_sigma, hold, window, period, calibrate, "
+               "error_factor, tensions (--ros-args -p name:=value). Stops cleanly on SIGINT/SIGTERM.")
+    parser.add_argument("--plant", choices=available_plants(), required=True, help="which plant")
+    args = parser.parse_args(user)
+    return run_node(make_node, args, ros_args, "model_monitor")
