@@ -102,8 +102,7 @@ def _message(markers: list[Marker], t: float, frame_id: str = "world"):
 class MarkerEncoder:
     """Serialise MarkerArrays that share one layout (same markers, same number of points: one
     plant's machine) by patching the numbers of a template serialised once
-    (:func:`cablelab.cdr.walk`); vectorised over frames, about a hundred times faster than
-    :func:`marker_array_cdr` per array."""
+    (:func:`cablelab.cdr.walk`); vectorised over frames (CPU per array: bench/bench_monitor.py)."""
 
     def __init__(self, template: list[Marker], frame_id: str = "world"):
         from . import cdr

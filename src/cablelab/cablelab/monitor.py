@@ -13,8 +13,9 @@ clears it after ``hold`` s back inside.
 The model and its band come from a ``cablelab identify --json`` document (parameters, and the
 band = ``band_sigma`` x the channel's residual RMS), or are identified on the first
 ``calibrate`` s of the stream (the nominal model of the description; band from that fit's
-residual). Times are the messages' header stamps (sim time in simulation), so detection delays
-are measured on the machine's clock, however loaded the computer.
+residual, outliers trimmed: :func:`trimmed_rms`). Times are the messages' header stamps (sim
+time in simulation), so detection delays are measured on the machine's clock, however loaded
+the computer.
 """
 from __future__ import annotations
 
@@ -37,6 +38,17 @@ def stamp_ns(data: bytes) -> int | None:
     sec = int.from_bytes(data[4:8], "little", signed=True)
     nsec = int.from_bytes(data[8:12], "little", signed=False)
     return sec * 1_000_000_000 + nsec
+
+
+def trimmed_rms(r) -> np.ndarray:
+    """RMS per column of ``r`` (N, C) without its outliers (beyond 5 robust sigmas, 1.4826 x
+    the median absolute deviation, from the median): a start-up transient in the calibration
+    window does not widen the band, the spread of normal running does."""
+    r = np.asarray(r, dtype=float)
+    med = np.nanmedian(r, axis=0)
+    sigma = 1.4826 * np.nanmedian(np.abs(r - med), axis=0)
+    keep = np.abs(r - med) <= 5.0 * np.maximum(sigma, 1e-300)
+    return np.sqrt(np.nanmean(np.where(keep, r, np.nan) ** 2, axis=0))
 
 
 class StreamWindow:
@@ -256,8 +268,7 @@ class ResidualMonitor:
         if self.params is None:
             ident = identify(self.model, ds)
             self.params = {k: float(v) for k, v in ident.params.items()}
-            rms = np.sqrt(np.nanmean(ident.residual ** 2, axis=0))
-            band = self.band_sigma * rms
+            band = self.band_sigma * trimmed_rms(ident.residual)
         else:
             band = np.array([self.band_by_channel.get(ch, np.nan) for ch in ds.channels])
             if not np.all(np.isfinite(band)):
@@ -313,4 +324,4 @@ class ResidualMonitor:
         return self.check.level(), msg, values
 
 
-__all__ = ["Alarm", "BandCheck", "MonitorModel", "ResidualMonitor", "Samples", "StreamWindow", "stamp_ns"]
+__all__ = ["Alarm", "BandCheck", "MonitorModel", "ResidualMonitor", "Samples", "StreamWindow", "stamp_ns", "trimmed_rms"]

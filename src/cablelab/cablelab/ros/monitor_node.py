@@ -108,7 +108,11 @@ class ModelMonitorNode(PlantNode):
     def evaluate(self) -> None:
         if self.monitor is None:
             return
+        was = self.monitor.calibrated
         s = self.monitor.step()
+        if self.monitor.calibrated and not was:
+            self.get_logger().info("model " + " + ".join(self.monitor.model.effects) + ", band " + ", ".join(
+                f"{ch} +-{b:.4g}" for ch, b in zip(self.monitor.channels, self.monitor.check.band)))
         if s is None:
             return
         names = list(s.channels)
