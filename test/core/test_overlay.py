@@ -145,3 +145,23 @@ def test_greedy_overlay_has_every_stage_and_the_final_model(tmp_path, capsys):
     last = _channel(topics[f"/axis/model/{stages[len(steps) - 1]['stage']}/prediction"], ["joint"])
     final = _channel(topics["/axis/model/prediction"], ["joint"])
     np.testing.assert_array_equal(final, last)
+
+
+def test_report_links_its_overlay_bag(tmp_path, capsys):
+    from cablelab.bags import open_bag
+
+    desc = "plant: axis\nname: slide\naxis:\n  joint_type: prismatic\n  inertia: 2.0\n"
+    run = simulate_axis(load_description(desc), AxisTruth(inertia=2.0, viscous=5.0, coulomb=3.0),
+                        duration=8.0, fs=250.0, amplitude=0.3, noise_effort=0.05, seed=2)
+    bag = tmp_path / "axis"
+    with BagWriter(bag) as w:
+        w.write_description(desc)
+        w.write_joint_states("/axis/joint_states", run.t, ["joint"], run.q[:, None], None, run.effort[:, None])
+    out = tmp_path / "rep"
+    assert main(["report", str(bag), "-o", str(out), "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert "href='overlay'" in (out / "index.html").read_text()
+    ov = open_bag(out / "overlay")
+    stages = json.loads(ov.strings("/axis/model/stages")[-1])["stages"]
+    assert stages[-1]["effects"] == doc["final"]
+    assert ov.counts["/axis/joint_states"] == open_bag(bag).counts["/axis/joint_states"]

@@ -105,6 +105,20 @@ def index_page(out: Path, parts: dict) -> str:
     return str(path)
 
 
+def open_commands(plant: str, bags) -> list[str]:
+    """The commands that open a plant's first demo bag with the shipped layouts: the model overlay
+    bag (``cablelab compare --out``), then PlotJuggler and Foxglove."""
+    from .layouts import shipped_layout
+
+    if not bags:
+        return []
+    bag = os.path.abspath(str(bags[0]))
+    overlay = bag.rstrip("/") + "_overlay"
+    return [f"overlay ./run cablelab compare {bag} --out {overlay} --overwrite",
+            f"plotjuggler -d {overlay}/{os.path.basename(overlay)}.mcap -l {shipped_layout(plant, 'plotjuggler')}",
+            f"foxglove: open {overlay}, Layouts > Import {shipped_layout(plant, 'foxglove')}"]
+
+
 def print_table(title: str, rows: list) -> None:
     w = max(len(r[0]) for r in rows)
     v = max(22, max(len(r[1]) for r in rows))
@@ -168,6 +182,8 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{title.split(' (')[0]}: bags {', '.join(str(b) for b in res.bags)}")
         print(f"    report {os.path.abspath(res.report)}")
         print(f"    page   {os.path.abspath(res.page)}")
+        for line in open_commands(part.plant, res.bags):
+            print(f"    {line}")
     if index:
         print(f"index:  {os.path.abspath(index)}")
     print(f"({time.monotonic() - t_start:.0f} s)")

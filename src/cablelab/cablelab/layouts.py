@@ -192,6 +192,16 @@ def plotjuggler_references(xml_text: str) -> list[str]:
 
 
 # ------------------------------------------------------------------ from a plant
+def shipped_layout(plant: str, tool: str):
+    """Path of the layout shipped in the repository's ``layouts/`` (``<plant>.foxglove.json``,
+    ``<plant>.plotjuggler.xml``; ``cablelab layout`` writes the same)."""
+    from pathlib import Path
+
+    ext = "foxglove.json" if tool == "foxglove" else "plotjuggler.xml"
+    return Path(__file__).resolve().parents[3] / "layouts" / f"{plant}.{ext}"
+
+
+
 def names_from_bag(bag) -> dict:
     """JointState topic -> the element names of its first message (a bag of the plant)."""
     out = {}
@@ -233,5 +243,5 @@ def plant_layout(plant_name: str, tool: str, *, bag=None, description=None) -> s
     return plotjuggler_layout(plant_name, pans)
 
 
-__all__ = ["Panel", "Series", "TOOLS", "foxglove_layout", "foxglove_references", "names_from_bag",
+__all__ = ["Panel", "Series", "TOOLS", "shipped_layout", "foxglove_layout", "foxglove_references", "names_from_bag",
            "panels", "plant_layout", "plotjuggler_layout", "plotjuggler_references"]

@@ -101,16 +101,34 @@ def write_overlay_out(args, plant, ds, stages) -> None:
     if not getattr(args, "out", None):
         return
     from ..atomic import atomic_output
+
+    with atomic_output(args.out, overwrite=args.overwrite, inputs=[args.bag, args.description]) as tmp:
+        write_overlay_bag(args, plant, ds, stages, tmp)
+
+
+def write_overlay_bag(args, plant, ds, stages, path) -> None:
+    """The overlay bag of ``stages`` (with the plant's markers when it draws itself) at ``path``
+    (a new directory); its warnings join ``args.warnings``."""
     from ..bags import open_bag
     from ..overlay import write_overlay
 
     bag = open_bag(args.bag, recover=getattr(args, "recover", False))
-    markers = None
-    if plant.markers is not None:
-        markers = plant.markers(bag, ds.description)
-    with atomic_output(args.out, overwrite=args.overwrite, inputs=[args.bag, args.description]) as tmp:
-        warnings = write_overlay(tmp, bag, ds.plant, stages, markers=markers)
+    markers = plant.markers(bag, ds.description) if plant.markers is not None else None
+    warnings = write_overlay(path, bag, ds.plant, stages, markers=markers)
     args.warnings = list(getattr(args, "warnings", []) or []) + warnings
+
+
+def greedy_stages(ds, model, steps) -> list:
+    """The overlay stages of a greedy waterfall (steps as dicts or :class:`Step`): each step's
+    model fitted on the whole record, ``nominal`` then ``plus_<effect>``."""
+    from ..model import Model
+    from ..overlay import fit_stage, stage_name
+
+    def get(s, k):
+        return s[k] if isinstance(s, dict) else getattr(s, k)
+
+    return [fit_stage(stage_name(get(s, "added")), ds, Model(ds.plant, tuple(get(s, "effects")), model.fixed))
+            for s in steps]
 
 
 def load_from_args(args, *, check_out: bool = False):

@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 from ._workbench_args import (add_common, add_folds, add_overlay_out, check_alpha, dump_json,
-                              load_from_args, with_warnings, write_overlay_out)
+                              greedy_stages, load_from_args, with_warnings, write_overlay_out)
 
 HELP = "rank the missing physical effects by held-out error (blocked k-fold), --greedy adds them"
 
@@ -36,12 +36,7 @@ def run(args) -> int:
     out = diagnose(ds, model, cands, folds=args.folds, alpha=args.alpha, min_gain=args.min_gain,
                    greedy_mode=args.greedy, quiet=args.json)
     if args.out:
-        from ..model import Model
-        from ..overlay import fit_stage, stage_name
-
-        stages = [fit_stage(stage_name(st.added), ds, Model(ds.plant, tuple(st.effects), model.fixed))
-                  for st in out.greedy]
-        write_overlay_out(args, plant, ds, stages)
+        write_overlay_out(args, plant, ds, greedy_stages(ds, model, out.greedy))
     doc = with_warnings(args, out.to_json())
     if args.json:
         print(dump_json(doc))

@@ -7,7 +7,8 @@ from __future__ import annotations
 
 import os
 
-from ._workbench_args import add_common, add_folds, add_overwrite, dump_json, load_from_args, with_warnings
+from ._workbench_args import (add_common, add_folds, add_overwrite, dump_json, greedy_stages, load_from_args,
+                              with_warnings, write_overlay_bag)
 
 HELP = "write DIR/index.html with plots: waterfall, ranking, parameters, overlay, residuals"
 
@@ -36,7 +37,9 @@ def run(args) -> int:
     with atomic_output(args.out, overwrite=args.overwrite, inputs=inputs, option="-o") as tmp:
         res = build_report(ds, model, plant.candidates(desc), str(tmp), folds=args.folds,
                            title=f"cablelab report: {desc.name or plant.name}", quiet=args.json,
-                           warnings=getattr(args, "warnings", ()))
+                           warnings=getattr(args, "warnings", ()), overlay="overlay")
+        write_overlay_bag(args, plant, ds, greedy_stages(ds, model, res["steps"]),
+                          os.path.join(str(tmp), "overlay"))
     res["index"] = _moved(res["index"], tmp, args.out)
     res["figures"] = [_moved(f, tmp, args.out) for f in res["figures"]]
     out = with_warnings(args, {"index": res["index"], "figures": res["figures"], "seconds": res["seconds"],

@@ -41,9 +41,10 @@ CSS = ("body{font-family:sans-serif;max-width:1100px;margin:auto;padding:1em}"
 
 @blas_single
 def build_report(ds: Dataset, model: Model, candidates, out_dir, *, folds: int = 5,
-                 title: str = "", quiet: bool = True, warnings=()) -> dict:
+                 title: str = "", quiet: bool = True, warnings=(), overlay: str = "") -> dict:
     """Analyse and write ``out_dir/index.html`` + PNGs; ``warnings`` (the input checks' lines,
-    :func:`cablelab.bagcheck.check_bag`) are shown at the top of the page.
+    :func:`cablelab.bagcheck.check_bag`) are shown at the top of the page; ``overlay``: path
+    (relative to ``out_dir``) of the model overlay bag the page links (:mod:`cablelab.overlay`).
 
     Returns:
         ``{"index": path, "figures": [...], "steps": greedy steps, "seconds": elapsed}``.
@@ -90,6 +91,10 @@ def build_report(ds: Dataset, model: Model, candidates, out_dir, *, folds: int =
     if warnings:
         parts.append("<div class='warnings'><b>Input warnings</b><ul>"
                      + "".join(f"<li>{html.escape(w)}</li>" for w in warnings) + "</ul></div>")
+    if overlay:
+        parts.append(f"<p>Measurement, model and residual of every step on one time axis: the overlay bag "
+                     f"<a href='{html.escape(overlay)}'>{html.escape(overlay)}</a> (open it in Foxglove or "
+                     f"PlotJuggler with the layouts of <code>cablelab layout --plant {ds.plant}</code>)</p>")
     parts.append("<h2>Adding the missing effects</h2><img src='waterfall.png'>")
     rows = [[i, html.escape(s["added"] or "nominal: " + " + ".join(s["effects"])),
              _num(100 * s["error"], "{:.2f} %"),
