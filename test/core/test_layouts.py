@@ -157,3 +157,14 @@ def test_shipped_layouts_are_what_the_command_writes(plant, tool, ext, tmp_path,
     assert shipped.read_text() == out.read_text(), f"regenerate {shipped}: cablelab layout --plant {plant} --tool {tool} -o {shipped} --overwrite"
     assert main(["layout", "--plant", plant, "--tool", tool, "-o", str(out)]) == 2   # no overwrite unasked
     assert "--overwrite" in capsys.readouterr().err
+
+
+def test_demo_prints_commands_that_open_its_bags_with_the_shipped_layouts(tmp_path):
+    from cablelab.demo import open_commands
+
+    lines = open_commands("cdpr", [tmp_path / "run"])
+    assert lines[0].startswith("overlay ./run cablelab compare ") and f"--out {tmp_path}/run_overlay" in lines[0]
+    pj = lines[1].split(" -l ")[1]
+    fox = lines[2].split("Import ")[1]
+    assert Path(pj).read_text().startswith("<?xml") and json.loads(Path(fox).read_text())["configById"]
+    assert lines[1].startswith(f"plotjuggler -d {tmp_path}/run_overlay/run_overlay.mcap")
