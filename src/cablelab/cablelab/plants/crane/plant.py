@@ -254,6 +254,13 @@ CRANE = register_plant(Plant(
     estimate=estimate_bag,
     check_bag=lambda bag, desc, options, series: _check_joint_names(bag, series),
     channels=JOINTS,
+    markers=lambda bag, desc: _bag_markers(bag, desc),
     topic_names=lambda desc: {JOINT_STATES: list(JOINTS), **{t: ["theta1", "theta2", "rope_length"] for t in
                                                           ("/crane/swing_estimate", "/crane/ground_truth/swing")}},
 ))
+
+
+def _bag_markers(bag, desc):
+    from .markers import bag_markers
+
+    return bag_markers(bag, desc)

@@ -44,7 +44,6 @@ from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 from trajectory_msgs.msg import MultiDOFJointTrajectory
-from visualization_msgs.msg import MarkerArray
 
 from ....description import load_description
 from ....errors import CablelabError
@@ -53,6 +52,7 @@ from ....ros import convert
 from ....rotations import wxyz_to_xyzw
 from ....ros.inputs import WARN
 from ....ros.fastspin import poll, take_newest
+from ....ros.markers import start_markers
 from ....ros.plant_node import PlantNode
 from ....ros.qos import stream_qos
 from ....ros import rawmsg
@@ -165,30 +165,18 @@ class CdprSimNode(PlantNode):
             poll(self, sub)
         self.start_diagnostics()
         self.timer = self.create_timer(1.0 / self.rate if self.real_time else 0.0002, self.tick)
-        self._markers_timer(float(p("markers_rate", 30.0).value))
+        start_markers(self, "/cdpr/markers", self._marker_frame, lambda: self.sim.time,
+                      float(p("markers_rate", 30.0).value))
         self.publish_state()
 
-    def _markers_timer(self, rate: float) -> None:
-        """The 3D view: ``/cdpr/markers`` at ``rate`` Hz of wall time (0 = off), pre-encoded
-        (:class:`cablelab.markers.MarkerEncoder`); the platform at its true pose, the cables
-        coloured by their true tension."""
-        if not rate > 0:
-            return
-        from ....markers import MarkerEncoder
-
-        self._marker_enc = MarkerEncoder(self._marker_frame())
-        self.pub_markers = self.create_publisher(MarkerArray, "/cdpr/markers", stream_qos(1))
-        self.create_timer(1.0 / rate, self.publish_markers)
-
     def _marker_frame(self):
+        """The 3D view: the platform at its true pose, the cables coloured by their true tension."""
         from ..markers import cdpr_markers
         from ....rotations import quat_to_matrix
 
         p, q = self.sim.truth_pose()
         return cdpr_markers(self.description, p, quat_to_matrix(q), self.sim.truth_state()["tension"])
 
-    def publish_markers(self) -> None:
-        self.pub_markers.publish(self._marker_enc.encode([self.sim.time], [self._marker_frame()])[0])
 
     def _templates(self) -> None:
         """Pre-serialised messages (fixed names and lengths): each step patches the numbers."""

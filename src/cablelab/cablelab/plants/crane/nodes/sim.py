@@ -9,7 +9,8 @@ rope_length), ``/clock`` and ``/plant_description`` (transient-local). Physics:
 ROS parameters: ``description`` (YAML file or text; default ``cablelab/plants/crane/data/crane.yaml``),
 ``slew_inertia``, ``luff_inertia`` (kg m^2), truth switches ``base_tilt`` [x, y] rad,
 ``viscous`` / ``coulomb`` / ``offset`` [slew, luff, hoist], ``mocap_noise`` (m),
-``mocap_dropout`` (probability), ``timestep`` (s), ``rate`` (Hz of publishing = command
+``mocap_dropout`` (probability), ``markers_rate`` (Hz of wall time of the 3D view
+``/crane/markers``, visualization_msgs/MarkerArray: mast, boom, rope, payload; 0 = off), ``timestep`` (s), ``rate`` (Hz of publishing = command
 sampling), ``command_timeout`` (s wall, real-time mode), ``lockstep`` (default true: once
 commands flow, after publishing a state the simulation waits for the command that answers it
 before advancing, so a slow or loaded controller slows the simulation down instead of
@@ -43,6 +44,7 @@ from ....description import load_description
 from ....errors import CablelabError
 from ..control import LIVE_GAINS, hold_command
 from ..model import JOINTS, CraneParams
+from ....ros.markers import start_markers
 from ....ros import convert
 from ....ros.lockstep import ADVANCE, FREE, LockStep
 from ....ros.plant_node import PlantNode
@@ -98,6 +100,10 @@ class CraneSimNode(PlantNode):
         self.create_subscription(Float64MultiArray, "/crane/effort_commands", self.on_command, stream_qos())
         self.start_diagnostics()
         self.timer = self.create_timer(1.0 / self.rate, self.tick)
+        from ..markers import state_markers
+
+        start_markers(self, "/crane/markers", lambda: state_markers(self.description, self.sim.state()[1]),
+                      lambda: self.sim.state()[0], float(p("markers_rate", 30.0).value))
         self.publish_state()
 
     def extend_status(self, level, msg, values):
