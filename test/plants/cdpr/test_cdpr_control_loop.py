@@ -1,0 +1,207 @@
+"""The CDPR control loop (``control_loop --plant cdpr``): its commands against the three-process
+loop's controller node on one recorded state stream, the hardware seam, the deadline
+accounting, and the loop over DDS surviving the estimator's death."""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+
+from cablelab.errors import CablelabError
+
+
+@pytest.fixture
+def ros_context(domain_id):
+    import rclpy
+
+    rclpy.init(domain_id=domain_id)
+    yield
+    rclpy.try_shutdown()
+
+
+def _capture(out: list, cls):
+    from rclpy.serialization import deserialize_message
+
+    return lambda m: out.append(deserialize_message(m, cls) if isinstance(m, bytes) else m)
+
+
+def test_loop_commands_equal_the_controller_node_on_a_recorded_stream(ros_context):
+    """The loop node's commands (read -> ReferenceLaw -> write, reference terms prepared after
+    each write, estimates taken between periods) equal what the ``pd_feedforward`` node answers to
+    the same states, references and estimates as messages, to round-off: one law, two shells."""
+    from geometry_msgs.msg import InertiaStamped
+    from std_msgs.msg import Float64MultiArray
+
+    from cablelab.plants.cdpr.nodes.control_loop import CdprControlLoop
+    from cablelab.plants.cdpr.nodes.controller import CdprController
+    from cablelab.ros import convert
+
+    loop_node = CdprControlLoop()
+    ctl = CdprController()
+    from_loop, from_node = [], []
+    loop_node.pub_cmd.publish = _capture(from_loop, Float64MultiArray)
+    ctl.pub_cmd.publish = _capture(from_node, Float64MultiArray)
+    ctl.polled = []                 # callbacks alone, no DDS
+    loop_node.take_every = 10 ** 9  # estimates are fed by hand below, at the same points for both
+    try:
+        # record: the loop runs untimed on its simulated hardware (a payload the nominal mass
+        # does not know), with live estimates at 100 Hz (and one NaN, one implausible)
+        loop = loop_node.loop
+        loop.start()
+        states, estimates = [], {}
+        rng = np.random.default_rng(3)
+        for k in range(400):
+            state, command = loop.cycle()
+            states.append(state)
+            if k % 10 == 5:
+                m = {105: float("nan"), 205: 1e6}.get(k, 615.0 + rng.normal(0.0, 5.0))
+                est = convert.inertia_msg(state.t, m, [0.05, -0.01, float("nan")])
+                estimates[k] = est
+                loop_node.on_estimate(est)
+            loop_node._after_write(state, command)
+        assert len(from_loop) == 400
+        assert loop_node.estimates_rejected == 1 and loop_node.inputs.inputs["payload_estimate"].rejected == 1
+
+        # replay the same stream to the controller node, as the three-process loop delivers it
+        ctl.on_description(convert.string_msg(loop_node.description.to_yaml()))
+        names = list(loop_node.hardware.joint_names)
+        for k, st in enumerate(states):
+            pos, vel, acc = loop_node.reference.at(st.t)
+            ctl.on_reference(convert.multidof_msg(st.t, pos, [0, 0, 0, 1.0], vel, None, acc, None))
+            ctl.on_state(convert.joint_state_msg(st.t, names, st.position, st.velocity, st.effort))
+            if k in estimates:
+                ctl.on_estimate(estimates[k])
+        assert len(from_node) == 400
+        a = np.array([m.data for m in from_loop])
+        b = np.array([m.data for m in from_node])
+        np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-9)
+        # each command names the state it answers, in both
+        assert [convert.command_stamp(m) for m in from_loop] == pytest.approx([s.t for s in states], abs=1e-9)
+        # the live mass was used (not the nominal 366 kg): the feedforward follows the estimate
+        assert loop_node.law.controller.mass == pytest.approx(ctl.controller.mass, rel=1e-12)
+        assert abs(loop_node.law.controller.mass - 615.0) < 20.0
+        # and the law was prepared ahead on the loop's side for most periods
+        assert loop_node.law.prepared_used > 300
+        # the loop's published state is the state it read (no copy lost, no reorder)
+        assert np.isfinite(a).all() and (a > 0).all()
+    finally:
+        loop_node.loop.stop()
+        loop_node.destroy_node()
+        ctl.destroy_node()
+
+
+def test_hardware_seam():
+    """The simulator satisfies the protocol; the stub stops with what a driver must implement;
+    the loop counts a late wake-up like the bare timer does, and a write(None) brakes."""
+    from cablelab.control_loop import ControlLoop
+    from cablelab.hardware import DriverStub, HardwareInterface, load_hardware_class
+    from cablelab.plants.cdpr.hardware import SimulatedCdpr
+    from cablelab.plants.cdpr.sim import CdprTruth, default_description
+
+    desc = default_description()
+    hw = SimulatedCdpr(desc, CdprTruth(payload_mass=122.0, timestep=0.001), 500.0, [-1.0, -0.3, 0.6])
+    assert isinstance(hw, HardwareInterface) and hw.nstep == 2
+    stub = DriverStub(hw.joint_names, desc)
+    assert isinstance(stub, HardwareInterface)
+    for call in (stub.start, stub.read, lambda: stub.write(np.zeros(8))):
+        with pytest.raises(CablelabError, match="not implemented.*hardware:=package.module:Class"):
+            call()
+    with pytest.raises(CablelabError, match="expected 'package.module:Class'"):
+        load_hardware_class("nonsense")
+    with pytest.raises(CablelabError, match="missing method"):
+        load_hardware_class("cablelab.hardware:HardwareState")
+    assert load_hardware_class("cablelab.hardware:DriverStub") is DriverStub
+
+    class Hold:                     # a law that never has a command: the hardware brakes
+        status = [(2, "no reference")]
+
+        def update(self, state):
+            return None
+
+    # a fake clock: the 3rd period wakes 2.5 periods late, then everything is on time
+    now = [0.0]
+    wake = {2: 2.5}
+
+    def sleep(t):
+        k = int(round(t * 500.0))
+        now[0] = max(now[0], t) + wake.pop(k, 0.0) / 500.0
+
+    loop = ControlLoop(hw, Hold(), 500.0, warmup=0.0, clock=lambda: now[0], sleep=sleep)
+    loop.start()
+    p0 = hw.sim.truth_pose()[0].copy()
+    loop.run_until(0.1)
+    s = loop.stats
+    # deadlines 0..49; period 2 woke 2.5 periods late: it and period 3 (run at once after it,
+    # 1.5 periods behind) are late, period 4 (0.5 behind) is not
+    assert s.cycles == 50 and s.late == 2 and s.dropped == 0 and s.missed_cycles == 2
+    assert hw.braked == 50 and np.linalg.norm(hw.sim.truth_pose()[0] - p0) < 0.02
+    assert hw.sim.time == pytest.approx(0.1)    # one period of physics per write
+
+
+def _diag_listener(launcher):
+    from diagnostic_msgs.msg import DiagnosticArray
+
+    probe = launcher.probe()
+    seen = {}
+
+    def on_diag(msg):
+        for st in msg.status:
+            seen[st.name] = (int.from_bytes(st.level, "little") if isinstance(st.level, bytes) else int(st.level),
+                             st.message, {kv.key: kv.value for kv in st.values}, time.monotonic())
+    probe.node.create_subscription(DiagnosticArray, "/diagnostics", on_diag, 50)
+    return probe, seen
+
+
+def test_loop_survives_the_estimator_over_dds(launcher):
+    """control_loop + payload_estimator as processes: the loop takes the live estimate; when the
+    estimator is killed it keeps running (its state stream goes on) and reports the stale
+    estimate on /diagnostics as WARN within a bounded time."""
+    launcher.node("estimator", "payload_estimator", "cdpr", {"poll_period": 0.01})
+    launcher.start("loop", [*_loop_argv(), "--ros-args", "-p", "rate:=250.0", "-p", "payload_mass:=249.0",
+                            "-p", "estimate_timeout:=1.0"])
+    probe, seen = _diag_listener(launcher)
+
+    def loop_alive():
+        assert launcher.procs["loop"].alive(), launcher.procs["loop"].log()[-2000:]
+
+    def spin_until(cond, timeout, what):
+        end = time.monotonic() + timeout
+        while time.monotonic() < end:
+            loop_alive()
+            probe.executor.spin_once(timeout_sec=0.05)
+            if cond():
+                return
+        raise AssertionError(f"timeout after {timeout} s waiting for {what}; control_loop diagnostics: "
+                             f"{seen.get('control_loop')}")
+
+    def loop_values():
+        return seen.get("control_loop", (None, "", {}, 0.0))
+
+    # the live estimate reaches the loop's feedforward (not the nominal mass)
+    spin_until(lambda: loop_values()[2].get("feedforward mass kg", "-") not in ("-", "366.0")
+               and int(loop_values()[2].get("payload_estimate received", "0")) > 5, 120, "estimates taken by the loop")
+    mass = float(loop_values()[2]["feedforward mass kg"])
+    assert 500.0 < mass < 700.0, mass       # 366 kg platform + 249 kg payload
+    cycles_before = int(loop_values()[2]["commands"])
+    launcher.kill("estimator")
+    killed = time.monotonic()
+    spin_until(lambda: loop_values()[0] == 1 and "stale" in loop_values()[1] and loop_values()[3] > killed,
+               60, "a WARN about the stale estimate")
+    level, message, values, _ = loop_values()
+    assert "payload_estimate" in message or "estimate stale" in message, message
+    # the loop goes on commanding and publishing its state after the estimator died
+    counts = probe.wait_for_topics({"/cdpr/joint_states": 50, "/cdpr/effort_commands": 50}, 60, loop_alive)
+    assert min(counts.values()) >= 50
+    spin_until(lambda: int(loop_values()[2]["commands"]) > cycles_before + 100, 60, "more commands")
+    assert launcher.procs["loop"].alive()
+    codes = launcher.stop_all()
+    assert codes["loop"] == 0, launcher.procs["loop"].log()[-2000:]
+    summary = [ln for ln in launcher.procs["loop"].log().splitlines() if ln.startswith('{"node": "control_loop"')]
+    assert summary, launcher.procs["loop"].log()[-2000:]
+
+
+def _loop_argv():
+    import sys
+
+    return [sys.executable, "-m", "pd_feedforward.control_loop", "--plant", "cdpr"]
