@@ -87,6 +87,7 @@ class ControlLoopNode(PlantNode):
         self._next_diag = 0.0
         self._queue = None
         self._thread = None
+        self._cpu0 = None           # (process CPU s, cycles) when the counted cycles started
 
     # ------------------------------------------------------------------ set-up
     def setup_loop(self, hardware, law) -> None:
@@ -127,6 +128,8 @@ class ControlLoopNode(PlantNode):
         else:
             self.publish_cycle(state, command)
         self._cycle += 1
+        if self._cpu0 is None and self.loop.stats.cycles:
+            self._cpu0 = (time.process_time(), self.loop.stats.cycles)    # the counted cycles start
         if self._cycle % self.take_every == 0:
             self.take_inputs()
         self.after_cycle(state)
@@ -178,6 +181,9 @@ class ControlLoopNode(PlantNode):
         """The cycle figures (:meth:`LoopStats.summary`) and the node's counts."""
         out = {"node": "control_loop"} | self.loop.stats.summary()
         out.update(commands=self.commands, periods_without_command=self.no_command)
+        if self._cpu0 is not None and self.loop.stats.cycles > self._cpu0[1]:   # all threads of the process
+            out["cpu_per_cycle_ms"] = 1e3 * (time.process_time() - self._cpu0[0]) / (self.loop.stats.cycles
+                                                                                  - self._cpu0[1])
         return out
 
     def shutdown(self) -> None:
