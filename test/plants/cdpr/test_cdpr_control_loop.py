@@ -156,10 +156,11 @@ def _diag_listener(launcher):
 def test_loop_survives_the_estimator_over_dds(launcher):
     """control_loop + payload_estimator as processes: the loop takes the live estimate; when the
     estimator is killed it keeps running (its state stream goes on) and reports the stale
-    estimate on /diagnostics as WARN within a bounded time."""
+    estimate on /diagnostics as WARN within a bounded time. (Publishing through the publisher
+    thread here; the equality test above covers publishing in the loop's thread.)"""
     launcher.node("estimator", "payload_estimator", "cdpr", {"poll_period": 0.01})
     launcher.start("loop", [*_loop_argv(), "--ros-args", "-p", "rate:=250.0", "-p", "payload_mass:=249.0",
-                            "-p", "estimate_timeout:=1.0"])
+                            "-p", "estimate_timeout:=1.0", "-p", "publish_thread:=true"])
     probe, seen = _diag_listener(launcher)
 
     def loop_alive():

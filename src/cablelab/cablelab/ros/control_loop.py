@@ -98,6 +98,9 @@ class ControlLoopNode(PlantNode):
         self.use_fast_executor()
         self.start_diagnostics()
         if self.publish_thread:
+            # a thread that holds the GIL keeps the loop's thread waiting after its wake-up for up
+            # to the interpreter's switch interval (5 ms by default): at most a tenth of a period
+            sys.setswitchinterval(min(sys.getswitchinterval(), 0.1 / self.rate))
             self._queue = queue.SimpleQueue()
             self._thread = threading.Thread(target=self._publisher, name="control_loop publisher", daemon=True)
             self._thread.start()
