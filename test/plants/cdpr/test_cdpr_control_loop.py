@@ -41,6 +41,12 @@ def test_loop_commands_equal_the_controller_node_on_a_recorded_stream(ros_contex
     ctl = CdprController()
     from_loop, from_node = [], []
     loop_node.pub_cmd.publish = _capture(from_loop, Float64MultiArray)
+    from sensor_msgs.msg import JointState
+    from trajectory_msgs.msg import MultiDOFJointTrajectory
+    js, tens, refs = [], [], []
+    loop_node.pub_js.publish = _capture(js, JointState)
+    loop_node.pub_ten.publish = _capture(tens, JointState)
+    loop_node.pub_ref.publish = _capture(refs, MultiDOFJointTrajectory)
     ctl.pub_cmd.publish = _capture(from_node, Float64MultiArray)
     ctl.polled = []                 # callbacks alone, no DDS
     loop_node.take_every = 10 ** 9  # estimates are fed by hand below, at the same points for both
@@ -83,8 +89,17 @@ def test_loop_commands_equal_the_controller_node_on_a_recorded_stream(ros_contex
         assert abs(loop_node.law.controller.mass - 615.0) < 20.0
         # and the law was prepared ahead on the loop's side for most periods
         assert loop_node.law.prepared_used > 300
-        # the loop's published state is the state it read (no copy lost, no reorder)
         assert np.isfinite(a).all() and (a > 0).all()
+        # the loop's published state, tensions and reference are what it read and used (the
+        # pre-serialised templates, read back by rclpy's deserialiser)
+        assert len(js) == len(tens) == len(refs) == 400
+        np.testing.assert_array_equal(np.array([m.position for m in js]), [s.position for s in states])
+        np.testing.assert_array_equal(np.array([m.velocity for m in js]), [s.velocity for s in states])
+        np.testing.assert_array_equal(np.array([m.effort for m in tens]), [s.extra["tension"] for s in states])
+        assert [convert.from_stamp(m.header.stamp) for m in js] == pytest.approx([s.t for s in states], abs=1e-9)
+        np.testing.assert_array_equal(
+            [[m.points[0].transforms[0].translation.x, m.points[0].transforms[0].translation.z] for m in refs],
+            [loop_node.reference.at(s.t)[0][[0, 2]] for s in states])
     finally:
         loop_node.loop.stop()
         loop_node.destroy_node()
@@ -206,3 +221,16 @@ def _loop_argv():
     import sys
 
     return [sys.executable, "-m", "pd_feedforward.control_loop", "--plant", "cdpr"]
+
+
+@pytest.mark.parametrize("stamp", [0.0, 9.999, 12.345678901, 1234.5])
+def test_command_template_equals_rclpy(ros_context, stamp):
+    """A pre-serialised command is byte for byte what rclpy serialises for convert.command_msg."""
+    from rclpy.serialization import serialize_message
+
+    from cablelab.ros import convert
+    from cablelab.ros.rawmsg import CommandTemplate
+
+    tpl = CommandTemplate("winch")
+    for cmd in (np.arange(8.0) * 1.5, np.linspace(-3.0, 7.0, 8), np.ones(4)):
+        assert tpl.data(cmd, stamp) == serialize_message(convert.command_msg(cmd, stamp=stamp, label="winch"))
