@@ -77,7 +77,7 @@ class CdprControlLoop(ControlLoopNode):
         self.reference = ReferenceTable(self.rate, settle, speed)
         self.law = ReferenceLaw(LiveController(c, desc.gravity, cfg), self.reference.at)
         self.extras_every = max(1, int(p("extras_every", 1)))
-        hardware = self._hardware(str(p("hardware", "sim")), desc)
+        self.hardware = hardware = self._hardware(str(p("hardware", "sim")), desc)
         self.simulated = isinstance(hardware, SimulatedCdpr)
         self.estimates_rejected = 0
 
@@ -135,6 +135,9 @@ class CdprControlLoop(ControlLoopNode):
         self.t_pose = RawTemplate(convert.pose_msg(0.0, z3, [0.0, 0.0, 0.0, 1.0]))
         self.t_tpose = RawTemplate(convert.pose_msg(0.0, z3, [0.0, 0.0, 0.0, 1.0]))
         self.t_tpay = RawTemplate(convert.inertia_msg(0.0, 0.0, z3))
+        if self.simulated:                  # the true moving mass and CoM do not change
+            self.t_tpay["inertia.m"][0] = self.hardware.sim.truth.total_mass
+            self.t_tpay.vector("inertia.com")[:] = self.hardware.sim.truth.total_com
 
     # ------------------------------------------------------------------ the loop's hooks
     def publish_cycle(self, state, command) -> None:
@@ -172,8 +175,6 @@ class CdprControlLoop(ControlLoopNode):
                 self._pose(self.t_tpose, t, tp, tq)
                 self.pub_tpose.publish(self.t_tpose.data())
                 self.t_tpay.stamp(t)
-                self.t_tpay["inertia.m"][0] = sim.truth.total_mass
-                self.t_tpay.vector("inertia.com")[:] = sim.truth.total_com
                 self.pub_tpay.publish(self.t_tpay.data())
 
     def take_inputs(self) -> None:
