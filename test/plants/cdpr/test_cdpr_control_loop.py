@@ -234,3 +234,74 @@ def test_command_template_equals_rclpy(ros_context, stamp):
     tpl = CommandTemplate("winch")
     for cmd in (np.arange(8.0) * 1.5, np.linspace(-3.0, 7.0, 8), np.ones(4)):
         assert tpl.data(cmd, stamp) == serialize_message(convert.command_msg(cmd, stamp=stamp, label="winch"))
+
+
+class ScriptedDriver:
+    """A user's driver as the loop sees it (built from ``hardware:=module:Class``): it reports
+    the motor state of a platform hanging at the start point and keeps what it is sent."""
+
+    def __init__(self, joint_names, description):
+        from cablelab.hardware import HardwareState
+        from cablelab.plants.cdpr.control import motor_angles
+        from cablelab.plants.cdpr.geometry import cable_geometry
+        from cablelab.plants.cdpr.trajectory import pick_and_place
+
+        self.joint_names = tuple(joint_names)
+        c = description.cdpr
+        start = pick_and_place(np.array([0.0])).position[0]
+        g = cable_geometry(c.exit_points, c.anchor_points, start[None], None, c.pulley_radius, c.swivel_axes)
+        self.q = motor_angles(g.lengths, c.drum_radius, c.gear_ratio)[0]
+        self.State, self.t, self.sent, self.events = HardwareState, 0.0, [], []
+
+    def start(self):
+        self.events.append("start")
+
+    def read(self):
+        self.t += 0.002
+        n = len(self.joint_names)
+        return self.State(self.t, self.q.copy(), np.zeros(n), np.zeros(n), {})
+
+    def write(self, command):
+        self.sent.append(None if command is None else np.array(command))
+
+    def stop(self):
+        self.events.append("stop")
+
+
+def test_a_driver_plugs_in_by_parameter(domain_id):
+    """``hardware:=module:Class`` replaces the simulator without touching the loop: the loop
+    starts the driver, writes it the law's command for the state it read (the IGM of the start
+    point, so only gravity feedforward and friction compensation), stops it at the end."""
+    import rclpy
+
+    from cablelab.plants.cdpr.nodes.control_loop import CdprControlLoop
+
+    rclpy.init(args=["test", "--ros-args", "-p", f"hardware:={__name__}:ScriptedDriver", "-p", "rate:=500.0"],
+               domain_id=domain_id)
+    try:
+        node = CdprControlLoop()
+        try:
+            drv = node.hardware
+            assert isinstance(drv, ScriptedDriver) and not node.simulated
+            node.loop.start()
+            for _ in range(20):
+                state, command = node.loop.cycle()
+                node._after_write(state, command)
+            node.shutdown()
+            assert drv.events == ["start", "stop"] and len(drv.sent) == 20
+            # the law of the pd_feedforward node for that state, independently: LiveController
+            from cablelab.plants.cdpr.live import ControllerConfig, LiveController
+            from cablelab.plants.cdpr.control import PdffConfig
+            c = node.description.cdpr
+            ctl = LiveController(c, node.description.gravity,
+                                 ControllerConfig(nominal_mass=c.platform_mass or 366.0,
+                                                  gains=PdffConfig(coulomb=0.3, viscous=0.002)))
+            pos, vel, acc = node.reference.at(0.04)
+            want = ctl.update(0.04, drv.q, np.zeros(len(drv.q)), pos, None, vel, acc)
+            np.testing.assert_allclose(drv.sent[-1], want, rtol=1e-12)
+            # the platform is held against gravity: every cable pulls (reels in)
+            assert (drv.sent[-1] > 0).all()
+        finally:
+            node.destroy_node()
+    finally:
+        rclpy.try_shutdown()

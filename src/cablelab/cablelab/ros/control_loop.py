@@ -195,6 +195,7 @@ class ControlLoopNode(PlantNode):
             self._thread.join(timeout=5.0)
         if self.loop is not None:
             self.loop.stop()
-            print(json.dumps(self.summary()), flush=True)
+            if self.loop.start_wall is not None:       # the hardware started: there are figures
+                print(json.dumps(self.summary()), flush=True)
             sys.stdout.flush()
 
