@@ -3,7 +3,8 @@
 :class:`SimulatedCdpr` is a :class:`~cablelab.hardware.HardwareInterface` over
 :class:`~cablelab.plants.cdpr.sim.CdprSim`: ``read()`` is one sample of the winch sensors
 (motor angle, rate, torque from current; dynamometer tensions, paid-out lengths and the measured
-pose as extras), ``write(torques)`` holds the torques for one control period of physics, and
+pose as extras, and the simulation's true pose as ``true_position``, ``true_quat``),
+``write(torques)`` holds the torques for one control period of physics, and
 ``write(None)`` engages the winch brakes (:class:`WinchBrakes`), the robot's own safety
 behaviour when no valid command comes. The ``cable_sim_node`` uses the same brakes.
 """
@@ -79,9 +80,11 @@ class SimulatedCdpr:
 
     def read(self) -> HardwareState:
         ms = self.sim.measure()
+        tp, tq = self.sim.truth_pose()
         return HardwareState(self.sim.time, ms["motor_angle"], ms["motor_velocity"], ms["motor_torque"],
                              {"tension": ms["tension"], "cable_length": ms["cable_length"],
-                              "position": ms["position"], "quat": ms["quat"]})
+                              "position": ms["position"], "quat": ms["quat"],
+                              "true_position": tp, "true_quat": tq})
 
     def write(self, command: np.ndarray | None) -> None:
         if command is None:

@@ -169,10 +169,8 @@ class CdprControlLoop(ControlLoopNode):
             if "position" in extra and "quat" in extra:
                 self._pose(self.t_pose, t, extra["position"], extra["quat"])
                 self.pub_pose.publish(self.t_pose.data())
-            if self.simulated:
-                sim = self.hardware.sim
-                tp, tq = sim.truth_pose()
-                self._pose(self.t_tpose, t, tp, tq)
+            if self.simulated:          # the truth read with the state (not now: another thread may publish)
+                self._pose(self.t_tpose, t, extra["true_position"], extra["true_quat"])
                 self.pub_tpose.publish(self.t_tpose.data())
                 self.t_tpay.stamp(t)
                 self.pub_tpay.publish(self.t_tpay.data())
