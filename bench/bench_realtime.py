@@ -283,6 +283,9 @@ def main(argv=None) -> int:
     bench.parser.add_argument("--skip-control-loop", action="store_true", help="no control_loop process")
     bench.parser.add_argument("--skip-three-process", action="store_true", help="no three-process loop")
     bench.parser.add_argument("--skip-sweep", action="store_true", help="no rate sweep")
+    bench.parser.add_argument("--loop-params", default=None, metavar="JSON",
+                              help='extra parameters of the control-loop runs\' processes, e.g. '
+                                   '\'{"loop": {"publish_thread": true}}\' (keys loop, estimator)')
     bench.parser.add_argument("--sweep-seconds", type=float, default=20.0,
                               help="s per rate of the sweep's 100, 250, 500 Hz runs (20)")
     args = bench.parse(argv)
@@ -291,6 +294,7 @@ def main(argv=None) -> int:
         bench.log("offline simulation vs bare mj_step ...")
         out["offline_sim"] = offline_sim(repeat=args.repeat)
     built = None
+    loop_extra = json.loads(args.loop_params) if args.loop_params else None
     if not args.skip_loop and not (args.skip_floor and args.skip_sweep):
         built, why = build_floor(bench.log)
         if built is None:
@@ -298,7 +302,7 @@ def main(argv=None) -> int:
     if not args.skip_loop and not args.skip_floor and built is not None:
         out["floor"] = floor(built, args.seconds, bench.log, args.pin)
     if not args.skip_loop and not args.skip_control_loop:
-        out["control_loop"] = control_loop(args.seconds, bench.log, 1000.0, args.pin)
+        out["control_loop"] = control_loop(args.seconds, bench.log, 1000.0, args.pin, loop_extra)
     if not args.skip_loop and not args.skip_sweep:
         from bench_rcl_floor import run_timer
 
@@ -308,7 +312,7 @@ def main(argv=None) -> int:
             if built is not None:
                 bench.log(f"sweep: bare timer {rate:g} Hz, {args.sweep_seconds:g} s ...")
                 row["bare_timer_missed"] = run_timer(built[0], args.sweep_seconds, args.pin, 0, rate)["missed_cycles"]
-            c = control_loop(args.sweep_seconds, bench.log, rate, args.pin)
+            c = control_loop(args.sweep_seconds, bench.log, rate, args.pin, loop_extra)
             row.update(control_loop_missed=c["missed_cycles"], p99_ms=c["p99_ms"], realtime_factor=c["realtime_factor"])
             sweep.append(row)
         f, c = out.get("floor", {}), out.get("control_loop")
