@@ -305,3 +305,41 @@ def test_a_driver_plugs_in_by_parameter(domain_id):
             node.destroy_node()
     finally:
         rclpy.try_shutdown()
+
+
+def test_loop_survives_any_estimate(ros_context):
+    """Whatever arrives on /cdpr/payload_estimate (NaN, inf, negative or absurd masses, NaN or
+    absurd CoM, any stamp), the loop's next commands are finite and pull on every cable: a bad
+    estimate is rejected and counted, never fed to the feedforward."""
+    from hypothesis import HealthCheck, given, settings, strategies as st
+
+    from cablelab.plants.cdpr.nodes.control_loop import CdprControlLoop
+    from cablelab.ros import convert
+
+    node = CdprControlLoop()
+    node.pub_cmd.publish = node.pub_js.publish = node.pub_ten.publish = node.pub_ref.publish = lambda m: None
+    node.loop.start()
+    anchors = node.description.cdpr.anchor_points[:, :2]
+    num = st.one_of(st.floats(allow_nan=True, allow_infinity=True), st.sampled_from([0.0, -615.0, 615.0, 1e300]))
+
+    @settings(max_examples=40, deadline=None, suppress_health_check=list(HealthCheck), derandomize=True)
+    @given(m=st.one_of(num, st.just(615.0)), x=num, y=num, dt=st.floats(-1e3, 1e3))
+    def check(m, x, y, dt):
+        state, _ = node.loop.cycle()
+        node.on_estimate(convert.inertia_msg(max(0.0, state.t + dt), m, [x, y, float("nan")]))
+        node._after_write(state, None)
+        _, command = node.loop.cycle()
+        assert command is not None and np.isfinite(command).all() and (command > 0).all()
+        mass = node.law.controller.mass
+        assert mass is None or (np.isfinite(mass) and 0.5 * 366.0 <= mass <= 3.0 * 366.0)
+        # the CoM stays on the platform (within twice its farthest anchor): the feedforward
+        # tensions stay those of a load the platform can carry, not 1e300 N clipped by max_torque
+        assert np.abs(node.law.controller.com).max() <= 2.0 * np.abs(anchors).max()
+        ff = node.law.terms(state.t).tensions_ff
+        assert np.isfinite(ff).all() and ff.max() < 1e5
+
+    try:
+        check()
+    finally:
+        node.loop.stop()
+        node.destroy_node()
