@@ -256,6 +256,10 @@ def control_loop(seconds: float, log, rate: float = 1000.0, pin: bool = False, e
             "placement": placement or None}
 
 
+def _fmt(x, digits: int = 4) -> str:
+    return "-" if x is None else f"{x:.{digits}f}"
+
+
 def main(argv=None) -> int:
     bench = Bench("realtime", __doc__)
     bench.parser.add_argument("--seconds", type=float, default=60.0, help="closed-loop steady state, s (60)")
@@ -370,7 +374,7 @@ def main(argv=None) -> int:
                  dict(case="control loop body p99 (read -> law -> write, worst 1 s window) / median",
                       value=f"{c['p99_ms']:.3f} / {c['median_ms']:.3f}", unit="ms", target="< 0.5"),
                  dict(case="control loop realtime factor / CPU per cycle (all threads)",
-                      value=f"{c['realtime_factor']:.4f} / {c['cpu_per_cycle_ms'] or float('nan'):.3f}",
+                      value=f"{_fmt(c['realtime_factor'])} / {_fmt(c['cpu_per_cycle_ms'], 3)}",
                       unit="x / ms", target="")]
     if "three_process" in out:
         c = out["three_process"]
@@ -402,7 +406,7 @@ def main(argv=None) -> int:
         print(table([dict(rate_hz=f"{r['rate_hz']:g}", seconds=f"{r['seconds']:g}",
                           bare_timer_missed="-" if r["bare_timer_missed"] is None else r["bare_timer_missed"],
                           control_loop_missed=r["control_loop_missed"], loop_body_p99_ms=f"{r['p99_ms']:.3f}",
-                          realtime_factor=f"{r['realtime_factor']:.4f}") for r in out["rate_sweep"]]))
+                          realtime_factor=_fmt(r["realtime_factor"])) for r in out["rate_sweep"]]))
     return 0
 
 
