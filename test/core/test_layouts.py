@@ -168,3 +168,10 @@ def test_demo_prints_commands_that_open_its_bags_with_the_shipped_layouts(tmp_pa
     fox = lines[2].split("Import ")[1]
     assert Path(pj).read_text().startswith("<?xml") and json.loads(Path(fox).read_text())["configById"]
     assert lines[1].startswith(f"plotjuggler -d {tmp_path}/run_overlay/run_overlay.mcap")
+
+
+def test_layout_of_another_plants_bag_is_a_one_line_error(tmp_path, capsys):
+    out = tmp_path / "x.json"
+    assert main(["layout", "--plant", "crane", "--bag", str(ROOT / "bags" / "emps"), "-o", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "axis bag, not crane" in err and not out.exists()
