@@ -122,11 +122,27 @@ def evaluate(field: str, factors, table: dict[str, np.ndarray], source: str) -> 
                 x = float(x[0])
             else:
                 series += 1
+        _check_factor(field, op, name, x, source)
         value = value * x if op == "*" else value / x
     if series != 1:
         raise CablelabError(f"{source}: --map {field}: expected exactly one column in the expression, "
                             f"found {series}")
     return np.asarray(value, dtype=float)
+
+
+def _check_factor(field: str, op: str, name: str, x, source: str) -> None:
+    """A scale factor must be finite and non-zero, a divisor column must hold no zero: the
+    imported values would be inf, NaN or all 0."""
+    if np.ndim(x) == 0:
+        if not np.isfinite(x) or x == 0:
+            role = "divisor" if op == "/" else "scale factor"
+            raise CablelabError(f"--map {field}: {role} {name!r} = {float(x):g}; expected a finite, "
+                                f"non-zero number")
+    elif op == "/" and np.any(np.asarray(x) == 0):
+        k = int(np.flatnonzero(np.asarray(x) == 0)[0])
+        raise CablelabError(f"{source}: --map {field}: divisor column {name!r} is 0 in "
+                            f"{int(np.sum(np.asarray(x) == 0))} row(s) (first: data row {k + 1}); the "
+                            f"imported values would be infinite")
 
 
 def joint_topic(plant: str) -> tuple[str, tuple[str, ...]]:
