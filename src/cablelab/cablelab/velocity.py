@@ -237,7 +237,7 @@ def velocity_contradiction(agreement: dict | None) -> str:
     s, r = agreement["scale"], agreement["correlation"]
     units = not 1.0 / VELOCITY_SCALE_TOLERANCE <= abs(s) <= VELOCITY_SCALE_TOLERANCE
     if s < 0 or r <= -VELOCITY_MIN_CORRELATION:
-        return "sign flipped" + (f", and {abs(s):.3g}x its size — units?" if units else "")
+        return "sign flipped" + (f", and {abs(s):.3g}x its size, units?" if units else "")
     if r < VELOCITY_MIN_CORRELATION:
         return "not correlated with the derivative of position"
     if units:
