@@ -72,6 +72,7 @@ def load_checked(bag_path, description_path=None, options: dict | None = None, *
         bag.require(topic, msgtype)
     check = check_bag(bag, plant, desc, options)
     ds = plant.dataset(bag, desc, {**(options or {}), "derived_velocity": check.derived_velocity})
+    check.warnings.extend(ds.signals.get("load_warnings") or ())   # e.g. too slow for its motion
     # drives that stop: every plant with friction-bearing actuators (joint or winch drives)
     # leaves its zero-speed zone out of the fits (cablelab.velocity; a plant may have applied it
     # itself with its encoder's floor). Swing modes or a hopping body are not drives: untouched.
