@@ -35,7 +35,7 @@ def load(bag_path, description_path=None, options: dict | None = None):
 
 
 def load_checked(bag_path, description_path=None, options: dict | None = None, *,
-                 recover: bool = False, before_dataset=None):
+                 recover: bool = False, before_dataset=None, limits=None):
     """:func:`load` with the input checks of :mod:`cablelab.bagcheck`: time base of every topic
     the plant reads (gaps, clock jumps, stamps out of order, NaN samples), description vs bag
     (joint and cable names), negative cable tensions. Samples inside a gap (widened by the
@@ -48,6 +48,8 @@ def load_checked(bag_path, description_path=None, options: dict | None = None, *
         recover: read an unfinished bag (recorder killed) up to its last complete chunk.
         before_dataset: optional ``fn(plant)`` called once the plant is known, before any data
             is read (e.g. refusing options of another plant).
+        limits: :class:`~cablelab.timebase.Limits` of the time-base checks (default: the
+            defaults; ``Limits(time_unit="s")`` trusts integer stamps as seconds).
     Returns:
         ``(plant, description, dataset, check)``, ``check`` a :class:`~cablelab.bagcheck.BagCheck`
         (``check.warnings``: lines for the text output and the JSON ``"warnings"`` list).
@@ -70,7 +72,9 @@ def load_checked(bag_path, description_path=None, options: dict | None = None, *
             raise CablelabError(f"{bag_path}: topic {topic} needed by plant {plant.name} is not in the "
                                 f"bag (topics: {have})")
         bag.require(topic, msgtype)
-    check = check_bag(bag, plant, desc, options)
+    from .timebase import Limits
+
+    check = check_bag(bag, plant, desc, options, limits or Limits())
     ds = plant.dataset(bag, desc, {**(options or {}), "derived_velocity": check.derived_velocity})
     check.warnings.extend(ds.signals.get("load_warnings") or ())   # e.g. too slow for its motion
     # drives that stop: every plant with friction-bearing actuators (joint or winch drives)

@@ -11,6 +11,21 @@ def add_bag(p) -> None:
     p.add_argument("--description", metavar="FILE",
                    help="plant description YAML (default: /plant_description in the bag)")
     add_recover(p)
+    add_time_unit(p)
+
+
+def add_time_unit(p) -> None:
+    """``--time-unit {auto,s}``: stamps that look like milliseconds are refused unless told."""
+    p.add_argument("--time-unit", choices=("auto", "s"), default="auto",
+                   help="unit of the stamps: auto (refuse stamps that look like milliseconds: integer "
+                        "stamps 1 apart) or s (they are seconds, e.g. a 1 Hz recording)")
+
+
+def limits_from_args(args):
+    """:class:`~cablelab.timebase.Limits` of the time-base checks from ``--time-unit``."""
+    from ..timebase import Limits
+
+    return Limits(time_unit=getattr(args, "time_unit", "auto") or "auto")
 
 
 def add_recover(p) -> None:
@@ -118,7 +133,8 @@ def load_from_args(args):
     options = {"conditioning": conditioning_from_args(args), "tensions": args.tensions}
     plant, desc, ds, check = load_checked(args.bag, args.description, options,
                                           recover=getattr(args, "recover", False),
-                                          before_dataset=lambda p: check_plant_options(args, p))
+                                          before_dataset=lambda p: check_plant_options(args, p),
+                                          limits=limits_from_args(args))
     args.warnings = list(check.warnings)
     baseline = None
     if args.baseline is not None:

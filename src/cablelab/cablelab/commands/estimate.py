@@ -11,7 +11,7 @@ import inspect
 
 from ..errors import CablelabError
 from ._workbench_args import (add_bag, add_json, add_overwrite, add_tensions, check_plant_options,
-                              dump_json, with_warnings)
+                              dump_json, limits_from_args, with_warnings)
 
 HELP = "estimate the payload (CDPR mass and CoM) or the swing (crane) per sample from a bag"
 
@@ -60,7 +60,8 @@ def run(args) -> int:
     desc = load_bag_description(args.bag, args.description, bag)
     plant = get_plant(desc.plant)
     check_plant_options(args, plant)
-    args.check = check_bag(bag, plant, desc, {"tensions": args.tensions})
+    args.check = check_bag(bag, plant, desc, {"tensions": args.tensions, "pose": args.pose},
+                           limits_from_args(args))
     args.warnings = args.check.warnings
     fn = plant.estimate
     if fn is None:

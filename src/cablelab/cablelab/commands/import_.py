@@ -32,6 +32,9 @@ def add_arguments(p) -> None:
     p.add_argument("-o", "--out", required=True, metavar="BAG", help="bag directory to write")
     p.add_argument("--overwrite", action="store_true", help="replace an existing output")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    from ._workbench_args import add_time_unit
+
+    add_time_unit(p)
 
 
 def read_table(path: str) -> dict[str, np.ndarray]:
@@ -199,7 +202,7 @@ def run(args) -> int:
     from ..atomic import atomic_output, check_target
     from ..bags import BagWriter
     from ..description import load_description
-    from ._workbench_args import dump_json
+    from ._workbench_args import dump_json, limits_from_args
 
     if not args.description:
         raise CablelabError(f"import --plant {args.plant}: give --description FILE or YAML text "
@@ -212,7 +215,7 @@ def run(args) -> int:
     s = import_series(args.file, args.plant, args.map)
     from ..timebase import check_stamps, raise_if_impossible
 
-    tb = check_stamps(s["t"], topic=f"{args.file}: time column")
+    tb = check_stamps(s["t"], topic=f"{args.file}: time column", limits=limits_from_args(args))
     raise_if_impossible(tb)                 # stamps in ms: refuse with the --map fix
     with atomic_output(args.out, overwrite=args.overwrite, inputs=inputs, option="-o") as tmp:
         with BagWriter(tmp) as w:
