@@ -145,8 +145,8 @@ def check_names(bag, topic: str, names, want, *, exact: bool = False, plant: str
                 what = (f"{len(set(have))} {noun} ({_span(have)}) but the plant description has "
                         f"{len(want)} {described or noun}")
             else:   # same count, other names: say which
-                what = f"{len(have)} {noun} as the description has {described or noun}, but"
-                what += f" not named {_span(want)}"
+                what = (f"{len(have)} {noun}, as many as the plant description, but named "
+                        f"{_span(have)}, not {_span(want)}")
             parts = ([f"missing {_list(missing)}"] if missing else []) + \
                 ([f"unexpected {_list(extra)}"] if extra else []) + \
                 ([f"repeated {_list(dup)}"] if dup else [])
@@ -178,7 +178,13 @@ def negative_tension_warnings(tensions, names, topic: str) -> list[str]:
         neg = T < 0
     count = neg.sum(axis=0)
     out = []
-    for j in np.flatnonzero(count):
+    bad = np.flatnonzero(count)
+    if bad.size > 3:    # one line for many cables (a sign convention, not a sensor)
+        names_bad = [names[j] if j < len(names) else f"column {j + 1}" for j in bad]
+        return [f"{topic}: {bad.size} cables ({_list(names_bad)}) have negative tension in "
+                f"{int(neg.any(axis=1).sum())} of {T.shape[0]} samples (min {np.nanmin(T):.4g} N): "
+                f"cables cannot push, check the sensor sign and offset"]
+    for j in bad:
         name = names[j] if j < len(names) else f"column {j + 1}"
         out.append(f"{topic}: {name} has {int(count[j])} of {T.shape[0]} samples with negative tension "
                    f"(min {np.nanmin(T[:, j]):.4g} N): cables cannot push, check the sensor sign and offset")

@@ -68,8 +68,8 @@ def check_plant_options(args, plant) -> None:
             except CablelabError:
                 continue
         raise CablelabError(f"{flag} {getattr(args, dest)}: an option of plant "
-                            f"{' / '.join(owners) or 'none'} only; {args.bag} is a {plant.name} bag "
-                            f"(leave {flag} out)")
+                            f"{' / '.join(owners) or 'none'} only, and {args.bag} holds plant "
+                            f"{plant.name} (leave {flag} out)")
 
 
 def add_json(p) -> None:
