@@ -447,3 +447,57 @@ def test_free_run_fit_starts_from_the_models_own_parameters(tmp_path):
     assert set(fit.params) == {"M", "Fv"}
     with pytest.raises(CablelabError, match=r"viscous friction Fv = -3.*not physical"):
         fit_free_run(ds, {"M": 2.2, "Fv": -3.0}, max_iter=2)
+
+
+@FUZZ
+@given(seed=st.integers(0, 10_000), degrees=st.booleans(), boom=st.floats(0.5, 20.0),
+       with_tip=st.booleans())
+def test_crane_degrees_flagged_iff_degrees(seed, degrees, boom, with_tip):
+    """Random slew / luff motions in radians (luff 0.1-1.3 rad) with a measured boom tip (1 % of
+    the boom of marker noise) or without one: refused exactly when the angles are in degrees."""
+    from cablelab.errors import CablelabError
+    from cablelab.plants.crane.kinematics import boom_tip
+    from cablelab.plants.crane.plant import check_measurements
+
+    rng = np.random.default_rng(seed)
+    t = np.linspace(0, 20, 400)
+    alpha = rng.uniform(-1.5, 1.5) * np.sin(2 * np.pi * rng.uniform(0.02, 0.2) * t)
+    beta = rng.uniform(0.1, 0.5) + rng.uniform(0.1, 0.8) * (1 + np.sin(2 * np.pi * rng.uniform(0.02, 0.2) * t)) / 2
+    tip = boom_tip(alpha, beta, boom) + 0.01 * boom * rng.normal(size=(t.size, 3))
+    q = np.column_stack([alpha, beta, np.full(t.size, 0.8)])
+    if degrees:
+        q[:, :2] = np.rad2deg(q[:, :2])
+
+    class JS:
+        names, position = ["slew", "luff", "hoist"], q
+    JS.t = t
+
+    class Tip:
+        position = tip
+    Tip.t = t
+
+    class B:
+        path = "bag"
+
+    try:
+        check_measurements(B, boom, JS, Tip if with_tip else None)
+        raised = False
+    except CablelabError as exc:
+        raised = "degrees" in str(exc)
+    assert raised == degrees
+
+
+@FUZZ
+@given(period=st.sampled_from([1.0, 2.0, 5.0]), start=st.sampled_from([0.0, 1.0, 1.6e9, 1.7e12]),
+       unit=st.sampled_from(["auto", "s"]))
+def test_integer_stamps_ms_only_when_ambiguous_or_epoch_ms(period, start, unit):
+    """Integer stamps >= 1 apart: with --time-unit s never milliseconds; in auto, UNIX epoch
+    seconds are seconds, epoch milliseconds and small (ambiguous) stamps are refused."""
+    from cablelab.timebase import Limits, check_stamps
+
+    t = start + period * np.arange(300.0)
+    ms = check_stamps(t, limits=Limits(time_unit=unit)).milliseconds
+    if unit == "s":
+        assert not ms
+    else:
+        assert ms == (not 1e8 <= start < 1e10)
