@@ -473,9 +473,8 @@ def check_geometry(bag, c, positions=None) -> None:
     (every exit point at or below its anchor point: the cables cannot carry the weight).
 
     Args:
-        c: the ``cdpr`` section; positions: (N, 3) recorded platform positions, or None (the
-            centre of the exit points' bounding box, 0.4 of its height above their lowest
-            point, is then the one pose checked).
+        c: the ``cdpr`` section; positions: (N, 3) recorded platform positions, or None (then
+            only the coincident cables are checked: the poses decide the rest).
     """
     A, B = c.exit_points, c.anchor_points
     n = len(A)
@@ -492,8 +491,7 @@ def check_geometry(bag, c, positions=None) -> None:
         P = P[np.all(np.isfinite(P), axis=1)]
         P = P[:: max(1, len(P) // 200)]
     if P is None or not len(P):
-        lo, hi = A.min(axis=0), A.max(axis=0)
-        P = np.array([[(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, lo[2] + 0.4 * (hi[2] - lo[2])]])
+        return
     geom = cable_geometry(A, B, P, None, 0.0, c.swivel_axes)
     u = geom.directions                                          # (N, n, 3) anchor -> exit
     up = u[:, :, 2].max(axis=1)
