@@ -27,7 +27,7 @@ def main() -> int:
     kept, moved = defaultdict(int), defaultdict(list)
     for seed in range(a.seed, a.seed + a.cases):
         rec = simulate(draw_case(seed))
-        fs = 1.0 / float(np.median(np.diff(rec["t"])))
+        fs = round(1.0 / float(np.median(np.diff(rec["t"]))), 3)
         cut, warn = motion_cutoff(np.asarray(rec["q"], float), fs, fs / 10.0)
         if cut == fs / 10.0 and not warn:
             kept[fs] += 1
