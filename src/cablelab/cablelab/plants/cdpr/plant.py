@@ -341,6 +341,10 @@ class Estimate:
         """JSON of CONTRACT section 5 (cdpr) + the model, parameters and, when the bag has the
         ground truth, the mass error in %."""
         ok = np.isfinite(self.mass)
+        if not ok.any():
+            raise CablelabError("no sample gives a finite mass: the cable geometry of the "
+                                "description is degenerate at the recorded poses (e.g. an anchor "
+                                "closer to its pulley than the sheave radius)")
         m = self.mass[ok]
         out = {"plant": "cdpr", "samples": int(ok.sum()),
                "mass": {"mean": float(m.mean()), "std": float(m.std()),
