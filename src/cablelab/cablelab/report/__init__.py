@@ -1,9 +1,11 @@
 """``cablelab report``: one ``index.html`` with PNG plots of compare, diagnose and identify.
 
 :func:`build_report` runs the analysis once (nominal fit, greedy diagnosis, final fit) and writes
-the sections: summary, waterfall, candidate ranking with explanations, parameter table with
-uncertainties, overlay, residual over time with the worst segments shaded, residual by regime,
-residual whiteness and cross-correlation.
+the answer first, then the evidence: summary, the answer sentence with the waterfall, the ranking
+of the candidates (each with the quantities its significance is decided on), the parameter table
+with uncertainties, the metrics and the overlay (gaps shaded), residual over time with the worst
+segments shaded, residual by regime, residual whiteness and cross-correlation. Every figure has a
+caption naming what it shows and its unit.
 """
 from __future__ import annotations
 
@@ -15,6 +17,7 @@ import numpy as np
 
 from ..diagnose import derived_regimes, greedy, residual_by_regime, whiteness, worst_segments
 from ..diagnose.metrics import channel_metrics
+from ..diagnose.ranking import ALPHA, MIN_GAIN
 from ..errors import CablelabError
 from ..fit import identify
 from ..fit.threads import blas_single
@@ -36,12 +39,131 @@ def _num(v, fmt="{:.5g}") -> str:
 CSS = ("body{font-family:sans-serif;max-width:1100px;margin:auto;padding:1em}"
        "table{border-collapse:collapse;margin:0.5em 0}td,th{border:1px solid #ccc;padding:3px 8px;"
        "font-size:90%;text-align:left}th{background:#eee}img{max-width:100%}.sig{color:#060;font-weight:bold}"
-       ".warnings{background:#fff4e0;border:1px solid #e0a040;padding:0.3em 1em}")
+       ".warnings{background:#fff4e0;border:1px solid #e0a040;padding:0.3em 1em}"
+       "figure{margin:0.8em 0}figcaption{font-size:90%;color:#333;margin-top:0.2em}"
+       ".answer{font-size:115%;background:#eef6ee;border-left:4px solid #060;padding:0.4em 0.8em}")
+
+
+def _figure(src: str, caption: str) -> str:
+    """One figure with its caption (every plot of the report says what it shows, in which unit)."""
+    return (f"<figure><img src='{html.escape(src)}' alt='{html.escape(caption)}'>"
+            f"<figcaption>{html.escape(caption)}</figcaption></figure>")
+
+
+def _channel_rms(y: np.ndarray) -> float | None:
+    y = y[np.isfinite(y)]
+    return float(np.sqrt(np.mean(y ** 2))) if y.size else None
+
+
+def _model_name(step: dict) -> str:
+    return " + ".join(step["effects"]) or "no effects"
+
+
+def answer_section(steps: list[dict]) -> str:
+    """The answer in one sentence, the waterfall and its table of steps."""
+    first, last = steps[0], steps[-1]
+    added = [s["added"] for s in steps[1:]]
+    if added:
+        names = ", ".join(f"<b>{html.escape(a)}</b>" for a in added)
+        answer = (f"The nominal model ({html.escape(_model_name(first))}) misses {names}: adding "
+                  f"{'it' if len(added) == 1 else 'them, one at a time,'} lowers the held-out NRMSE "
+                  f"from {100 * first['error']:.2f} % to {100 * last['error']:.2f} %. No further "
+                  "candidate is significant.")
+    else:
+        answer = (f"No candidate effect is significant: the nominal model ({html.escape(_model_name(first))}, "
+                  f"held-out NRMSE {100 * first['error']:.2f} %) is not improved on held-out data by "
+                  "any of them.")
+    rows = [[i, html.escape(s["added"] or "nominal: " + _model_name(s)),
+             _num(100 * s["error"], "{:.2f} %"),
+             html.escape(", ".join(f"{k} = {v:.5g} +- {s['stderr'].get(k, 0):.2g} {s['units'].get(k, '')}"
+                                   for k, v in s["params"].items()))] for i, s in enumerate(steps)]
+    return ("<h2>Answer: which effect is missing</h2>"
+            f"<p class='answer'>{answer}</p>"
+            + _figure("waterfall.png", "Held-out NRMSE of the nominal model and after adding each "
+                      "significant effect in turn (greedy).")
+            + _table(rows, ["step", "model", "held-out NRMSE", "parameters (full record)"]))
+
+
+def decision(row: dict, threshold: float, min_gain: float) -> tuple[bool, str]:
+    """Why a ranked candidate is, or is not, significant, from the criteria of
+    :mod:`cablelab.diagnose.ranking` (held-out gain, held-out error falls, likelihood-ratio p,
+    identifiable): ``(significant, reason)``; the reason names the first criterion that fails."""
+    if row.get("error_after") is None:
+        return False, "cannot be fitted"
+    gain, p = row.get("gain"), row.get("p_value")
+    if gain is None or gain < min_gain:
+        return False, f"held-out gain below {100 * min_gain:g} %"
+    if not row["error_after"] < row["error_before"]:
+        return False, "held-out error over all channels does not fall"
+    if p is None or not p < threshold:
+        return False, f"p not below {threshold:.2g}"
+    if not row.get("identifiability", {}).get("identifiable", True):
+        return False, "not identifiable in this recording"
+    return True, "all criteria met"
+
+
+def _p(v) -> str:
+    if v is None:
+        return "-"
+    return "< 1e-300" if v < 1e-300 else f"{v:.2g}"
+
+
+def ranking_section(ranking: list[dict], error_before: float, *, alpha: float = ALPHA,
+                    min_gain: float = MIN_GAIN) -> str:
+    """The candidates ranked by held-out error when added to the nominal model, with every
+    quantity the significance decision is made on next to the decision and its reason."""
+    threshold = alpha / max(len(ranking), 1)
+    rows = []
+    for r in ranking:
+        sig, reason = decision(r, threshold, min_gain)
+        if sig != bool(r["significant"]):   # the diagnosis decided on more than these criteria
+            sig, reason = bool(r["significant"]), "see the explanation"
+        ident = r.get("identifiability")
+        rows.append([f"<span class='sig'>{html.escape(r['effect'])}</span>" if sig else html.escape(r["effect"]),
+                     _num(None if r["error_after"] is None else 100 * r["error_after"], "{:.2f} %"),
+                     _num(None if r.get("gain") is None else 100 * r["gain"], "{:.1f} %"),
+                     _p(r.get("p_value")),
+                     "-" if ident is None else ("yes" if ident.get("identifiable", True) else "no"),
+                     ("yes" if sig else "no") + f" ({html.escape(reason)})",
+                     html.escape(r["explanation"])])
+    head = ["effect", "held-out NRMSE with it", "held-out gain", "p (LR test, full record)",
+            "identifiable", "significant", "explanation"]
+    return (f"<h2>Ranking of the candidate effects (nominal model, held-out NRMSE "
+            f"{100 * error_before:.2f} %)</h2>"
+            f"<p>A candidate is significant when all of these hold: its <b>held-out gain</b> (the "
+            f"relative drop of the held-out error on the channels it changes) is at least "
+            f"{100 * min_gain:g} %; the held-out NRMSE over all channels falls; the likelihood-ratio "
+            f"test on the full record rejects \"no gain\" at p &lt; {alpha:g} / {len(ranking)} = "
+            f"{threshold:.2g} (effective sample count, Bonferroni); and its parameters are "
+            f"identifiable in this recording. A tiny p alone does not make an effect significant: "
+            f"with thousands of samples almost any extra parameter lowers the in-sample error.</p>"
+            + _table(rows, head))
+
+
+def metrics_table(channels, units, met_b, met_f) -> str:
+    """Error metrics per channel; a dimensional column carries the channels' unit in its header
+    when they share one, otherwise in each cell."""
+    shared = units[0] if len(set(units)) == 1 else None
+
+    def dim(v, unit):
+        return _num(v) if shared is not None or v is None else f"{_num(v)} {html.escape(unit)}"
+
+    def head(name):
+        return f"{name} [{shared}]" if shared is not None else name
+
+    rows = [[html.escape(f"{ch} [{unit}]"), _num(100 * mb["nrmse"], "{:.2f} %"),
+             _num(100 * mf["nrmse"], "{:.2f} %"), _num(mf["fit_percent"], "{:.1f} %"),
+             _num(mf["pearson"], "{:.4f}"), dim(mf["mae"], unit), _num(mf["mre"], "{:.3g}"),
+             dim(mf["max_abs"], unit)]
+            for ch, unit, mb, mf in zip(channels, units, met_b, met_f)]
+    return _table(rows, ["channel [unit]", "NRMSE nominal", "NRMSE final", "fit", "Pearson",
+                         head("MAE final"), "MRE", head("max abs final")])
 
 
 @blas_single
 def build_report(ds: Dataset, model: Model, candidates, out_dir, *, folds: int = 5,
-                 title: str = "", quiet: bool = True, warnings=()) -> dict:
+                 title: str = "", quiet: bool = True, warnings=(), alpha: float = ALPHA,
+                 min_gain: float = MIN_GAIN) -> dict:
     """Analyse and write ``out_dir/index.html`` + PNGs; ``warnings`` (the input checks' lines,
     :func:`cablelab.bagcheck.check_bag`) are shown at the top of the page.
 
@@ -53,7 +175,7 @@ def build_report(ds: Dataset, model: Model, candidates, out_dir, *, folds: int =
         os.makedirs(out_dir, exist_ok=True)
     except OSError as exc:
         raise CablelabError(f"{out_dir}: cannot create report directory ({exc.strerror})") from None
-    steps = greedy(model, ds, candidates, folds=folds, quiet=quiet)
+    steps = greedy(model, ds, candidates, folds=folds, alpha=alpha, min_gain=min_gain, quiet=quiet)
     final_model = Model(model.plant, tuple(steps[-1]["effects"]), model.fixed)
     base = identify(model, ds)
     fin = identify(final_model, ds)
@@ -73,44 +195,37 @@ def build_report(ds: Dataset, model: Model, candidates, out_dir, *, folds: int =
         return os.path.join(out_dir, name)
 
     plots.waterfall(fig("waterfall.png"), steps)
-    plots.overlay(fig("overlay.png"), ds.t, y_meas_b, base.y_hat, fin.y_hat, ds.channels, ds.units)
+    plots.overlay(fig("overlay.png"), ds.t, y_meas_b, base.y_hat, fin.y_hat, ds.channels, ds.units,
+                  valid=base.valid & fin.valid)
     plots.residual_time(fig("residual_time.png"), ds.t, base.residual, segs, ds.channels, ds.units,
-                        "residual of the nominal model; worst segments shaded")
+                        "residual of the nominal model; worst segments shaded", valid=base.valid)
     plots.residual_time(fig("residual_time_final.png"), ds.t, fin.residual, [], ds.channels,
-                        ds.units, "residual of the final model")
+                        ds.units, "residual of the final model", valid=fin.valid)
+    step_figs = []
+    for i, st in enumerate(steps[1:], 1):
+        ident_i = fin if i == len(steps) - 1 else identify(Model(model.plant, tuple(st["effects"]),
+                                                                 model.fixed), ds)
+        name = f"step_{i}_residual.png"
+        plots.residual_time(fig(name), ds.t, ident_i.residual, [], ds.channels, ds.units,
+                            f"step {i}: + {st['added']} (held-out NRMSE {100 * st['error']:.2f} %)",
+                            valid=ident_i.valid)
+        step_figs.append((i, name, f"Residual after step {i} (+ {st['added']}) over time."))
     white = {}
-    for c, ch in enumerate(ds.channels):
-        plots.residual_regimes(fig(f"regimes_{c}.png"), reg_b, reg_f, ch)
+    for c, (ch, unit) in enumerate(zip(ds.channels, ds.units)):
+        plots.residual_regimes(fig(f"regimes_{c}.png"), reg_b, reg_f, ch, unit)
         white[ch] = whiteness(fin.residual[:, c], ds.inputs, decimate=_decimation(ds))  # issue 10
         plots.correlations(fig(f"whiteness_{c}.png"), white[ch], ch)
 
     parts = [f"<h1>{html.escape(title or 'cablelab report')}</h1>",
              f"<p>plant <b>{ds.plant}</b>, {ds.n} samples at {ds.fs:.4g} Hz from "
-             f"{html.escape(ds.source)}; held-out errors by blocked {folds}-fold cross-validation.</p>"]
+             f"{html.escape(ds.source)}; held-out errors by blocked {folds}-fold cross-validation "
+             f"(NRMSE: residual RMS / measured RMS).</p>"]
     if warnings:
         parts.append("<div class='warnings'><b>Input warnings</b><ul>"
                      + "".join(f"<li>{html.escape(w)}</li>" for w in warnings) + "</ul></div>")
-    parts.append("<h2>Adding the missing effects</h2><img src='waterfall.png'>")
-    rows = [[i, html.escape(s["added"] or "nominal: " + " + ".join(s["effects"])),
-             _num(100 * s["error"], "{:.2f} %"),
-             html.escape(", ".join(f"{k} = {v:.5g} +- {s['stderr'].get(k, 0):.2g} {s['units'].get(k, '')}"
-                                   for k, v in s["params"].items()))] for i, s in enumerate(steps)]
-    parts.append(_table(rows, ["step", "model", "held-out NRMSE", "parameters (full record)"]))
-    for i, st in enumerate(steps):
-        if i == 0:
-            continue  # the nominal residual is plotted below
-        ident_i = fin if i == len(steps) - 1 else identify(Model(model.plant, tuple(st["effects"]),
-                                                                 model.fixed), ds)
-        name = f"step_{i}_residual.png"
-        plots.residual_time(fig(name), ds.t, ident_i.residual, [], ds.channels, ds.units,
-                            f"step {i}: + {st['added']} (held-out NRMSE {100 * st['error']:.2f} %)")
-        parts.append(f"<img src='{name}'>")
-    parts.append("<h2>Which effect is missing (nominal model)</h2>")
-    rows = [[f"<span class='sig'>{r['effect']}</span>" if r["significant"] else r["effect"],
-             _num(None if r["error_after"] is None else 100 * r["error_after"], "{:.2f} %"),
-             "yes" if r["significant"] else "no", _num(r.get("p_value"), "{:.2g}"),
-             html.escape(r["explanation"])] for r in steps[0]["ranking"]]
-    parts.append(_table(rows, ["effect", "held-out NRMSE with it", "significant", "p", "explanation"]))
+    # the answer first: what is missing (waterfall, ranking), then the fitted model, then evidence
+    parts.append(answer_section(steps))
+    parts.append(ranking_section(steps[0]["ranking"], steps[0]["error"], alpha=alpha, min_gain=min_gain))
     parts.append("<h2>Parameters of the final model</h2>")
     rows = [[html.escape(r["name"]), _num(r["value"], "{:.6g}"), _num(r["stderr"], "{:.2g}"),
              html.escape(r["unit"]), "fixed" if r["fixed"] else ""] for r in fin.table()]
@@ -119,27 +234,39 @@ def build_report(ds: Dataset, model: Model, candidates, out_dir, *, folds: int =
                  + (f"; unidentifiable: {html.escape('; '.join(fin.linear.unidentifiable))}"
                     if fin.linear.unidentifiable else "") + "</p>")
     parts.append("<h2>Measured vs model</h2>")
-    rows = [[html.escape(f"{ch} [{unit}]"), _num(100 * mb["nrmse"], "{:.2f} %"),
-             _num(100 * mf["nrmse"], "{:.2f} %"), _num(mf["fit_percent"], "{:.1f} %"),
-             _num(mf["pearson"], "{:.4f}"), _num(mf["mae"]), _num(mf["mre"], "{:.3g}"),
-             _num(mf["max_abs"])]
-            for ch, unit, mb, mf in zip(ds.channels, ds.units, met_b, met_f)]
-    parts.append(_table(rows, ["channel [unit]", "NRMSE nominal", "NRMSE final", "fit", "Pearson",
-                               "MAE final [unit]", "MRE", "max abs final [unit]"]))
-    parts.append("<img src='overlay.png'>")
-    parts.append("<h2>Where the nominal model fails</h2><img src='residual_time.png'>")
-    rows = [[s["channel"], f"{s['t_start']:.3f}", f"{s['t_end']:.3f}", f"{100 * s['error']:.1f} %"]
-            for s in segs]
+    parts.append(metrics_table(ds.channels, ds.units, met_b, met_f))
+    n_bad = int(np.sum(~fin.valid))
+    gaps = (f" Grey bands: {n_bad} samples ({100 * n_bad / max(ds.n, 1):.1f} %) with no valid "
+            "measurement (gaps, NaN, filter edges); nothing is fitted or drawn there." if n_bad else "")
+    parts.append(_figure("overlay.png", "Measured output (black) and the output of the nominal "
+                         "(orange) and final (blue) models, each channel in its own unit." + gaps))
+    parts.append("<h2>Evidence: where the nominal model fails</h2>")
+    parts.append(_figure("residual_time.png", "Residual (measured - model) of the nominal model "
+                         "over time; the worst windows (table below) shaded gold." + gaps))
+    rows = [[html.escape(s["channel"]), f"{s['t_start']:.3f}", f"{s['t_end']:.3f}",
+             f"{100 * s['error']:.1f} %"] for s in segs]
     parts.append(_table(rows, ["channel", "from [s]", "to [s]", "window NRMSE"]))
-    parts.append("<img src='residual_time_final.png'>")
-    parts.append("<h2>Residual by operating regime</h2>")
-    for c, _ in enumerate(ds.channels):
-        parts.append(f"<img src='regimes_{c}.png'>")
-    parts.append("<h2>Residual whiteness of the final model</h2>")
+    for i, name, caption in step_figs:
+        parts.append(_figure(name, caption))
+    parts.append(_figure("residual_time_final.png", "Residual of the final model over time."))
+    parts.append("<h2>Residual by operating regime</h2><p>Each bar: the residual RMS within one "
+                 "operating regime (samples sharing a velocity sign, closeness to a velocity "
+                 "reversal, acceleration level, or the plant's own regimes) as a percentage of the "
+                 "channel's RMS over the whole record, nominal model (orange) vs final model (blue). "
+                 "A regime where the nominal bar stands out is where the missing effect lives.</p>")
+    for c, (ch, unit) in enumerate(zip(ds.channels, ds.units)):
+        rms = _channel_rms(y_meas_b[:, c])
+        parts.append(_figure(f"regimes_{c}.png", f"Residual of {ch} by regime, in % of the RMS of "
+                             f"{ch} over the record ({_num(rms, '{:.4g}')} {unit}); n = samples in "
+                             "the regime."))
+    parts.append("<h2>Residual whiteness of the final model</h2><p>A model that explains "
+                 "everything leaves a white residual: autocorrelation inside the 99 % band at every "
+                 "lag and no correlation with the inputs.</p>")
     for c, ch in enumerate(ds.channels):
         w = white[ch]
-        parts.append(f"<p>{ch}: {100 * w['outside']:.0f} % of autocorrelation lags outside the 99 % "
-                     f"band ({'white' if w['white'] else 'not white'}).</p><img src='whiteness_{c}.png'>")
+        parts.append(_figure(f"whiteness_{c}.png", f"{ch}: {100 * w['outside']:.0f} % of "
+                             f"autocorrelation lags outside the 99 % band "
+                             f"({'white' if w['white'] else 'not white'}); lags in samples."))
     doc = (f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>cablelab report</title>"
            f"<style>{CSS}</style></head><body>{''.join(parts)}</body></html>")
     index = os.path.join(out_dir, "index.html")
