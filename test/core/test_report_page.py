@@ -255,3 +255,20 @@ def test_report_every_figure_captioned_and_units_in_headers(cdpr_report):
     # the CDPR bag has holes: the overlay's caption says how many samples are shaded
     overlay = next(f for f in page.figures if f["src"] == "overlay.png")
     assert re.search(r"Grey bands: \d+ samples", overlay["caption"])
+
+
+def test_report_evidence_points_at_the_missing_effect(cdpr_report):
+    """The CDPR bag lacks the platform's inertia m a, a vertical force while the platform
+    accelerates vertically: the shaded worst windows and the worst regime of Fz say so (and not
+    the noisiest channel), and no figure repeats another."""
+    import hashlib
+
+    page = Page((cdpr_report / "index.html").read_text())
+    segs = page.table_with("residual RMS in the window")
+    assert segs["rows"] and {r[0] for r in segs["rows"]} == {"Fz"}, segs["rows"]
+    regimes = page.table_with("regime")
+    fz = next(r for r in regimes["rows"] if r[0] == "Fz")
+    assert "vertical" in fz[1], fz
+    assert _pct(fz[-1]) < _pct(fz[-2]) / 3          # the final model removes most of it
+    digests = [hashlib.sha256((cdpr_report / f["src"]).read_bytes()).hexdigest() for f in page.figures]
+    assert len(set(digests)) == len(digests)

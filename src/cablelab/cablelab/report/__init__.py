@@ -4,7 +4,8 @@
 the answer first, then the evidence: summary, the answer sentence with the waterfall, the ranking
 of the candidates (each with the quantities its significance is decided on), the parameter table
 with uncertainties, the metrics and the overlay (gaps shaded), residual over time with the worst
-segments shaded, residual by regime, residual whiteness and cross-correlation. Every figure has a
+segments shaded and after each added effect, residual by regime (a table of the worst regime per
+channel, the bar charts folded), residual whiteness and cross-correlation. Every figure has a
 caption naming what it shows and its unit.
 """
 from __future__ import annotations
@@ -160,6 +161,41 @@ def metrics_table(channels, units, met_b, met_f) -> str:
                          head("MAE final"), "MRE", head("max abs final")])
 
 
+def regime_section(reg_b: list[dict], reg_f: list[dict], channels, units, y_meas: np.ndarray,
+                   min_share: float = 0.02) -> str:
+    """Residual by operating regime: per channel the regime where the nominal model's residual is
+    largest (holding at least ``min_share`` of the samples) and the final model's there; the
+    per-channel bar charts below it, folded."""
+    final = {(r["regime"], r["label"], r["channel"]): r for r in reg_f}
+    rows = []
+    for ch, unit in zip(channels, units):
+        mine = [r for r in reg_b if r["channel"] == ch and r["nrmse"] is not None]
+        n_max = max((r["n"] for r in mine), default=0)
+        mine = [r for r in mine if r["n"] >= min_share * n_max]
+        if not mine:
+            continue
+        w = max(mine, key=lambda r: r["nrmse"])
+        f = final.get((w["regime"], w["label"], ch), {})
+        rows.append([html.escape(ch), html.escape(f"{w['regime']}: {w['label']}"), w["n"],
+                     f"{w['rms']:.4g} {html.escape(unit)}", _num(100 * w["nrmse"], "{:.1f} %"),
+                     _num(None if f.get("nrmse") is None else 100 * f["nrmse"], "{:.1f} %")])
+    out = ["<h2>Residual by operating regime</h2><p>The residual RMS within one operating regime "
+           "(samples sharing a velocity sign, closeness to a velocity reversal, acceleration level, "
+           "or the plant's own regimes) as a percentage of the channel's RMS over the whole record. "
+           "A regime where the nominal model's residual stands out is where the missing effect "
+           "lives. Per channel, the regime where it is largest:</p>",
+           _table(rows, ["channel", "regime", "samples", "nominal residual RMS",
+                         "in % of the channel RMS, nominal", "final"])]
+    for c, (ch, unit) in enumerate(zip(channels, units)):
+        rms = _channel_rms(y_meas[:, c])
+        out.append(f"<details><summary>{html.escape(ch)}: every regime</summary>"
+                   + _figure(f"regimes_{c}.png", f"Residual of {ch} by regime, in % of the RMS of "
+                             f"{ch} over the record ({_num(rms, '{:.4g}')} {unit}), nominal model "
+                             "(orange) vs final model (blue); n = samples in the regime.")
+                   + "</details>")
+    return "".join(out)
+
+
 @blas_single
 def build_report(ds: Dataset, model: Model, candidates, out_dir, *, folds: int = 5,
                  title: str = "", quiet: bool = True, warnings=(), alpha: float = ALPHA,
@@ -181,7 +217,9 @@ def build_report(ds: Dataset, model: Model, candidates, out_dir, *, folds: int =
     fin = identify(final_model, ds)
     y_meas = np.where(fin.valid[:, None], fin.residual + fin.y_hat, np.nan)
     y_meas_b = np.where(base.valid[:, None], base.residual + base.y_hat, np.nan)
-    segs = worst_segments(ds.t, base.residual, y_meas_b, ds.channels)
+    # windows where the residual rises most above its own level over the record (normalised by the
+    # residual, not the signal: a noisy, well-modelled channel would otherwise take every window)
+    segs = worst_segments(ds.t, base.residual, base.residual, ds.channels)
     regimes = derived_regimes(ds)
     reg_b = residual_by_regime(base.residual, y_meas_b, regimes, ds.channels)
     reg_f = residual_by_regime(fin.residual, y_meas, regimes, ds.channels)
@@ -199,8 +237,6 @@ def build_report(ds: Dataset, model: Model, candidates, out_dir, *, folds: int =
                   valid=base.valid & fin.valid)
     plots.residual_time(fig("residual_time.png"), ds.t, base.residual, segs, ds.channels, ds.units,
                         "residual of the nominal model; worst segments shaded", valid=base.valid)
-    plots.residual_time(fig("residual_time_final.png"), ds.t, fin.residual, [], ds.channels,
-                        ds.units, "residual of the final model", valid=fin.valid)
     step_figs = []
     for i, st in enumerate(steps[1:], 1):
         ident_i = fin if i == len(steps) - 1 else identify(Model(model.plant, tuple(st["effects"]),
@@ -209,7 +245,8 @@ def build_report(ds: Dataset, model: Model, candidates, out_dir, *, folds: int =
         plots.residual_time(fig(name), ds.t, ident_i.residual, [], ds.channels, ds.units,
                             f"step {i}: + {st['added']} (held-out NRMSE {100 * st['error']:.2f} %)",
                             valid=ident_i.valid)
-        step_figs.append((i, name, f"Residual after step {i} (+ {st['added']}) over time."))
+        final = " (the final model)" if i == len(steps) - 1 else ""
+        step_figs.append((i, name, f"Residual after step {i} (+ {st['added']}){final} over time."))
     white = {}
     for c, (ch, unit) in enumerate(zip(ds.channels, ds.units)):
         plots.residual_regimes(fig(f"regimes_{c}.png"), reg_b, reg_f, ch, unit)
@@ -242,26 +279,26 @@ def build_report(ds: Dataset, model: Model, candidates, out_dir, *, folds: int =
                          "(orange) and final (blue) models, each channel in its own unit." + gaps))
     parts.append("<h2>Evidence: where the nominal model fails</h2>")
     parts.append(_figure("residual_time.png", "Residual (measured - model) of the nominal model "
-                         "over time; the worst windows (table below) shaded gold." + gaps))
+                         "over time; the windows where it rises most above its own level (table "
+                         "below) shaded gold." + gaps))
+    unit_of = dict(zip(ds.channels, ds.units))
     rows = [[html.escape(s["channel"]), f"{s['t_start']:.3f}", f"{s['t_end']:.3f}",
-             f"{100 * s['error']:.1f} %"] for s in segs]
-    parts.append(_table(rows, ["channel", "from [s]", "to [s]", "window NRMSE"]))
+             f"{s['rms']:.4g} {html.escape(unit_of[s['channel']])}", f"{s['error']:.2f}"] for s in segs]
+    parts.append(_table(rows, ["channel", "from [s]", "to [s]", "residual RMS in the window",
+                               "x the channel's residual RMS over the record"]))
+    if not step_figs:
+        parts.append("<p>No effect was added: the nominal model is the final model.</p>")
     for i, name, caption in step_figs:
         parts.append(_figure(name, caption))
-    parts.append(_figure("residual_time_final.png", "Residual of the final model over time."))
-    parts.append("<h2>Residual by operating regime</h2><p>Each bar: the residual RMS within one "
-                 "operating regime (samples sharing a velocity sign, closeness to a velocity "
-                 "reversal, acceleration level, or the plant's own regimes) as a percentage of the "
-                 "channel's RMS over the whole record, nominal model (orange) vs final model (blue). "
-                 "A regime where the nominal bar stands out is where the missing effect lives.</p>")
-    for c, (ch, unit) in enumerate(zip(ds.channels, ds.units)):
-        rms = _channel_rms(y_meas_b[:, c])
-        parts.append(_figure(f"regimes_{c}.png", f"Residual of {ch} by regime, in % of the RMS of "
-                             f"{ch} over the record ({_num(rms, '{:.4g}')} {unit}); n = samples in "
-                             "the regime."))
+    parts.append(regime_section(reg_b, reg_f, ds.channels, ds.units, y_meas_b))
     parts.append("<h2>Residual whiteness of the final model</h2><p>A model that explains "
                  "everything leaves a white residual: autocorrelation inside the 99 % band at every "
                  "lag and no correlation with the inputs.</p>")
+    rows = [[html.escape(ch), f"{100 * white[ch]['outside']:.0f} %", "yes" if white[ch]["white"] else "no",
+             html.escape(", ".join(k for k, x in white[ch]["cross"].items() if not x["uncorrelated"]) or "none")]
+            for ch in ds.channels]
+    parts.append(_table(rows, ["channel", "autocorrelation lags outside the 99 % band", "white",
+                               "inputs the residual still correlates with"]))
     for c, ch in enumerate(ds.channels):
         w = white[ch]
         parts.append(_figure(f"whiteness_{c}.png", f"{ch}: {100 * w['outside']:.0f} % of "
