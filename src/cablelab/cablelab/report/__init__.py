@@ -68,8 +68,9 @@ def answer_section(steps: list[dict]) -> str:
         names = ", ".join(f"<b>{html.escape(a)}</b>" for a in added)
         answer = (f"The nominal model ({html.escape(_model_name(first))}) misses {names}: adding "
                   f"{'it' if len(added) == 1 else 'them, one at a time,'} lowers the held-out NRMSE "
-                  f"from {100 * first['error']:.2f} % to {100 * last['error']:.2f} %. No further "
-                  "candidate is significant.")
+                  f"from {100 * first['error']:.2f} % to {100 * last['error']:.2f} %."
+                  + ("" if any(r["significant"] for r in last["ranking"])
+                     else " No further candidate is significant."))
     else:
         answer = (f"No candidate effect is significant: the nominal model ({html.escape(_model_name(first))}, "
                   f"held-out NRMSE {100 * first['error']:.2f} %) is not improved on held-out data by "
@@ -109,10 +110,10 @@ def _p(v) -> str:
     return "< 1e-300" if v < 1e-300 else f"{v:.2g}"
 
 
-def ranking_section(ranking: list[dict], error_before: float, *, alpha: float = ALPHA,
-                    min_gain: float = MIN_GAIN) -> str:
-    """The candidates ranked by held-out error when added to the nominal model, with every
-    quantity the significance decision is made on next to the decision and its reason."""
+def _ranking_table(ranking: list[dict], alpha: float, min_gain: float) -> str:
+    """One ranking: every candidate with the quantities its significance is decided on, the
+    decision and its reason; the p threshold (Bonferroni over this ranking's candidates) heads the
+    p column."""
     threshold = alpha / max(len(ranking), 1)
     rows = []
     for r in ranking:
@@ -127,18 +128,35 @@ def ranking_section(ranking: list[dict], error_before: float, *, alpha: float = 
                      "-" if ident is None else ("yes" if ident.get("identifiable", True) else "no"),
                      ("yes" if sig else "no") + f" ({html.escape(reason)})",
                      html.escape(r["explanation"])])
-    head = ["effect", "held-out NRMSE with it", "held-out gain", "p (LR test, full record)",
+    head = ["effect", "held-out NRMSE with it", f"held-out gain (significant from {100 * min_gain:g} %)",
+            f"p, LR test on the full record (significant below {threshold:.2g})",
             "identifiable", "significant", "explanation"]
-    return (f"<h2>Ranking of the candidate effects (nominal model, held-out NRMSE "
-            f"{100 * error_before:.2f} %)</h2>"
-            f"<p>A candidate is significant when all of these hold: its <b>held-out gain</b> (the "
-            f"relative drop of the held-out error on the channels it changes) is at least "
-            f"{100 * min_gain:g} %; the held-out NRMSE over all channels falls; the likelihood-ratio "
-            f"test on the full record rejects \"no gain\" at p &lt; {alpha:g} / {len(ranking)} = "
-            f"{threshold:.2g} (effective sample count, Bonferroni); and its parameters are "
-            f"identifiable in this recording. A tiny p alone does not make an effect significant: "
-            f"with thousands of samples almost any extra parameter lowers the in-sample error.</p>"
-            + _table(rows, head))
+    return _table(rows, head)
+
+
+def ranking_section(steps: list[dict], *, alpha: float = ALPHA, min_gain: float = MIN_GAIN) -> str:
+    """Which effect is missing: the candidates ranked by held-out error when added to the nominal
+    model (shown), then to the model of each greedy step (folded), each with the quantities its
+    significance is decided on next to the decision and its reason."""
+    out = [f"<h2>Ranking of the candidate effects (nominal model, held-out NRMSE "
+           f"{100 * steps[0]['error']:.2f} %)</h2>"
+           f"<p>A candidate is significant when all of these hold: its <b>held-out gain</b> (the "
+           f"relative drop of the held-out error on the channels it changes) is at least "
+           f"{100 * min_gain:g} %; the held-out NRMSE over all channels falls; the likelihood-ratio "
+           f"test on the full record rejects \"no gain\" at p &lt; {alpha:g} / m (m = candidates "
+           f"in the ranking, Bonferroni; effective sample count); and its parameters are "
+           f"identifiable in this recording. A tiny p alone does not make an effect significant: "
+           f"with thousands of samples almost any extra parameter lowers the in-sample error. An "
+           f"effect added at a later step is ranked against the model holding the earlier ones "
+           f"(rankings after each step below).</p>",
+           _ranking_table(steps[0]["ranking"], alpha, min_gain)]
+    for i, st in enumerate(steps[1:], 1):
+        last = (" (no remaining candidate is significant)"
+                if i == len(steps) - 1 and not any(r["significant"] for r in st["ranking"]) else "")
+        out.append(f"<details><summary>Ranking after step {i} (+ {html.escape(st['added'])}, held-out "
+                   f"NRMSE {100 * st['error']:.2f} %){last}</summary>"
+                   + _ranking_table(st["ranking"], alpha, min_gain) + "</details>")
+    return "".join(out)
 
 
 def metrics_table(channels, units, met_b, met_f) -> str:
@@ -262,7 +280,7 @@ def build_report(ds: Dataset, model: Model, candidates, out_dir, *, folds: int =
                      + "".join(f"<li>{html.escape(w)}</li>" for w in warnings) + "</ul></div>")
     # the answer first: what is missing (waterfall, ranking), then the fitted model, then evidence
     parts.append(answer_section(steps))
-    parts.append(ranking_section(steps[0]["ranking"], steps[0]["error"], alpha=alpha, min_gain=min_gain))
+    parts.append(ranking_section(steps, alpha=alpha, min_gain=min_gain))
     parts.append("<h2>Parameters of the final model</h2>")
     rows = [[html.escape(r["name"]), _num(r["value"], "{:.6g}"), _num(r["stderr"], "{:.2g}"),
              html.escape(r["unit"]), "fixed" if r["fixed"] else ""] for r in fin.table()]
