@@ -282,9 +282,12 @@ def build_report(ds: Dataset, model: Model, candidates, out_dir, *, folds: int =
     parts.append(answer_section(steps))
     parts.append(ranking_section(steps, alpha=alpha, min_gain=min_gain))
     parts.append("<h2>Parameters of the final model</h2>")
+    table = fin.table()
+    any_fixed = any(r["fixed"] for r in table)     # a column for --fix only when it was used
     rows = [[html.escape(r["name"]), _num(r["value"], "{:.6g}"), _num(r["stderr"], "{:.2g}"),
-             html.escape(r["unit"]), "fixed" if r["fixed"] else ""] for r in fin.table()]
-    parts.append(_table(rows, ["parameter", "value", "std. error", "unit", ""]))
+             html.escape(r["unit"])] + (["fixed (--fix)" if r["fixed"] else "fitted"] if any_fixed else [])
+            for r in table]
+    parts.append(_table(rows, ["parameter", "value", "std. error", "unit"] + (["source"] if any_fixed else [])))
     parts.append(f"<p>rank {fin.linear.rank}, condition number {fin.linear.cond:.3g}"
                  + (f"; unidentifiable: {html.escape('; '.join(fin.linear.unidentifiable))}"
                     if fin.linear.unidentifiable else "") + "</p>")
