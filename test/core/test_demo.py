@@ -101,7 +101,8 @@ def check_index_links(index) -> list[tuple[str, str]]:
             assert target.suffix == ".html" and target.is_file(), (href, text)
             assert "<title>cablelab report</title>" in target.read_text(), (href, text)
         elif text.startswith("bag "):
-            assert target.is_dir() and target.name == text[4:] and list(target.glob("*.mcap")), (href, text)
+            assert target.is_dir() and (index.parent / text[4:]).resolve() == target, (href, text)
+            assert list(target.glob("*.mcap")), (href, text)
         else:
             raise AssertionError(f"link {text!r} ({href}) names no known kind")
     reports = {(index.parent / h).resolve() for h, t in links if t == "diagnosis report"}

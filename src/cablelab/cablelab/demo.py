@@ -87,18 +87,22 @@ def demo_parts() -> list[DemoPart]:
 INDEX_LINKS = {"demo page": ("page", "html"), "diagnosis report": ("report", "html")}
 
 
-def part_links(part: PartResult) -> list[tuple[str, str]]:
+def part_links(part: PartResult, out=None) -> list[tuple[str, str]]:
     """``[(label, path)]`` of a part's index line: its page, its ``cablelab report`` when it has
     one of its own (an existing HTML page other than its demo page), then each existing bag
-    (a directory). A link is only ever made to a file of the kind its label names."""
+    (a directory, named by its path relative to ``out`` when given). A link is only ever made to
+    a file of the kind its label names."""
     links, seen = [], set()
     for label, (key, kind) in INDEX_LINKS.items():
         path = str(getattr(part, key) or "")
         if path.endswith(f".{kind}") and os.path.isfile(path) and os.path.abspath(path) not in seen:
             seen.add(os.path.abspath(path))
             links.append((label, path))
-    return links + [(f"bag {os.path.basename(os.path.normpath(str(b)))}", str(b))
-                    for b in part.bags if os.path.isdir(b)]
+    for b in part.bags:
+        if os.path.isdir(b):
+            name = os.path.relpath(b, out) if out is not None else os.path.basename(os.path.normpath(str(b)))
+            links.append((f"bag {name}", str(b)))
+    return links
 
 
 def index_page(out: Path, parts: dict) -> str:
@@ -111,7 +115,7 @@ def index_page(out: Path, parts: dict) -> str:
             "report</code> on the recorded bags.</p>"]
     for title, part in parts.items():
         links = " | ".join(f"<a href='{html.escape(os.path.relpath(path, out))}'>{html.escape(label)}</a>"
-                           for label, path in part_links(part))
+                           for label, path in part_links(part, out))
         rows = "".join("<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in r) + "</tr>"
                        for r in part.rows)
         body.append(f"<h2>{html.escape(title)}</h2><p>{links}</p>"
