@@ -100,7 +100,24 @@ def test_every_verb_help_names_only_files_in_the_repository():
     assert not bad, bad
 
 
-@pytest.mark.parametrize("exe", ["cable_sim_node", "payload_estimator", "pd_feedforward"])
+def _console_scripts() -> list[str]:
+    """Every executable the repository's packages install (their setup.cfg console_scripts)."""
+    import configparser
+
+    names = []
+    for cfg in sorted((REPO / "src").glob("*/setup.cfg")):
+        parser = configparser.ConfigParser()
+        parser.read(cfg)
+        spec = parser.get("options.entry_points", "console_scripts", fallback="")
+        names += [line.split("=")[0].strip() for line in spec.splitlines() if "=" in line]
+    return names
+
+
+def test_the_executables_are_found():
+    assert {"cable_sim_node", "payload_estimator", "pd_feedforward"} <= set(_console_scripts())
+
+
+@pytest.mark.parametrize("exe", _console_scripts())
 def test_node_help_names_only_files_in_the_repository(exe):
     path = shutil.which(exe, path=str(REPO / ".venv" / "bin")) or shutil.which(exe)
     if path is None:
