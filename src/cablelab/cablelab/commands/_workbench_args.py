@@ -79,7 +79,7 @@ def add_json(p) -> None:
 def add_common(p, *, effects_required: bool = False) -> None:
     add_bag(p)
     p.add_argument("--effects", metavar="A,B", default="", required=effects_required,
-                   help="effects added to the plant's nominal model (ids of CONTRACT section 4)")
+                   help="effects added to the plant's nominal model (ids: docs/interface.md section 3)")
     p.add_argument("--baseline", metavar="A,B", default=None,
                    help="replace the plant's nominal effects ('none' = empty model)")
     p.add_argument("--fix", metavar="NAME=VALUE", action="append", default=[],
