@@ -1,8 +1,8 @@
 """``cablelab compare BAG [--effects a,b] --json``: measured vs model per channel."""
 from __future__ import annotations
 
-from ._workbench_args import (add_common, add_overlay_out, dump_json, load_from_args, param_line,
-                              with_warnings, write_overlay_out)
+from ._workbench_args import (add_common, add_overlay_out, dump_json, flag_impossible, load_from_args,
+                              param_line, with_warnings, write_overlay_out)
 
 HELP = "compare the model (nominal effects + --effects, fitted) with the measurement per channel"
 
@@ -18,9 +18,10 @@ def run(args) -> int:
     from ..workbench import compare_fit
 
     plant, _, ds, model = load_from_args(args, check_out=True)
-    out, ident = compare_fit(ds, model, segments=args.segments)
+    res, ident = compare_fit(ds, model, segments=args.segments)
+    flag_impossible(args, model.effects, res["params"])
     write_overlay_out(args, plant, ds, [stage_from_fit(None, ds, ident)])
-    out = with_warnings(args, out)
+    out = with_warnings(args, res)
     if args.json:
         print(dump_json(out))
         return 0
