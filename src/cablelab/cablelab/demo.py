@@ -201,7 +201,7 @@ def main(argv: list[str] | None = None) -> int:
         took = f" (analysis {res.seconds:.0f} s)" if res.seconds else ""
         print_table(f"{title}: {part.how}{took}", res.rows)
     print()
-    for title, (_, res) in results.items():
+    for title, (part, res) in results.items():
         print(f"{title.split(' (')[0]}: bags {', '.join(str(b) for b in res.bags)}")
         for label, path in part_links(res):
             if not label.startswith("bag "):
