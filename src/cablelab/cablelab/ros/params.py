@@ -195,7 +195,7 @@ class Param:
         text = self.description + (f" [{self.unit}]" if self.unit else "")
         d = ParameterDescriptor(name=self.name, description=text, additional_constraints=self.allowed(),
                                 read_only=self.read_only)
-        if self.kind == "float":
+        if self.kind == "float" and not self.nan:      # (ROS ranges refuse NaN: the text says it)
             lo = next((b for b in (self.ge, self.gt) if b is not None), -math.inf)
             hi = next((b for b in (self.le, self.lt) if b is not None), math.inf)
             if (lo, hi) != (-math.inf, math.inf):
