@@ -93,6 +93,7 @@ def load_from_args(args):
     plant, desc, ds, check = load_checked(args.bag, args.description, options,
                                           recover=getattr(args, "recover", False))
     args.warnings = list(check.warnings)
+    check_measured(ds)
     baseline = None
     if args.baseline is not None:
         baseline = () if args.baseline.strip() in ("", "none") else parse_effect_list(args.baseline)
@@ -109,6 +110,22 @@ def load_from_args(args):
         raise CablelabError(f"--baseline {args.baseline}: the model has no effects left to fit; add some "
                             f"with --effects A,B (e.g. --effects {','.join(plant.baseline(desc))})")
     return plant, desc, ds, model
+
+
+def check_measured(ds) -> None:
+    """A measured channel that is exactly zero in every usable sample holds no measurement (an
+    effort never recorded, a dead sensor): nothing to compare or fit, one line naming it."""
+    import numpy as np
+
+    from ..errors import CablelabError
+
+    y = np.asarray(ds.y, dtype=float)
+    ok = np.asarray(ds.valid, dtype=bool) & np.isfinite(y).all(axis=1)
+    for c, ch in enumerate(ds.channels):
+        if ok.any() and not np.any(y[ok, c]):
+            raise CablelabError(f"channel {ch!r} is zero in all {int(ok.sum())} usable samples: no "
+                                "measurement to compare or fit (was it recorded? check the bag's "
+                                "effort / tension fields)")
 
 
 def with_warnings(args, out: dict) -> dict:
