@@ -4,6 +4,8 @@ from __future__ import annotations
 import json
 import math
 
+from .numeric import number
+
 
 def add_bag(p) -> None:
     """The bag and its plant description (every verb that reads a recorded run)."""
@@ -44,15 +46,15 @@ def add_common(p, *, effects_required: bool = False) -> None:
     p.add_argument("--fix", metavar="NAME=VALUE", action="append", default=[],
                    help="known parameter moved to the left-hand side (repeatable)")
     add_tensions(p)
-    p.add_argument("--cutoff", type=float, metavar="HZ", default=None,
+    p.add_argument("--cutoff", type=number(gt=0, unit="Hz"), metavar="HZ", default=None,
                    help="zero-phase Butterworth cut-off for positions (default fs/10)")
-    p.add_argument("--decimate", type=int, metavar="K", default=None,
+    p.add_argument("--decimate", type=number(ge=1, integer=True), metavar="K", default=None,
                    help="keep every K-th sample after filtering")
     add_json(p)
 
 
 def add_folds(p) -> None:
-    p.add_argument("--folds", type=int, default=5, metavar="K",
+    p.add_argument("--folds", type=number(ge=0, le=1000, integer=True), default=5, metavar="K",
                    help="blocked k-fold cross-validation over time (default 5; identify: 0 = none)")
 
 
