@@ -278,7 +278,7 @@ def test_unparsable_ros_args_are_one_line(capsys):
                     "cable_sim_node --plant cdpr")
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 2 and len(err) == 1
-    assert "bad --ros-args" in err[0] and "[0.0, 0.5]" in err[0] and "payload_com" in err[0]
+    assert "bad --ros-args" in err[0] and "[0.0, 0.5, 1.0]" in err[0] and "payload_com" in err[0]
 
 
 def test_docs_nodes_tables_match_the_specs():

@@ -75,6 +75,12 @@ def run_node(node_factory, args, ros_args: list[str], prog: str) -> int:
     stop = _Stop()
     old = {s: signal.signal(s, stop) for s in (signal.SIGINT, signal.SIGTERM)}
     _tight_timers()
+    problem = mixed_lists(ros_args)
+    if problem:            # (rcl would refuse it too, after logging an error line of its own)
+        for s, h in old.items():
+            signal.signal(s, h)
+        print(f"{prog}: error: {problem}", file=sys.stderr)
+        return 2
     try:
         rclpy.init(args=[prog] + ros_args, signal_handler_options=SignalHandlerOptions.NO)
     except Exception as exc:  # noqa: BLE001 - rcl's argument parser: one line, not a traceback
@@ -138,6 +144,29 @@ def ros_args_problem(exc: Exception) -> str:
     hint = (" (write every element of a number list with a decimal point, e.g. [0.0, 0.5])"
             if "same type" in text else "")
     return f"bad --ros-args: {text}{hint}"
+
+
+def mixed_lists(ros_args: list[str]) -> str:
+    """The problem with a ``-p name:=[...]`` list mixing integers and numbers (rcl refuses such a
+    list: every element of a number list must be written with a decimal point), else ''."""
+    import yaml
+
+    for i, arg in enumerate(ros_args[:-1]):
+        if arg not in ("-p", "--param") or ":=" not in ros_args[i + 1]:
+            continue
+        name, _, text = ros_args[i + 1].partition(":=")
+        if not text.strip().startswith("["):
+            continue
+        try:
+            value = yaml.safe_load(text)
+        except yaml.YAMLError:
+            continue
+        kinds = {type(x) for x in value} if isinstance(value, list) else set()
+        if {int, float} <= kinds:
+            return (f"bad --ros-args: parameter {name}:={text}: a list mixing integers and numbers; "
+                    f"write every element with a decimal point, e.g. "
+                    f"[{', '.join(repr(float(x)) if isinstance(x, (int, float)) else str(x) for x in value)}]")
+    return ""
 
 
 def parameters_of(module, role: str) -> tuple:
