@@ -223,7 +223,8 @@ def test_integer_and_partial_overrides_work(ros_with, plant, role, overrides, na
 
 
 @pytest.mark.parametrize("plant, role, override, expect", [
-    ("cdpr", "sim", "rate:=0.0", "parameter rate:=0.0: expected a number > 0"),
+    ("cdpr", "sim", "rate:=0.0", "parameter rate:=0.0: expected a number in [1, 10000] [Hz]"),
+    ("cdpr", "sim", "timestep:=1e-9", "parameter timestep:=1e-09: expected 0 (auto) or a step of at least"),
     ("cdpr", "sim", "seed:=-1", "parameter seed:=-1: expected an integer >= 0"),
     ("cdpr", "sim", "payload_mass:=-500", "parameter payload_mass:=-500: expected a number in [0, 100000] [kg]"),
     ("cdpr", "sim", "tension_noise:=-5", "parameter tension_noise:=-5: expected a number in [0, 100000] [N]"),
@@ -231,7 +232,7 @@ def test_integer_and_partial_overrides_work(ros_with, plant, role, overrides, na
     ("cdpr", "sim", "tension_bias:=[1.0, 2.0]", "parameter tension_bias:=[1.0, 2.0]: expected 1 or 8 numbers"),
     ("cdpr", "estimator", "poll_period:=1.0", "parameter poll_period:=1.0: expected a number in [0, 0.1] [s]"),
     ("cdpr", "controller", "model:=III", "parameter model:=III: expected one of: II, I"),
-    ("axis", "sim", "rate:=abc", "parameter rate:=abc: expected a number > 0"),
+    ("axis", "sim", "rate:=abc", "parameter rate:=abc: expected a number in [1, 10000]"),
     ("axis", "estimator", "forgetting:=1.5", "parameter forgetting:=1.5"),
     ("crane", "sim", "base_tilt:=[0.1]", "parameter base_tilt:=[0.1]: expected 2 numbers"),
     ("crane", "controller", "kp:=[1.0, 2.0]", "parameter kp:=[1.0, 2.0]: expected 3 numbers"),
@@ -266,7 +267,7 @@ def test_node_help_lists_the_plant_parameters(capsys):
         for spec in parameters_of(node_module("cdpr", "sim"), "sim"):
             line = next(ln for ln in out.splitlines() if ln.startswith(f"  {spec.name} ("))
             assert spec.allowed() in line and spec.default_text() in line
-        assert "rate (double, default 100.0; a number > 0 and <= 10000 [Hz], read-only)" in out
+        assert "rate (double, default 100.0; a number in [1, 10000] [Hz], read-only)" in out
         assert "payload centre of mass" in out
 
 

@@ -46,7 +46,7 @@ PARAMETERS = {
         Param("preload", float("nan"), "true spring preload F_0 (NaN = the description's)", "N",
               ge=-1e5, le=1e5, nan=True),
         Param("z0_offset", 0.03, "start height above touch-down height z_td", "m", ge=0.0, le=10.0),
-        Param("rate", 1000.0, "simulation and publishing rate", "Hz", gt=0.0, le=100000.0),
+        Param("rate", 1000.0, "simulation and publishing rate", "Hz", ge=1.0, le=100000.0),
         Param("command_timeout", 0.5, "a torque command older than this means zero torque",
               "s wall", gt=0.0),
     ),

@@ -75,7 +75,7 @@ PARAMETERS = {
         Param("pose_noise", 0.0, "standard deviation of the measured platform position", "m",
               ge=0.0, le=10.0),
         Param("rate", 100.0, "publishing rate = command sampling (use 1000 with arm_input effort)",
-              "Hz", gt=0.0, le=10000.0),
+              "Hz", ge=1.0, le=10000.0),
         Param("duration", 0.0, "simulated time after which the node exits (0 = run for ever)", "s",
               ge=0.0),
         Param("lockstep", False, "after a state, wait for the command answering it (needs "

@@ -34,7 +34,7 @@ def mjcf(mass: float, length: float, damping: float) -> str:
 PARAMETERS = (
     Param("description", "", "plant description: YAML file or text (empty = a 0.5 kg, 0.4 m pendulum)"),
     Param("damping", 0.05, "hinge damping (the hidden effect)", "N m s/rad", ge=0.0, le=100.0),
-    Param("rate", 200.0, "publishing rate", "Hz", gt=0.0, le=1000.0),
+    Param("rate", 200.0, "publishing rate", "Hz", ge=1.0, le=1000.0),
     Param("duration", 8.0, "simulated time after which the node exits", "s", gt=0.0, le=3600.0),
     Param("realtime_factor", 4.0, "simulated seconds per wall second", gt=0.0, le=1000.0),
     Param("torque_noise", 0.01, "standard deviation of the measured torque", "N m", ge=0.0, le=100.0),

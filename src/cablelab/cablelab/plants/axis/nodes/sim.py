@@ -43,8 +43,8 @@ PARAMETERS = merge((
     Param("viscous", 5.0, "true viscous friction Fv", "N s/m or N m s/rad", ge=0.0, le=1e6),
     Param("coulomb", 1.0, "true Coulomb friction Fc", "N or N m", ge=0.0, le=1e6),
     Param("offset", 0.0, "bias added to the reported effort", "N or N m", ge=-1e6, le=1e6),
-    Param("timestep", 0.001, "physics step", "s", gt=0.0, le=0.01),
-    Param("rate", 200.0, "publishing rate = command sampling", "Hz", gt=0.0, le=10000.0),
+    Param("timestep", 0.001, "physics step", "s", ge=1e-5, le=0.01),
+    Param("rate", 200.0, "publishing rate = command sampling", "Hz", ge=1.0, le=10000.0),
     Param("command_timeout", 0.5, "a command older than this falls back to 0 (WARN)", "s wall", gt=0.0),
     Param("lockstep", False, "advance one period only once the command answering the last state "
           "arrived"),

@@ -58,8 +58,9 @@ PARAMETERS = merge((
     Param("torque_noise", 0.02, "standard deviation of the motor-torque (current) noise", "N m",
           ge=0.0, le=1e4),
     Param("pose_noise", 0.0, "standard deviation of the measured platform position", "m", ge=0.0, le=10.0),
-    Param("timestep", 0.0, "physics step (0 = min(2 ms, 1/rate))", "s", ge=0.0, le=0.01),
-    Param("rate", 100.0, "publishing rate of the state = command sampling", "Hz", gt=0.0, le=10000.0),
+    Param("timestep", 0.0, "physics step (0 = min(2 ms, 1/rate); else at least 10 us)", "s",
+          ge=0.0, le=0.01),
+    Param("rate", 100.0, "publishing rate of the state = command sampling", "Hz", ge=1.0, le=10000.0),
     Param("real_time", True, "step at rate Hz of wall time (false: as fast as possible in lock-step "
           "with the controller)"),
     Param("publish_reference", True, "publish /cdpr/reference, the pick-and-place s-curve of 001 "
@@ -94,6 +95,9 @@ class CdprSimNode(PlantNode):
         if len(bias) not in (1, self.n):
             raise CablelabError(f"{self.get_name()}: parameter tension_bias:={bias}: expected 1 or "
                                 f"{self.n} numbers (one per cable) [N]")
+        if 0 < v.timestep < 1e-5:
+            raise CablelabError(f"{self.get_name()}: parameter timestep:={v.timestep!r}: expected 0 (auto) "
+                                "or a step of at least 1e-05 [s]")
         truth = CdprTruth(
             pulleys=v.pulleys, payload_mass=v.payload_mass, payload_com=tuple(v.payload_com),
             winch_coulomb=v.winch_coulomb, winch_viscous=v.winch_viscous,

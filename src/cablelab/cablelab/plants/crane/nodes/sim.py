@@ -60,10 +60,10 @@ PARAMETERS = merge((
           length=(3,), ge=-1e6, le=1e6),
     Param("mocap_noise", 0.0, "standard deviation of the motion-capture positions", "m", ge=0.0, le=10.0),
     Param("mocap_dropout", 0.0, "probability of a motion-capture dropout (NaN pose)", ge=0.0, le=1.0),
-    Param("timestep", 0.001, "physics step", "s", gt=0.0, le=0.01),
+    Param("timestep", 0.001, "physics step", "s", ge=1e-5, le=0.01),
     Param("initial", [0.0, 0.5, 0.6], "initial [slew rad, luff rad, hoist rope length m]", length=(3,),
           ge=-10.0, le=100.0),
-    Param("rate", 100.0, "publishing rate = command sampling", "Hz", gt=0.0, le=10000.0),
+    Param("rate", 100.0, "publishing rate = command sampling", "Hz", ge=1.0, le=10000.0),
     Param("command_timeout", 0.5, "a command older than this is stale: the drives hold (real time)",
           "s wall", gt=0.0),
     Param("lockstep", True, "once commands flow, advance only when the command answering the last "
