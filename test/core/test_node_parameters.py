@@ -163,8 +163,8 @@ def test_descriptor_carries_range_and_read_only():
     specs = {s.name: s for s in parameters_of(node_module("cdpr", "sim"), "sim")}
     d = specs["rate"].descriptor()
     assert d.read_only
-    assert d.floating_point_range[0].from_value == 0.0 and d.floating_point_range[0].to_value == 10000.0
-    assert "Hz" in d.description and "> 0" in d.additional_constraints
+    assert d.floating_point_range[0].from_value == 1.0 and d.floating_point_range[0].to_value == 10000.0
+    assert "Hz" in d.description and "in [1, 10000]" in d.additional_constraints
     seed = specs["seed"].descriptor()
     assert seed.integer_range[0].from_value == 0 and not seed.floating_point_range
 
