@@ -294,3 +294,20 @@ def test_docs_nodes_tables_match_the_specs():
         assert marker in text, f"docs/nodes.md lacks the table of {node}"
         block = text.split(marker, 1)[1].split("<!-- end parameters -->", 1)[0]
         assert block.strip() == markdown_table(specs), f"docs/nodes.md: table of {node} is stale"
+
+
+def test_simulator_refuses_a_pulley_radius_the_geometry_cannot_hold(ros_with, tmp_path):
+    import yaml
+
+    from cablelab.bags import open_bag
+    from cablelab.errors import CablelabError
+    from robust_helpers import CDPR
+
+    doc = yaml.safe_load(open_bag(CDPR).description_yaml)
+    doc["cdpr"]["pulley_radius"] = 100
+    f = tmp_path / "d.yaml"
+    f.write_text(yaml.safe_dump(doc))
+    ros_with(f"description:={f}")
+    with pytest.raises(CablelabError) as exc:
+        _make("cdpr", "sim").destroy_node()
+    assert "description cdpr.pulley_radius: 100 m is larger than the geometry allows" in str(exc.value)

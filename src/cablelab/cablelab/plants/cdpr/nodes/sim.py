@@ -40,6 +40,7 @@ from ....ros.plant_node import PlantNode
 from ....ros.qos import stream_qos
 from ....ros import rawmsg
 from ....ros.rawmsg import RawTemplate
+from ..geometry import check_pulley_radius
 from ..sim import CdprSim, CdprTruth, default_description_path
 
 
@@ -122,6 +123,8 @@ class CdprSimNode(PlantNode):
         self.command_timeout = v.command_timeout
         self.lockstep_timeout = v.lockstep_timeout
         start = pick_and_place(np.array([0.0])).position[0]
+        check_pulley_radius(c.exit_points, c.anchor_points, start[None], None, c.pulley_radius,
+                            c.swivel_axes, f"{self.get_name()}: description cdpr.pulley_radius")
         self.sim = CdprSim(self.description, truth, start)
         self.nstep = max(1, int(round(1.0 / (self.rate * self.sim.truth.timestep))))
         # winch brakes: lock each motor angle where it was when the commands stopped, holding the
