@@ -28,7 +28,7 @@ def section() -> str:
              "length stops the node with one line naming the node, the parameter, the value and "
              "what is allowed.", ""]
     for plant in available_plants():
-        for package, role in ROLES.items():
+        for package, role in {**ROLES, "control_loop": "control_loop"}.items():
             module = node_module(plant, role)
             if module is None:
                 continue

@@ -43,7 +43,7 @@ def _all_specs():
 
     out = []
     for plant in available_plants():
-        for package, role in ROLES.items():
+        for package, role in {**ROLES, "control_loop": "control_loop"}.items():
             module = node_module(plant, role)
             if module is not None:
                 out.append((f"{package} --plant {plant}", parameters_of(module, role)))
