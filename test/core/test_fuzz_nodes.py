@@ -208,3 +208,47 @@ def test_node_survives_hostile_messages(ros, plant, role):
         run()
     finally:
         node.destroy_node()
+
+
+# ----------------------------------------------------------------------------- ROS parameters
+
+@pytest.mark.parametrize("plant, role", NODES, ids=[f"{p}.{r}" for p, r in NODES])
+def test_node_refuses_random_bad_parameters(ros, monkeypatch, plant, role):
+    """Hypothesis: the real node built with one random invalid override of one of its declared
+    parameters (wrong type, out of range, wrong length: strategies of test_node_parameters) stops
+    with one line naming the node and the parameter, never a traceback or a node half built."""
+    from rclpy.node import Node
+    from rclpy.parameter import Parameter
+
+    from cablelab.errors import CablelabError
+    from cablelab.ros.runner import node_module, parameters_of
+    from test_node_parameters import any_value, valid
+
+    module = node_module(plant, role)
+    specs = parameters_of(module, role)
+    overrides = []
+    init = Node.__init__
+
+    def with_overrides(self, *a, **kw):
+        kw["parameter_overrides"] = list(overrides)
+        init(self, *a, **kw)
+
+    monkeypatch.setattr(Node, "__init__", with_overrides)
+
+    def homogeneous(v):          # what an override can hold (rcl refuses mixed lists itself)
+        return not isinstance(v, list) or (v and len({type(x) for x in v}) == 1)
+
+    @settings(max_examples=max(3, EXAMPLES // 2), deadline=None,
+              derandomize=not os.environ.get("CABLELAB_FUZZ_RANDOM"), suppress_health_check=list(HealthCheck))
+    @given(data=st.data())
+    def run(data):
+        spec = data.draw(st.sampled_from(specs))
+        value = data.draw(any_value(spec).filter(lambda v: not valid(spec, v) and homogeneous(v)
+                                                 and v is not None))
+        overrides[:] = [Parameter(spec.name, value=value)]
+        with pytest.raises(CablelabError) as exc:
+            module.make_node(None).destroy_node()
+        text = str(exc.value)
+        assert "\n" not in text and f"parameter {spec.name}:=" in text, text
+
+    run()

@@ -209,6 +209,10 @@ def condition_motion(t: np.ndarray, q: np.ndarray, effort: np.ndarray,
         if not np.all(np.isfinite(s)):
             raise CablelabError(f"{source}: {name} has no finite samples in some column")
     fs = 1.0 / float(np.median(np.diff(t)))
+    if opts.cutoff_hz is not None:
+        from .filters import check_cutoff
+
+        check_cutoff(float(opts.cutoff_hz), fs, len(t))
     cutoff = default_cutoff(fs, opts)
     warnings: list[str] = []
     method = "central"

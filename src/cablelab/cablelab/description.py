@@ -8,8 +8,8 @@ arrays, SI units). Unknown keys, missing required keys, wrong types and wrong ve
 from __future__ import annotations
 
 import dataclasses
-import math
 import os
+import re
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -61,60 +61,61 @@ class Description:
 
 
 # ----------------------------------------------------------------------------- validation helpers
-
-def _fail(path: str, msg: str) -> CablelabError:
-    return CablelabError(f"{path}: {msg}")
-
-
-def _mapping(obj: Any, path: str) -> dict:
-    if not isinstance(obj, dict):
-        raise _fail(path, f"expected a mapping, got {type(obj).__name__}")
-    return obj
+# (the public validators are cablelab.fields; these names stay for plants written against them)
+from .fields import check_keys as _check_keys  # noqa: E402
+from .fields import fail as _fail  # noqa: E402
+from .fields import mapping as _mapping  # noqa: E402
+from .fields import number as _number  # noqa: E402
+from .fields import vector as _vector  # noqa: E402
 
 
-def _check_keys(obj: dict, path: str, required: tuple[str, ...], optional: tuple[str, ...]) -> None:
-    for key in obj:
-        if key not in required and key not in optional:
-            allowed = ", ".join(required + optional)
-            raise _fail(f"{path}.{key}" if path else str(key), f"unknown key (allowed: {allowed})")
-    for key in required:
-        if key not in obj:
-            raise _fail(f"{path}.{key}" if path else key, "missing required key")
+# ----------------------------------------------------------------------------- YAML 1.2 reading
+
+class DescriptionLoader(yaml.SafeLoader):
+    """PyYAML's safe loader with YAML 1.2 core-schema scalars and no duplicated keys.
+
+    PyYAML implements YAML 1.1, where ``2e3`` (no dot) is text and ``yes``/``no``/``on``/``off``
+    are booleans, ``1:30`` is 90 and ``010`` is octal; YAML 1.2 (what other tools write and
+    users expect) reads ``2e3`` as the number 2000.0, only ``true``/``false`` as booleans,
+    ``010`` as 10. A key given twice in one mapping is an error naming it and both lines (1.1
+    loaders keep the last one silently)."""
+
+    yaml_implicit_resolvers: dict = {}
+
+    def construct_mapping(self, node, deep=False):
+        seen: dict = {}
+        for key_node, _ in node.value:
+            key = self.construct_object(key_node, deep=True)
+            try:
+                first = seen.get(key)
+            except TypeError:               # an unhashable key: PyYAML's own error follows
+                continue
+            if first is not None:
+                raise CablelabError(f"line {key_node.start_mark.line + 1}: duplicated key {key!r} "
+                                    f"(first given on line {first})")
+            seen[key] = key_node.start_mark.line + 1
+        return super().construct_mapping(node, deep=deep)
+
+    def construct_yaml_int(self, node):
+        text = self.construct_scalar(node)
+        return int(text, 0) if text.lstrip("+-").startswith(("0x", "0o")) else int(text, 10)
 
 
-def _number(obj: dict, key: str, path: str, *, positive: bool = False, nonneg: bool = False,
-            default: float | None = None) -> float | None:
-    p = f"{path}.{key}" if path else key
-    if key not in obj or obj[key] is None:
-        return default
-    v = obj[key]
-    if isinstance(v, bool) or not isinstance(v, (int, float)):
-        raise _fail(p, f"expected a number, got {v!r}")
-    v = float(v)
-    if not math.isfinite(v):
-        raise _fail(p, f"expected a finite number, got {v}")
-    if positive and v <= 0:
-        raise _fail(p, f"expected a positive number, got {v:g}")
-    if nonneg and v < 0:
-        raise _fail(p, f"expected a number >= 0, got {v:g}")
-    return v
+_INT = r"^(?:[-+]?[0-9]+|0o[0-7]+|0x[0-9a-fA-F]+)$"
+_FLOAT = (r"^(?:[-+]?(?:\.[0-9]+|[0-9]+(?:\.[0-9]*)?)(?:[eE][-+]?[0-9]+)?"
+          r"|[-+]?\.(?:inf|Inf|INF)|\.(?:nan|NaN|NAN))$")
+for _tag, _regexp, _first in (
+        ("tag:yaml.org,2002:bool", r"^(?:true|True|TRUE|false|False|FALSE)$", "tTfF"),
+        ("tag:yaml.org,2002:int", _INT, "-+0123456789"),
+        ("tag:yaml.org,2002:float", _FLOAT, "-+0123456789."),
+        ("tag:yaml.org,2002:null", r"^(?:~|null|Null|NULL|)$", ["~", "n", "N", ""])):
+    DescriptionLoader.add_implicit_resolver(_tag, re.compile(_regexp), list(_first))
+DescriptionLoader.add_constructor("tag:yaml.org,2002:int", DescriptionLoader.construct_yaml_int)
 
 
-def _vector(obj: dict, key: str, path: str, n: int = 3, default=None) -> np.ndarray:
-    p = f"{path}.{key}"
-    if key not in obj:
-        if default is None:
-            raise _fail(p, "missing required key")
-        return np.asarray(default, dtype=float)
-    v = obj[key]
-    if not isinstance(v, (list, tuple)):
-        raise _fail(p, f"expected {n} numbers, got {v!r}")
-    if len(v) != n:
-        raise _fail(p, f"expected {n} numbers, got {len(v)}")
-    for i, x in enumerate(v):
-        if isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(float(x)):
-            raise _fail(f"{p}[{i}]", f"expected a finite number, got {x!r}")
-    return np.array(v, dtype=float)
+def read_yaml(text: str):
+    """Parse YAML text with :class:`DescriptionLoader` (YAML 1.2 numbers, no duplicated keys)."""
+    return yaml.load(text, Loader=DescriptionLoader)  # noqa: S506 - a SafeLoader subclass
 
 
 # ----------------------------------------------------------------------------- plant sections
@@ -165,9 +166,14 @@ def load_description(src: str | os.PathLike) -> Description:
                 text = fh.read()
         except OSError as exc:
             raise CablelabError(f"{src}: cannot read description ({exc.strerror})") from None
+        except UnicodeDecodeError as exc:
+            raise CablelabError(f"{src}: not a UTF-8 text file (byte 0x{exc.object[exc.start]:02x} at "
+                                f"offset {exc.start}): a description is YAML text") from None
         origin = str(src)
     try:
-        data = yaml.safe_load(text)
+        data = read_yaml(text)
+    except CablelabError as exc:                     # a duplicated key
+        raise CablelabError(f"{origin}: {exc}") from None
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f" line {mark.line + 1}" if mark is not None else ""

@@ -133,6 +133,8 @@ def parse_fixed(items: Sequence[str] | None) -> dict:
             if "=" not in part:
                 raise CablelabError(f"--fix {part!r}: expected NAME=VALUE")
             k, v = part.split("=", 1)
+            if k.strip() in out:
+                raise CablelabError(f"--fix {k.strip()}: given twice ({k.strip()}={out[k.strip()]:g} and {part.strip()})")
             try:
                 out[k.strip()] = float(v)
             except ValueError:

@@ -4,6 +4,8 @@ from __future__ import annotations
 import json
 import math
 
+from .numeric import number
+
 
 def add_bag(p) -> None:
     """The bag and its plant description (every verb that reads a recorded run)."""
@@ -85,15 +87,15 @@ def add_common(p, *, effects_required: bool = False) -> None:
     p.add_argument("--fix", metavar="NAME=VALUE", action="append", default=[],
                    help="known parameter moved to the left-hand side (repeatable)")
     add_tensions(p)
-    p.add_argument("--cutoff", type=float, metavar="HZ", default=None,
+    p.add_argument("--cutoff", type=number(gt=0, unit="Hz"), metavar="HZ", default=None,
                    help="zero-phase Butterworth cut-off for positions (default fs/10)")
-    p.add_argument("--decimate", type=int, metavar="K", default=None,
+    p.add_argument("--decimate", type=number(ge=1, integer=True), metavar="K", default=None,
                    help="keep every K-th sample after filtering")
     add_json(p)
 
 
 def add_folds(p) -> None:
-    p.add_argument("--folds", type=int, default=5, metavar="K",
+    p.add_argument("--folds", type=number(ge=0, le=1000, integer=True), default=5, metavar="K",
                    help="blocked k-fold cross-validation over time (default 5; identify: 0 = none)")
 
 
@@ -190,6 +192,7 @@ def load_from_args(args, *, check_out: bool = False):
                                           before_dataset=lambda p: check_plant_options(args, p),
                                           limits=limits_from_args(args))
     args.warnings = list(check.warnings)
+    check_measured(ds)
     baseline = None
     if args.baseline is not None:
         baseline = () if args.baseline.strip() in ("", "none") else parse_effect_list(args.baseline)
@@ -206,6 +209,22 @@ def load_from_args(args, *, check_out: bool = False):
         raise CablelabError(f"--baseline {args.baseline}: the model has no effects left to fit; add some "
                             f"with --effects A,B (e.g. --effects {','.join(plant.baseline(desc))})")
     return plant, desc, ds, model
+
+
+def check_measured(ds) -> None:
+    """A measured channel that is exactly zero in every usable sample holds no measurement (an
+    effort never recorded, a dead sensor): nothing to compare or fit, one line naming it."""
+    import numpy as np
+
+    from ..errors import CablelabError
+
+    y = np.asarray(ds.y, dtype=float)
+    ok = np.asarray(ds.valid, dtype=bool) & np.isfinite(y).all(axis=1)
+    for c, ch in enumerate(ds.channels):
+        if ok.any() and not np.any(y[ok, c]):
+            raise CablelabError(f"channel {ch!r} is zero in all {int(ok.sum())} usable samples: no "
+                                "measurement to compare or fit (was it recorded? check the bag's "
+                                "effort / tension fields)")
 
 
 def flag_impossible(args, effects, params: dict, units: dict | None = None, where: str = "") -> None:

@@ -2,6 +2,7 @@
 bag under ROOT on Dask distributed, write OUT/results.parquet and the fleet report OUT/index.html."""
 from __future__ import annotations
 
+from .numeric import number
 from ._workbench_args import add_folds, add_json, dump_json
 
 HELP = "diagnose every bag under ROOT (Dask), results.parquet + fleet report with parameter drift"
@@ -17,14 +18,14 @@ def add_arguments(p) -> None:
     add_folds(p)
     p.add_argument("--scheduler", metavar="ADDRESS", default=None,
                    help="existing Dask scheduler, e.g. tcp://HOST:8786 (default: a LocalCluster)")
-    p.add_argument("--workers", type=int, default=None, metavar="N",
+    p.add_argument("--workers", type=number(ge=1, le=4096, integer=True), default=None, metavar="N",
                    help="LocalCluster worker processes (default: one per core)")
     p.add_argument("--group-by", metavar="PATTERN", default=None,
                    help="machine and date from the bag path relative to ROOT, e.g. '{machine}/{date}/*' "
                         "(default: description name and first stamp)")
     p.add_argument("--reports", action="store_true",
                    help="also write each bag's own `cablelab report` under OUT/bags/<hash>/")
-    p.add_argument("--alpha", type=float, default=0.01, help="family-wise level of the drift tests")
+    p.add_argument("--alpha", type=number(gt=0, lt=1), default=0.01, help="family-wise level of the drift tests")
     add_json(p)
 
 

@@ -1,6 +1,7 @@
 """``cablelab compare BAG [--effects a,b] --json``: measured vs model per channel."""
 from __future__ import annotations
 
+from .numeric import number
 from ._workbench_args import (add_common, add_overlay_out, dump_json, flag_impossible, load_from_args,
                               param_line, with_warnings, write_overlay_out)
 
@@ -9,7 +10,8 @@ HELP = "compare the model (nominal effects + --effects, fitted) with the measure
 
 def add_arguments(p) -> None:
     add_common(p)
-    p.add_argument("--segments", type=int, default=5, help="number of worst segments to list")
+    p.add_argument("--segments", type=number(ge=1, le=1000, integer=True), default=5,
+                   help="number of worst segments to list")
     add_overlay_out(p)
 
 

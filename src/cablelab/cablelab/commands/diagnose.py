@@ -1,6 +1,7 @@
 """``cablelab diagnose BAG [--effects a,b] [--greedy] --json``: which effect is missing."""
 from __future__ import annotations
 
+from .numeric import number
 from ._workbench_args import (add_common, add_folds, add_overlay_out, check_alpha, dump_json,
                               flag_impossible, greedy_stages, load_from_args, with_warnings,
                               write_overlay_out)
@@ -15,8 +16,8 @@ def add_arguments(p) -> None:
                    help="effects to try (default: every effect applicable to the plant)")
     p.add_argument("--greedy", action="store_true",
                    help="add the best significant effect until none helps (the waterfall)")
-    p.add_argument("--alpha", type=float, default=0.01, help="family-wise significance level")
-    p.add_argument("--min-gain", type=float, default=0.05,
+    p.add_argument("--alpha", type=number(gt=0, lt=1), default=0.01, help="family-wise significance level")
+    p.add_argument("--min-gain", type=number(ge=0, le=1), default=0.05,
                    help="minimum relative held-out error reduction of a significant effect, over the "
                         "channels it changes (default 0.05)")
     add_overlay_out(p, greedy=True)

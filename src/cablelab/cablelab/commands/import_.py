@@ -8,6 +8,7 @@ plants use ``time, position, velocity, effort``; multi-joint plants ``position.<
 """
 from __future__ import annotations
 
+import io
 import os
 import re
 
@@ -59,18 +60,58 @@ def read_table(path: str) -> dict[str, np.ndarray]:
         return out
     try:
         with open(path, encoding="utf-8") as fh:
-            header = fh.readline()
-        delim = ";" if header.count(";") > header.count(",") else ","
-        names = [h.strip().strip('"') for h in header.strip().split(delim)]
-        data = np.genfromtxt(path, delimiter=delim, skip_header=1, dtype=float, ndmin=2)
-        text = np.genfromtxt(path, delimiter=delim, skip_header=1, dtype=str, ndmin=2,
-                             autostrip=True, comments=None)
-    except (OSError, ValueError, UnicodeDecodeError) as exc:
+            content = fh.read()
+    except (OSError, UnicodeDecodeError) as exc:
+        raise CablelabError(f"{path}: cannot read CSV ({str(exc).splitlines()[0] if str(exc) else exc})") from None
+    header = content.split("\n", 1)[0]
+    delim = ";" if header.count(";") > header.count(",") else ","
+    names = [h.strip().strip('"') for h in header.strip().split(delim)]
+    _check_header(path, names)
+    _check_cell_sizes(path, names, content, delim)
+    try:
+        data = np.genfromtxt(io.StringIO(content), delimiter=delim, skip_header=1, dtype=float, ndmin=2)
+    except ValueError as exc:
         raise CablelabError(f"{path}: cannot read CSV ({str(exc).splitlines()[0] if str(exc) else exc})") from None
     if data.shape[1] != len(names):
         raise CablelabError(f"{path}: header has {len(names)} names but rows have {data.shape[1]} values")
-    _check_text_cells(path, names, data, text)
+    if not np.isfinite(data).all():         # which cells are text: only when some did not parse
+        text = np.genfromtxt(io.StringIO(content), delimiter=delim, skip_header=1, dtype=f"U{MAX_CELL}",
+                             ndmin=2, autostrip=True, comments=None)
+        _check_text_cells(path, names, data, text)
     return {n: data[:, i] for i, n in enumerate(names)}
+
+
+#: longest cell read (characters): a number never needs more; a longer cell is an error, not memory
+MAX_CELL = 100
+
+
+def _check_header(path, names) -> None:
+    """Column names must be unique and non-empty: a duplicated one would silently shadow the other."""
+    seen: dict[str, int] = {}
+    for i, n in enumerate(names):
+        if not n:
+            raise CablelabError(f"{path}: row 1, column {i + 1}: empty column name in the header")
+        if n in seen:
+            raise CablelabError(f"{path}: row 1: column name {n!r} appears twice (columns {seen[n] + 1} "
+                                f"and {i + 1}): rename one")
+        seen[n] = i
+
+
+def _check_cell_sizes(path, names, content: str, delim: str) -> None:
+    """No cell longer than :data:`MAX_CELL` characters (one huge cell would make the text table of
+    every cell that wide): one line naming row and column."""
+    lines = content.splitlines()
+    lengths = np.fromiter(map(len, lines), dtype=np.int64, count=len(lines))
+    if lengths.size == 0 or lengths.max() <= MAX_CELL:
+        return
+    for r in np.flatnonzero(lengths > MAX_CELL):
+        cells = lines[r].split(delim)
+        sizes = [len(c.strip()) for c in cells]
+        c = int(np.argmax(sizes))
+        if sizes[c] > MAX_CELL:
+            col = repr(names[c]) if c < len(names) else str(c + 1)
+            raise CablelabError(f"{path}: row {int(r) + 1}, column {col}: a cell of {sizes[c]} characters "
+                                f"(at most {MAX_CELL}) is not a number")
 
 
 _MISSING = {"", "nan", "NaN", "NAN", "na", "NA", "n/a", "N/A"}
@@ -167,7 +208,8 @@ def import_series(path: str, plant: str, spec: str) -> dict:
     topic, joints = joint_topic(plant)
     if "time" not in fields:
         raise CablelabError(f"--map: missing 'time=' (e.g. time=t)")
-    t = evaluate("time", fields.pop("time"), table, path)
+    fields_time = fields.pop("time")
+    t = evaluate("time", fields_time, table, path)
     n = t.size
     arrays = {f: None for f in FIELDS}
     for key, factors in fields.items():
@@ -189,12 +231,18 @@ def import_series(path: str, plant: str, spec: str) -> dict:
         arrays[base][:, joints.index(joint)] = v
     if arrays["position"] is None and arrays["effort"] is None:
         raise CablelabError("--map: map at least position and effort")
+    if np.any(t < 0):
+        k = int(np.flatnonzero(t < 0)[0])
+        col = next((name for _, name in fields_time if name in table), "time")
+        raise CablelabError(f"{path}: row {k + 2}, column {col!r}: time {float(t[k]):g} s is negative "
+                            f"({int((t < 0).sum())} such rows); bag stamps start at 0 or later: "
+                            "shift the time column")
     if not np.all(np.isfinite(t)):
         raise CablelabError(f"{path}: time column has {int((~np.isfinite(t)).sum())} missing or non-finite values")
     if not np.all(np.diff(t) > 0):
         k = int(np.flatnonzero(np.diff(t) <= 0)[0])
-        raise CablelabError(f"{path}: time column is not strictly increasing (row {k + 3}: {t[k + 1]!r} after "
-                            f"{t[k]!r})")
+        raise CablelabError(f"{path}: time column is not strictly increasing (row {k + 3}: {float(t[k + 1])!r} after "
+                            f"{float(t[k])!r})")
     return {"topic": topic, "t": t, "names": list(joints), **arrays}
 
 

@@ -5,6 +5,8 @@ A real ROS 2 node (see :mod:`cablelab.ros.recorder`); stops on SIGINT/SIGTERM or
 """
 from __future__ import annotations
 
+from .numeric import number
+
 HELP = "record a plant's contract topics (or --topics) into a rosbag2 MCAP bag"
 
 
@@ -15,9 +17,9 @@ def add_arguments(p) -> None:
     p.add_argument("--plant", choices=available_plants(),
                    help="record this plant's contract topics (+ /clock, /plant_description)")
     p.add_argument("--topics", help="comma-separated topics to record (types discovered)")
-    p.add_argument("--duration", type=float, default=0.0, help="stop after this many s (0: on signal)")
+    p.add_argument("--duration", type=number(ge=0, unit="s"), default=0.0, help="stop after this many s (0: on signal)")
     p.add_argument("--overwrite", action="store_true", help="replace an existing bag")
-    p.add_argument("--flush-period", type=float, default=1.0,
+    p.add_argument("--flush-period", type=number(gt=0, le=3600, unit="s"), default=1.0,
                    help="s between flushes to disk (bounds what a SIGKILL loses)")
     p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
 

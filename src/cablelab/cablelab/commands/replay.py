@@ -2,6 +2,7 @@
 see :mod:`cablelab.ros.replayer`), with /clock and the transient-local /plant_description."""
 from __future__ import annotations
 
+from .numeric import number
 from ._workbench_args import add_recover
 
 HELP = "republish a bag on its original topics with /clock and /plant_description"
@@ -9,9 +10,9 @@ HELP = "republish a bag on its original topics with /clock and /plant_descriptio
 
 def add_arguments(p) -> None:
     p.add_argument("bag", help="rosbag2 directory or its .mcap file")
-    p.add_argument("--rate", type=float, default=1.0, help="replay speed factor (default 1)")
+    p.add_argument("--rate", type=number(gt=0), default=1.0, help="replay speed factor (default 1)")
     p.add_argument("--topics", help="comma-separated subset of topics to replay")
-    p.add_argument("--start-delay", type=float, default=1.0,
+    p.add_argument("--start-delay", type=number(ge=0, le=3600, unit="s"), default=1.0,
                    help="start once every topic has a subscriber, or after this many s")
     p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
     add_recover(p)

@@ -75,7 +75,8 @@ def derived_regimes(ds: Dataset) -> dict[str, np.ndarray]:
             s = np.sign(v[:, j])
             flips = np.zeros(ds.n)
             flips[1:] = (s[1:] * s[:-1] < 0) | ((s[1:] != s[:-1]) & (s[1:] != 0) & (s[:-1] != 0))
-            near = np.convolve(flips, kernel, mode="same") > 0
+            # (centred window; "same" would return the kernel's length for a record shorter than it)
+            near = np.convolve(flips, kernel)[half:half + ds.n] > 0
             out[f"reversal{sfx}"] = np.where(near, "near reversal", "away from reversal")
             a = np.abs(acc[:, j])
             hi = a > np.median(a)

@@ -131,7 +131,8 @@ def solve_linear(phi: np.ndarray, y: np.ndarray, params: Sequence[Param], *,
         w = np.ones(n_c)
     else:
         w = np.asarray(channel_scale, dtype=float).reshape(n_c)
-    a = (phi[mask] * w[None, :, None]).reshape(-1, p)
+    # (no free parameter, e.g. every one fixed: no columns, the residual is y itself)
+    a = (phi[mask] * w[None, :, None]).reshape(-1, p) if p else np.zeros((int(mask.sum()) * n_c, 0))
     b = (y[mask] * w[None, :]).reshape(-1)
     n = a.shape[0]
     if n <= p:

@@ -18,12 +18,9 @@ SIGTERM stop it within 0.1 s; at shutdown the hardware is stopped and one JSON l
 cycle figures is printed (``{"node": "control_loop", "missed_cycles", "late", "dropped",
 "p99_ms", ...}``, read by ``bench/bench_realtime.py``).
 
-ROS parameters of every loop: ``rate`` (Hz, 1000), ``duration`` (s of hardware stamps after which
-the node exits, 0 = run until stopped), ``warmup`` (s not counted in the cycle figures, 1),
-``publish_thread`` (false: publish in the loop's thread after the write; true: hand the samples
-to a publisher thread through a queue), ``input_period`` (s between non-blocking takes of the
-input topics, 0.01), and the placement parameters of every node (``cpu_affinity``, ``niceness``,
-``sched_idle``, ``sched_slice``, ``rt_priority``: :meth:`PlantNode.use_fast_executor`).
+ROS parameters of every loop: :data:`LOOP_PARAMETERS`, and the placement parameters of every
+node (``cpu_affinity``, ``niceness``, ``sched_idle``, ``sched_slice``, ``rt_priority``:
+:meth:`PlantNode.use_fast_executor`).
 """
 from __future__ import annotations
 
@@ -34,8 +31,8 @@ import threading
 import time
 
 from ..control_loop import ControlLoop
-from ..errors import CablelabError
 from .inputs import WARN
+from .params import Param
 from .plant_node import PlantNode
 
 __all__ = ["ControlLoopNode", "LoopSpinner"]
@@ -64,19 +61,30 @@ class LoopSpinner:
         return True
 
 
+#: parameters of every control loop (a plant's loop adds its own: ``merge(LOOP_PARAMETERS, ...)``)
+LOOP_PARAMETERS = (
+    Param("rate", 1000.0, "loop rate (one read, update, write per period)", "Hz", ge=1.0, le=100000.0),
+    Param("duration", 0.0, "time of hardware stamps after which the node exits (0 = run until "
+          "stopped)", "s", ge=0.0),
+    Param("warmup", 1.0, "time not counted in the cycle figures", "s", ge=0.0, le=3600.0),
+    Param("publish_thread", False, "hand the samples to a publisher thread through a queue (false: "
+          "publish in the loop's thread after the write)"),
+    Param("input_period", 0.01, "time between non-blocking takes of the input topics", "s",
+          ge=0.0, le=10.0),
+)
+
+
 class ControlLoopNode(PlantNode):
     """Base of a plant's control-loop node (module docstring)."""
 
     def __init__(self, name: str = "control_loop"):
         super().__init__(name, start_parameter_services=False)
-        self.rate = float(self.param("rate", 1000.0))
-        self.duration = float(self.param("duration", 0.0))
-        self.warmup = float(self.param("warmup", 1.0))
-        self.publish_thread = bool(self.param("publish_thread", False))
-        input_period = float(self.param("input_period", 0.01))
-        if not self.rate > 0 or self.duration < 0 or self.warmup < 0 or input_period < 0:
-            raise CablelabError(f"{name}: parameters rate > 0, duration >= 0, warmup >= 0 and "
-                                "input_period >= 0 expected")
+        v = self.declare_params(LOOP_PARAMETERS)
+        self.rate = v.rate
+        self.duration = v.duration
+        self.warmup = v.warmup
+        self.publish_thread = v.publish_thread
+        input_period = v.input_period
         self.take_every = max(1, int(round(input_period * self.rate)))
         self.loop: ControlLoop | None = None
         self.done = False

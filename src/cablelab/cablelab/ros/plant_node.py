@@ -9,6 +9,7 @@ the node's own values, and the choice of executor (``fast_executor``, ``rt_prior
 from __future__ import annotations
 
 import time
+from types import SimpleNamespace
 
 from rclpy.duration import Duration
 from rclpy.node import Node
@@ -28,7 +29,8 @@ NO_WAIT = Duration(seconds=0)
 class PlantNode(Node):
     """Base of every plant node.
 
-    Subclasses call, in ``__init__``: :meth:`param` for their ROS parameters,
+    Subclasses call, in ``__init__``: :meth:`declare_params` with their parameter specs (the
+    module's ``PARAMETERS``, :mod:`cablelab.ros.params`),
     :meth:`listen_for_description` (estimators, controllers) or :meth:`publish_description`
     (simulators), and :meth:`start_diagnostics` last; they override :meth:`set_description`
     (what the law needs from the description) and :meth:`extend_status` (their own values).
@@ -44,47 +46,78 @@ class PlantNode(Node):
         self._desc_pub = None
 
     # ------------------------------------------------------------------ parameters
+    def declare_params(self, specs) -> SimpleNamespace:
+        """Declare the node's ROS parameters from their specs (:class:`~cablelab.ros.params.Param`)
+        with descriptors (description, range, read-only) and return the validated values as
+        attributes (``v.rate``). Each value (``-p name:=value``, a params file, else the default)
+        is checked before use (:meth:`Param.check <cablelab.ros.params.Param.check>`: integers
+        accepted where numbers are, range, array length, choices); a bad one raises a one-line
+        :class:`~cablelab.errors.CablelabError` naming the node, the parameter, the value and what
+        is allowed. Parameters already declared keep their value."""
+        overrides = getattr(self, "_parameter_overrides", {})   # rclpy: -p and --params-file values
+        values = {}
+        for spec in specs:
+            if self.has_parameter(spec.name):
+                values[spec.name] = self.get_parameter(spec.name).value
+                continue
+            raw = overrides[spec.name].value if spec.name in overrides else spec.default
+            value = spec.check(raw, f"{self.get_name()}")
+            # declared with the checked value itself (an int given for a double parameter is
+            # declared as the double it means, not refused by rclpy's type check)
+            self.declare_parameter(spec.name, value, spec.descriptor(), ignore_override=True)
+            values[spec.name] = value
+        return SimpleNamespace(**values)
+
+    def unknown_parameters(self) -> list[str]:
+        """Overridden parameter names this node never declared (typos: ``-p rat:=100``)."""
+        overrides = getattr(self, "_parameter_overrides", {})
+        return sorted(n for n in overrides if not self.has_parameter(n))
+
     def param(self, name: str, default):
-        """Declare a ROS parameter (once) and return its value."""
+        """A ROS parameter declared (once) from its default alone (type inferred, validated like
+        :meth:`declare_params`); prefer a :class:`~cablelab.ros.params.Param` spec."""
+        from .params import Param
+
         if self.has_parameter(name):
             return self.get_parameter(name).value
-        return self.declare_parameter(name, default).value
+        return getattr(self.declare_params((Param(name, default, "", read_only=False),)), name)
 
     def choice(self, name: str, default: str, allowed: tuple[str, ...]) -> str:
         """A text ROS parameter restricted to ``allowed`` (one-line error naming it otherwise)."""
-        value = str(self.param(name, default))
-        if value not in allowed:
-            raise CablelabError(f"{self.get_name()}: parameter {name}: expected "
-                                f"{' or '.join(repr(a) for a in allowed)}, got {value!r}")
-        return value
+        from .params import Param
+
+        return getattr(self.declare_params((Param(name, default, "", choices=tuple(allowed)),)), name)
 
     def use_fast_executor(self, default: bool = True) -> None:
         """Parameters ``fast_executor`` (spin with :class:`~cablelab.ros.fastspin.FastExecutor`),
         ``events_executor`` (spin with rclpy's C++ ``EventsExecutor`` instead, for comparison),
         ``rt_priority`` (SCHED_FIFO priority, 0 = off; needs the privilege), and the placement a
         deployment gives a 1 kHz loop without privileges: ``cpu_affinity`` (CPU numbers the
-        node's threads run on, [] = any), ``niceness`` (0-19: lower priority for a node off
+        node's threads run on, [-1] = any), ``niceness`` (0-19: lower priority for a node off
         the critical path), ``sched_idle`` (run in the SCHED_IDLE class: only on otherwise idle
         CPU, preempted at once, :func:`~cablelab.ros.fastspin.set_idle_class`) and ``sched_slice``
         (s, 0 = the kernel's default: a short EEVDF time slice for a node on the critical path,
-        :func:`~cablelab.ros.fastspin.set_latency_slice`)."""
+        :func:`~cablelab.ros.fastspin.set_latency_slice`). Their specs:
+        :func:`~cablelab.ros.params.executor_params`."""
         from .fastspin import (set_background, set_cpu_affinity, set_idle_class, set_latency_slice,
                                set_realtime_priority)
+        from .params import executor_params
 
-        self.fast = bool(self.param("fast_executor", default))
-        self.events = bool(self.param("events_executor", False))
-        cpus = [int(c) for c in self.param("cpu_affinity", [-1]) if int(c) >= 0]
+        v = self.declare_params(executor_params(default))
+        self.fast = bool(v.fast_executor)
+        self.events = bool(v.events_executor)
+        cpus = [int(c) for c in v.cpu_affinity if int(c) >= 0]
         if cpus:
             self.get_logger().info(f"cpu_affinity: {set_cpu_affinity(cpus)}")
-        nice = int(self.param("niceness", 0))
+        nice = int(v.niceness)
         if nice > 0:
             self.get_logger().info(f"niceness: {set_background(nice)}")
-        if bool(self.param("sched_idle", False)):
+        if bool(v.sched_idle):
             self.get_logger().info(f"sched_idle: {set_idle_class()}")
-        slice_s = float(self.param("sched_slice", 0.0))
+        slice_s = float(v.sched_slice)
         if slice_s > 0:
             self.get_logger().info(f"sched_slice: {set_latency_slice(slice_s)}")
-        rt = int(self.param("rt_priority", 0))
+        rt = int(v.rt_priority)
         if rt > 0:
             self.get_logger().info(f"rt_priority: {set_realtime_priority(rt)}")
 
@@ -130,7 +163,9 @@ class PlantNode(Node):
     def start_gate(self) -> None:
         """Parameter ``wait_for_subscribers`` (simulators): before time starts, wait (at most
         60 s) until the state topic has that many subscribers, see :meth:`waiting_for_subscribers`."""
-        self.wait_subs = int(self.param("wait_for_subscribers", 0))
+        from .params import START_GATE
+
+        self.wait_subs = int(self.declare_params(START_GATE).wait_for_subscribers)
         self.probe_sent: float | None = None
         self.created = time.monotonic()
 

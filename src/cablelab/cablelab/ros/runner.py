@@ -75,7 +75,19 @@ def run_node(node_factory, args, ros_args: list[str], prog: str) -> int:
     stop = _Stop()
     old = {s: signal.signal(s, stop) for s in (signal.SIGINT, signal.SIGTERM)}
     _tight_timers()
-    rclpy.init(args=[prog] + ros_args, signal_handler_options=SignalHandlerOptions.NO)
+    problem = mixed_lists(ros_args)
+    if problem:            # (rcl would refuse it too, after logging an error line of its own)
+        for s, h in old.items():
+            signal.signal(s, h)
+        print(f"{prog}: error: {problem}", file=sys.stderr)
+        return 2
+    try:
+        rclpy.init(args=[prog] + ros_args, signal_handler_options=SignalHandlerOptions.NO)
+    except Exception as exc:  # noqa: BLE001 - rcl's argument parser: one line, not a traceback
+        for s, h in old.items():
+            signal.signal(s, h)
+        print(f"{prog}: error: {ros_args_problem(exc)}", file=sys.stderr)
+        return 2
     node = None
     code = 0
     try:
@@ -84,6 +96,10 @@ def run_node(node_factory, args, ros_args: list[str], prog: str) -> int:
         except CablelabError as exc:
             print(f"{prog}: error: {exc}", file=sys.stderr)
             return 2
+        unknown = getattr(node, "unknown_parameters", None)
+        if callable(unknown) and unknown():
+            node.get_logger().warning(f"parameters this node does not have (ignored): {', '.join(unknown())}; "
+                                      f"{prog} --help lists its parameters")
         # what start-up built lives to the end: keep it out of the collector's scans, so that a
         # full collection in a 1 kHz callback costs microseconds, not milliseconds
         gc.collect()
@@ -118,6 +134,49 @@ def run_node(node_factory, args, ros_args: list[str], prog: str) -> int:
     return code
 
 
+def ros_args_problem(exc: Exception) -> str:
+    """rcl's complaint about ``--ros-args`` as one line (e.g. a list mixing integers and numbers,
+    which rcl refuses: ``-p com:=[0, 0.5]`` must be written ``[0.0, 0.5]``)."""
+    text = " ".join(str(exc).split())
+    for cut in (", at /", " at /"):
+        text = text.split(cut)[0]
+    text = text.replace("failed to initialize rcl: ", "")
+    hint = (" (write every element of a number list with a decimal point, e.g. [0.0, 0.5])"
+            if "same type" in text else "")
+    return f"bad --ros-args: {text}{hint}"
+
+
+def mixed_lists(ros_args: list[str]) -> str:
+    """The problem with a ``-p name:=[...]`` list mixing integers and numbers (rcl refuses such a
+    list: every element of a number list must be written with a decimal point), else ''."""
+    import yaml
+
+    for i, arg in enumerate(ros_args[:-1]):
+        if arg not in ("-p", "--param") or ":=" not in ros_args[i + 1]:
+            continue
+        name, _, text = ros_args[i + 1].partition(":=")
+        if not text.strip().startswith("["):
+            continue
+        try:
+            value = yaml.safe_load(text)
+        except yaml.YAMLError:
+            continue
+        kinds = {type(x) for x in value} if isinstance(value, list) else set()
+        if {int, float} <= kinds:
+            return (f"bad --ros-args: parameter {name}:={text}: a list mixing integers and numbers; "
+                    f"write every element with a decimal point, e.g. "
+                    f"[{', '.join(repr(float(x)) if isinstance(x, (int, float)) else str(x) for x in value)}]")
+    return ""
+
+
+def parameters_of(module, role: str) -> tuple:
+    """The parameter specs (:class:`~cablelab.ros.params.Param`) of a plant's node module for
+    ``role``: its ``PARAMETERS`` (a tuple, or a mapping role -> tuple for a one-module
+    ``nodes``)."""
+    specs = getattr(module, "PARAMETERS", ())
+    return tuple(specs.get(role, ())) if isinstance(specs, dict) else tuple(specs)
+
+
 #: node role of each node package (its executable is ``main(role)`` over the plant registry)
 ROLES = {"cable_sim_node": "sim", "payload_estimator": "estimator", "pd_feedforward": "controller"}
 
@@ -150,7 +209,8 @@ def node_module(plant: str, role: str):
             raise
     if role not in getattr(nodes, "ROLES", (role,)) or not hasattr(nodes, "make_node"):
         return None
-    adapter = types.SimpleNamespace(make_node=lambda args: nodes.make_node(role, args))
+    adapter = types.SimpleNamespace(make_node=lambda args: nodes.make_node(role, args),
+                                    PARAMETERS=parameters_of(nodes, role))
     if hasattr(nodes, "add_arguments"):
         adapter.add_arguments = lambda parser: nodes.add_arguments(role, parser)
     return adapter
@@ -169,13 +229,18 @@ def plant_main(package: str, role: str, argv: list[str] | None, description: str
     """``main`` of a node package: ``--plant P`` selects plant P's node for ``role``."""
     from ..registry import available_plants
 
+    from .params import help_text
+
     plants = available_plants()
     argv = list(sys.argv[1:] if argv is None else argv)
     user, ros_args = split_ros_args(argv)
+    if any(a in ("-h", "--help") for a in ros_args):     # --ros-args --help: the same help
+        user.append("--help")
+        ros_args = [a for a in ros_args if a not in ("-h", "--help")]
     parser = argparse.ArgumentParser(
-        prog=package, description=description,
-        epilog="ROS parameters: --ros-args -p name:=value, --params-file FILE.yaml. "
-               "Stops cleanly on SIGINT/SIGTERM.")
+        prog=package, description=description, formatter_class=argparse.RawDescriptionHelpFormatter,
+        epilog="ROS parameters: --ros-args -p name:=value, --params-file FILE.yaml "
+               "(with --plant P, --help lists P's). Stops cleanly on SIGINT/SIGTERM.")
     parser.add_argument("--plant", choices=plants, required=True, help="which plant")
     pre = argparse.ArgumentParser(add_help=False)
     pre.add_argument("--plant", choices=plants)
@@ -192,5 +257,10 @@ def plant_main(package: str, role: str, argv: list[str] | None, description: str
             return 2
         if module is not None and hasattr(module, "add_arguments"):
             module.add_arguments(parser)
+        specs = parameters_of(module, role) if module is not None else ()
+        if specs:
+            parser.epilog = (f"ROS parameters of {package} --plant {known.plant} (--ros-args -p "
+                             f"name:=value, or --params-file FILE.yaml):\n{help_text(specs)}\n\n"
+                             "Stops cleanly on SIGINT/SIGTERM.")
     args = parser.parse_args(user)
-    return run_node(module.make_node, args, ros_args, package)
+    return run_node(module.make_node, args, ros_args, f"{package} --plant {args.plant}")

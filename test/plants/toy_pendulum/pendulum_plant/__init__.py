@@ -17,7 +17,7 @@ import numpy as np
 
 from cablelab.conditioning import Conditioning, condition_motion
 from cablelab.dataset import Dataset
-from cablelab.description import _check_keys, _mapping, _number
+from cablelab.fields import check_keys, mapping, number
 from cablelab.effects import register
 from cablelab.effects.base import Effect, Param
 from cablelab.errors import CablelabError
@@ -36,10 +36,10 @@ class PendulumDescription:
 
 
 def parse_section(obj) -> PendulumDescription:
-    obj = _mapping(obj, "pendulum")
-    _check_keys(obj, "pendulum", ("mass", "length"), ())
-    return PendulumDescription(_number(obj, "mass", "pendulum", positive=True),
-                               _number(obj, "length", "pendulum", positive=True))
+    obj = mapping(obj, "pendulum")
+    check_keys(obj, "pendulum", ("mass", "length"), ())
+    return PendulumDescription(number(obj, "mass", "pendulum", positive=True),
+                               number(obj, "length", "pendulum", positive=True))
 
 
 def dataset(bag, description, options=None) -> Dataset:

@@ -4,7 +4,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from ...description import _check_keys, _fail, _mapping, _number
+from ...fields import check_keys, fail, mapping, number
 
 
 @dataclass(frozen=True)
@@ -18,13 +18,13 @@ class AxisDescription:
 
 def parse_section(obj: Any) -> AxisDescription:
     path = "axis"
-    obj = _mapping(obj, path)
-    _check_keys(obj, path, ("joint_type",), ("inertia", "gravity_moment"))
+    obj = mapping(obj, path)
+    check_keys(obj, path, ("joint_type",), ("inertia", "gravity_moment"))
     jt = obj["joint_type"]
     if jt not in ("revolute", "prismatic"):
-        raise _fail("axis.joint_type", f"expected 'revolute' or 'prismatic', got {jt!r}")
-    gm = _number(obj, "gravity_moment", path, default=0.0)
+        raise fail("axis.joint_type", f"expected 'revolute' or 'prismatic', got {jt!r}")
+    gm = number(obj, "gravity_moment", path, default=0.0)
     if jt == "prismatic" and gm:
-        raise _fail("axis.gravity_moment", "only applies to a revolute joint")
-    return AxisDescription(joint_type=jt, inertia=_number(obj, "inertia", path, positive=True),
+        raise fail("axis.gravity_moment", "only applies to a revolute joint")
+    return AxisDescription(joint_type=jt, inertia=number(obj, "inertia", path, positive=True),
                            gravity_moment=gm)

@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from ...description import _check_keys, _fail, _mapping, _number, _vector
+from ...fields import check_keys, fail, mapping, number, vector
 
 
 @dataclass(frozen=True)
@@ -47,27 +47,27 @@ class CdprDescription:
 
 def parse_section(obj: Any) -> CdprDescription:
     path = "cdpr"
-    obj = _mapping(obj, path)
-    _check_keys(obj, path, ("drum_radius", "gear_ratio", "cables"), ("platform_mass", "pulley_radius"))
+    obj = mapping(obj, path)
+    check_keys(obj, path, ("drum_radius", "gear_ratio", "cables"), ("platform_mass", "pulley_radius"))
     cables_raw = obj["cables"]
     if not isinstance(cables_raw, list) or not cables_raw:
-        raise _fail("cdpr.cables", "expected a non-empty list of cables")
+        raise fail("cdpr.cables", "expected a non-empty list of cables")
     cables = []
     for i, c in enumerate(cables_raw):
         cp = f"cdpr.cables[{i}]"
-        c = _mapping(c, cp)
-        _check_keys(c, cp, ("exit_point", "anchor_point"), ("swivel_axis",))
-        axis = _vector(c, "swivel_axis", cp, default=[0.0, 0.0, 1.0])
+        c = mapping(c, cp)
+        check_keys(c, cp, ("exit_point", "anchor_point"), ("swivel_axis",))
+        axis = vector(c, "swivel_axis", cp, default=[0.0, 0.0, 1.0])
         norm = float(np.linalg.norm(axis))
         if norm < 1e-9:
-            raise _fail(f"{cp}.swivel_axis", "must not be the zero vector")
-        cables.append(Cable(_vector(c, "exit_point", cp), _vector(c, "anchor_point", cp), axis / norm))
+            raise fail(f"{cp}.swivel_axis", "must not be the zero vector")
+        cables.append(Cable(vector(c, "exit_point", cp), vector(c, "anchor_point", cp), axis / norm))
     return CdprDescription(
-        drum_radius=_number(obj, "drum_radius", path, positive=True),
-        gear_ratio=_number(obj, "gear_ratio", path, positive=True),
+        drum_radius=number(obj, "drum_radius", path, positive=True),
+        gear_ratio=number(obj, "gear_ratio", path, positive=True),
         cables=tuple(cables),
-        platform_mass=_number(obj, "platform_mass", path, positive=True),
-        pulley_radius=_number(obj, "pulley_radius", path, nonneg=True, default=0.0),
+        platform_mass=number(obj, "platform_mass", path, positive=True),
+        pulley_radius=number(obj, "pulley_radius", path, nonneg=True, default=0.0),
     )
 
 

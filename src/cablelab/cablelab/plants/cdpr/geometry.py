@@ -65,22 +65,9 @@ def swivel_reference(axes: np.ndarray) -> np.ndarray:
     return ref / np.linalg.norm(ref, axis=-1, keepdims=True)
 
 
-def cable_geometry(exit_points: np.ndarray, anchor_points: np.ndarray, position: np.ndarray,
-                   rotation: np.ndarray | None = None, pulley_radius: float = 0.0,
-                   swivel_axes: np.ndarray | None = None) -> CableGeometry:
-    """Inverse geometric model of a CDPR, Model I (``pulley_radius == 0``) or Model II.
-
-    Args:
-        exit_points: (n, 3) A_i in world, m.
-        anchor_points: (n, 3) B_i in the platform frame, m.
-        position: (N, 3) or (3,) platform origin P in world, m.
-        rotation: (N, 3, 3) or (3, 3) platform -> world rotation; None = level platform.
-        pulley_radius: sheave radius r_p, m (001 eq. 6); 0 gives Model I (001 eq. 1-2).
-        swivel_axes: (n, 3) unit swivel axes; default +z.
-
-    Returns:
-        :class:`CableGeometry` (arrays with a leading sample axis N; N = 1 for a single pose).
-    """
+def _swivel_plane(exit_points, anchor_points, position, rotation, swivel_axes):
+    """Anchors in world and each cable's swivel plane: (A, B, R b, z, d = B - A, its part dz
+    along the swivel axis, the distance h normal to it, the in-plane unit x_p of 001 eq. 6)."""
     A = np.asarray(exit_points, dtype=float)
     b = np.asarray(anchor_points, dtype=float)
     p = np.atleast_2d(np.asarray(position, dtype=float))
@@ -99,6 +86,49 @@ def cable_geometry(exit_points: np.ndarray, anchor_points: np.ndarray, position:
     dh = d - dz[..., None] * z                               # part normal to the swivel axis
     h = np.sqrt(np.einsum("tni,tni->tn", dh, dh))
     xp = dh / np.maximum(h, 1e-12)[..., None]                # x_p of 001 eq. 6
+    return A, B, bw, z, d, dz, h, xp
+
+
+def check_pulley_radius(exit_points, anchor_points, position, rotation, pulley_radius: float,
+                        swivel_axes=None, where: str = "cdpr.pulley_radius") -> None:
+    """A sheave of radius r_p must leave every cable a tangent: the attachment point B_i must stay
+    farther than r_p from the sheave centre O_i = A_i + r_p x_p in every pose (else Model II has no
+    solution and every sample is lost). One-line :class:`~cablelab.errors.CablelabError` naming
+    the radius, the cable and the largest radius the poses allow otherwise."""
+    from ...errors import CablelabError
+
+    r = float(pulley_radius)
+    if r <= 0:
+        return
+    _, _, _, _, _, dz, h, _ = _swivel_plane(exit_points, anchor_points, position, rotation, swivel_axes)
+    # (h - r)^2 + dz^2 > r^2  <=>  r < (h^2 + dz^2) / (2 h): the largest radius of each pose
+    largest = (h * h + dz * dz) / np.maximum(2.0 * h, 1e-300)
+    if np.all(r < largest):
+        return
+    k, i = np.unravel_index(int(np.argmin(largest)), largest.shape)
+    hint = f"; these poses allow at most {float(largest[k, i]):.3g} m"
+    raise CablelabError(f"{where}: {r:g} m is larger than the geometry allows: cable {i + 1}'s "
+                        f"attachment comes within {float(np.hypot(h[k, i] - r, dz[k, i])):.3g} m of its sheave centre "
+                        f"(sample {k}), so no cable leaves the sheave tangentially{hint}")
+
+
+def cable_geometry(exit_points: np.ndarray, anchor_points: np.ndarray, position: np.ndarray,
+                   rotation: np.ndarray | None = None, pulley_radius: float = 0.0,
+                   swivel_axes: np.ndarray | None = None) -> CableGeometry:
+    """Inverse geometric model of a CDPR, Model I (``pulley_radius == 0``) or Model II.
+
+    Args:
+        exit_points: (n, 3) A_i in world, m.
+        anchor_points: (n, 3) B_i in the platform frame, m.
+        position: (N, 3) or (3,) platform origin P in world, m.
+        rotation: (N, 3, 3) or (3, 3) platform -> world rotation; None = level platform.
+        pulley_radius: sheave radius r_p, m (001 eq. 6); 0 gives Model I (001 eq. 1-2).
+        swivel_axes: (n, 3) unit swivel axes; default +z.
+
+    Returns:
+        :class:`CableGeometry` (arrays with a leading sample axis N; N = 1 for a single pose).
+    """
+    A, B, bw, z, d, dz, h, xp = _swivel_plane(exit_points, anchor_points, position, rotation, swivel_axes)
     ref = swivel_reference(z)
     swivel = np.arctan2(np.einsum("tni,ni->tn", xp, cross(z, ref)), np.einsum("tni,ni->tn", xp, ref))
     r = float(pulley_radius)

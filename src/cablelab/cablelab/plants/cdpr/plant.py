@@ -23,7 +23,7 @@ from ...rotations import quat_to_matrix, xyzw_to_wxyz
 from ...registry import Plant, register_plant
 from .description import dump_section, parse_section
 from .estimation import mass_com, mass_com_batch
-from .geometry import cable_geometry, wrench_matrix
+from .geometry import cable_geometry, check_pulley_radius, wrench_matrix
 
 JOINT_STATE = "sensor_msgs/msg/JointState"
 TENSIONS = "/cdpr/cable_tensions"
@@ -228,6 +228,7 @@ def dataset_from_arrays(arr: CdprArrays, description, source: str = "data",
     k = max(1, int(decimate))
     sl = slice(None, None, k)
     pos, R = arr.position[sl], None if arr.R is None else arr.R[sl]
+    check_pulley_radius(c.exit_points, c.anchor_points, pos, R, c.pulley_radius, c.swivel_axes)
     geom = cable_geometry(c.exit_points, c.anchor_points, pos, R, 0.0, c.swivel_axes)
     W = wrench_matrix(geom)
     t = arr.tensions[sl]
@@ -401,6 +402,8 @@ def estimate_arrays(arr: CdprArrays, description, effects=(), params: dict | Non
     if "tension_sensor_offset" in effs:
         t = t - np.array([params.get(f"b[{w}]", 0.0) for w in names])
     r = params.get("r_p", 0.0) if "pulley_geometry" in effs else 0.0
+    check_pulley_radius(c.exit_points, c.anchor_points, arr.position, arr.R, r, c.swivel_axes,
+                        "r_p (pulley_geometry)" if r != c.pulley_radius else "cdpr.pulley_radius")
     if arr.R is None and "platform_inertia" not in effs:      # level and static: fast kernel
         est = mass_com_batch(c.exit_points, c.anchor_points, arr.position, t, r,
                              description.gravity, c.swivel_axes)

@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from ...description import _check_keys, _mapping, _number
+from ...fields import check_keys, mapping, number
 
 
 @dataclass(frozen=True)
@@ -26,17 +26,17 @@ class CraneDescription:
 
 def parse_section(obj: Any) -> CraneDescription:
     path = "crane"
-    obj = _mapping(obj, path)
-    _check_keys(obj, path, ("boom_length",), ("payload_mass", "boom_mass", "counterbalance"))
+    obj = mapping(obj, path)
+    check_keys(obj, path, ("boom_length",), ("payload_mass", "boom_mass", "counterbalance"))
     cb = None
     if obj.get("counterbalance") is not None:
-        cbo = _mapping(obj["counterbalance"], "crane.counterbalance")
-        _check_keys(cbo, "crane.counterbalance", ("mass", "distance"), ())
-        cb = Counterbalance(_number(cbo, "mass", "crane.counterbalance", nonneg=True),
-                            _number(cbo, "distance", "crane.counterbalance", nonneg=True))
+        cbo = mapping(obj["counterbalance"], "crane.counterbalance")
+        check_keys(cbo, "crane.counterbalance", ("mass", "distance"), ())
+        cb = Counterbalance(number(cbo, "mass", "crane.counterbalance", nonneg=True),
+                            number(cbo, "distance", "crane.counterbalance", nonneg=True))
     return CraneDescription(
-        boom_length=_number(obj, "boom_length", path, positive=True),
-        payload_mass=_number(obj, "payload_mass", path, positive=True),
-        boom_mass=_number(obj, "boom_mass", path, nonneg=True),
+        boom_length=number(obj, "boom_length", path, positive=True),
+        payload_mass=number(obj, "payload_mass", path, positive=True),
+        boom_mass=number(obj, "boom_mass", path, nonneg=True),
         counterbalance=cb,
     )

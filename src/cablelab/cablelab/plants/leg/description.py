@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ...description import _check_keys, _fail, _mapping, _number
+from ...fields import check_keys, fail, mapping, number
 from .hybrid import LegParams
 
 REQUIRED = ("spring_stiffness", "link_length")
@@ -37,23 +37,23 @@ class LegDescription:
 def parse_section(obj) -> LegDescription:
     """Validate the ``leg:`` mapping (required: spring_stiffness, link_length)."""
     path = "leg"
-    obj = _mapping(obj, path)
-    _check_keys(obj, path, REQUIRED, OPTIONAL)
-    L = _number(obj, "link_length", path, positive=True)
-    theta0 = _number(obj, "free_angle", path, positive=True, default=0.349066)
+    obj = mapping(obj, path)
+    check_keys(obj, path, REQUIRED, OPTIONAL)
+    L = number(obj, "link_length", path, positive=True)
+    theta0 = number(obj, "free_angle", path, positive=True, default=0.349066)
     if theta0 >= 1.5707963:
-        raise _fail("leg.free_angle", f"expected an angle below pi/2 rad, got {theta0:g}")
-    rest = _number(obj, "spring_rest", path, positive=True)
+        raise fail("leg.free_angle", f"expected an angle below pi/2 rad, got {theta0:g}")
+    rest = number(obj, "spring_rest", path, positive=True)
     if rest is not None and rest >= 2 * L:
-        raise _fail("leg.spring_rest", f"expected a height below the fully extended leg 2 L = {2 * L:g} m, got {rest:g}")
+        raise fail("leg.spring_rest", f"expected a height below the fully extended leg 2 L = {2 * L:g} m, got {rest:g}")
     return LegDescription(
-        spring_stiffness=_number(obj, "spring_stiffness", path, positive=True),
+        spring_stiffness=number(obj, "spring_stiffness", path, positive=True),
         link_length=L,
-        mass=_number(obj, "mass", path, positive=True, default=1.55),
+        mass=number(obj, "mass", path, positive=True, default=1.55),
         free_angle=theta0,
         spring_rest=rest,
-        spring_preload=_number(obj, "spring_preload", path, nonneg=True, default=0.0),
-        encoder_resolution=_number(obj, "encoder_resolution", path, nonneg=True, default=9.0e-5),
+        spring_preload=number(obj, "spring_preload", path, nonneg=True, default=0.0),
+        encoder_resolution=number(obj, "encoder_resolution", path, nonneg=True, default=9.0e-5),
     )
 
 

@@ -4,14 +4,13 @@
 * ``sim``: steps the hybrid plant at ``rate`` (default 1 kHz) with the latest
   ``/leg/effort_commands`` torque (stale -> 0), publishes ``/leg/joint_states`` (``body``: encoder
   height, backward-difference velocity, F_in; ``motor``: theta, 0, torque), ``/leg/contact``,
-  ``/leg/ground_truth/state``, ``/clock``, ``/plant_description``. Parameters ``description``,
-  ``mass_scale`` (truth mass / nominal), ``preload`` (truth F_0, N), ``z0_offset`` (start height
-  above z_td, m), ``rate``.
+  ``/leg/ground_truth/state``, ``/clock``, ``/plant_description``.
 * ``estimator``: ``/leg/joint_states`` (+ ``/leg/contact`` when present) -> ``/leg/hop_estimate``;
   /diagnostics reports the phase source, chattering flips, switch/height disagreements, dropouts.
 * ``controller``: ``/leg/hop_estimate`` (+ ``/leg/reference`` apex height) ->
-  ``/leg/effort_commands``; ``mode`` ``apex`` (default) or ``open_loop``, ``T``, ``P``, ``k_i``,
-  ``k_ff``, ``T_max``, ``h_des`` (m above z_td when no reference arrived).
+  ``/leg/effort_commands``.
+
+ROS parameters of each role: :data:`PARAMETERS` (``cable_sim_node --plant leg --help``, ...).
 """
 from __future__ import annotations
 
@@ -26,6 +25,7 @@ from trajectory_msgs.msg import JointTrajectory
 from ...description import load_description
 from ...ros import convert
 from ...ros.clock import ClockPublisher
+from ...ros.params import Param
 from ...ros.plant_node import PlantNode
 from ...ros.qos import publisher_qos, stream_qos
 from .controller import ApexController
@@ -35,6 +35,40 @@ from .hybrid import STANCE
 from .sim import LegSim
 
 DEFAULT_DESCRIPTION_FILE = "data/leg.yaml"
+
+
+_DESCRIPTION = Param("description", "", "plant description: YAML file or text (empty = the "
+                     "package's data/leg.yaml)")
+PARAMETERS = {
+    "sim": (
+        _DESCRIPTION,
+        Param("mass_scale", 1.0, "true mass / the description's mass", gt=0.0, le=100.0),
+        Param("preload", float("nan"), "true spring preload F_0 (NaN = the description's)", "N",
+              ge=-1e5, le=1e5, nan=True),
+        Param("z0_offset", 0.03, "start height above touch-down height z_td", "m", ge=0.0, le=10.0),
+        Param("rate", 1000.0, "simulation and publishing rate", "Hz", ge=1.0, le=100000.0),
+        Param("command_timeout", 0.5, "a torque command older than this means zero torque",
+              "s wall", gt=0.0),
+    ),
+    "estimator": (
+        _DESCRIPTION,
+        Param("h", 0.5e-3, "height hysteresis of the phase detection", "m", ge=0.0, le=1.0),
+        Param("f_on", 1.0, "ground reaction force above which stance starts without a contact switch",
+              "N", ge=0.0, le=1e5),
+    ),
+    "controller": (
+        _DESCRIPTION,
+        Param("h_des", 0.016, "desired apex height above z_td until a /leg/reference arrives", "m",
+              ge=0.0, le=10.0),
+        Param("T", 1.0, "initial stance torque", "N m", ge=0.0, le=1e4),
+        Param("P", 0.30, "stance torque duration", "s", gt=0.0, le=10.0),
+        Param("k_i", 10.0, "integral gain on the apex-height error", "N m/m", ge=0.0, le=1e6),
+        Param("k_ff", 0.5, "feedforward fraction of the model-based Newton step", ge=0.0, le=10.0),
+        Param("T_max", 4.0, "largest stance torque", "N m", gt=0.0, le=1e4),
+        Param("mode", "apex", "apex-height control or a constant open-loop torque",
+              choices=("apex", "open_loop")),
+    ),
+}
 
 
 def _description(text: str):
@@ -48,18 +82,18 @@ def _description(text: str):
 class LegSimNode(PlantNode):
     def __init__(self):
         super().__init__("cable_sim_node")
-        p = self.declare_parameter
-        self.description = _description(p("description", "").value)
+        v = self.declare_params(PARAMETERS["sim"])
+        self.description = _description(v.description)
         leg = leg_of(self.description)
         nominal = leg.params(self.description.gravity)
-        truth = nominal.replace(m=nominal.m * float(p("mass_scale", 1.0).value),
-                                F0=float(p("preload", nominal.F0).value))
+        truth = nominal.replace(m=nominal.m * v.mass_scale,
+                                F0=nominal.F0 if math.isnan(v.preload) else v.preload)
         self.res = leg.encoder_resolution
-        self.rate = float(p("rate", 1000.0).value)
-        self.sim = LegSim(truth, nominal.z_td + float(p("z0_offset", 0.03).value), 0.0, dt=1.0 / self.rate)
+        self.rate = v.rate
+        self.sim = LegSim(truth, nominal.z_td + v.z0_offset, 0.0, dt=1.0 / self.rate)
         self.tau = 0.0
         self._z_prev = None
-        self.inputs.add("effort_commands", timeout=float(p("command_timeout", 0.5).value), length=1,
+        self.inputs.add("effort_commands", timeout=v.command_timeout, length=1,
                         required=False)
         self.pub_js = self.create_publisher(JointState, "/leg/joint_states", publisher_qos())
         self.pub_contact = self.create_publisher(JointState, "/leg/contact", publisher_qos())
@@ -104,10 +138,10 @@ class LegSimNode(PlantNode):
 class LegEstimatorNode(PlantNode):
     def __init__(self):
         super().__init__("payload_estimator")
-        p = self.declare_parameter
-        self.description = _description(p("description", "").value)
+        v = self.declare_params(PARAMETERS["estimator"])
+        self.description = _description(v.description)
         params = leg_of(self.description).params(self.description.gravity)
-        self.est = HopEstimator(params, h=float(p("h", 0.5e-3).value), f_on=float(p("f_on", 1.0).value))
+        self.est = HopEstimator(params, h=v.h, f_on=v.f_on)
         self.contact = None
         self.t_contact = -math.inf
         self.inputs.add("joint_states", timeout=0.5)
@@ -149,13 +183,11 @@ class LegEstimatorNode(PlantNode):
 class LegControllerNode(PlantNode):
     def __init__(self):
         super().__init__("pd_feedforward")
-        p = self.declare_parameter
-        self.description = _description(p("description", "").value)
+        v = self.declare_params(PARAMETERS["controller"])
+        self.description = _description(v.description)
         params = leg_of(self.description).params(self.description.gravity)
-        self.ctl = ApexController(params, params.z_td + float(p("h_des", 0.016).value),
-                                  T=float(p("T", 1.0).value), P=float(p("P", 0.30).value),
-                                  k_i=float(p("k_i", 10.0).value), k_ff=float(p("k_ff", 0.5).value),
-                                  T_max=float(p("T_max", 4.0).value), mode=str(p("mode", "apex").value))
+        self.ctl = ApexController(params, params.z_td + v.h_des, T=v.T, P=v.P, k_i=v.k_i, k_ff=v.k_ff,
+                                  T_max=v.T_max, mode=v.mode)
         self.last_apex = math.nan
         self.inputs.add("hop_estimate", timeout=0.5)
         self.inputs.add("reference", timeout=math.inf, length=1, required=False)

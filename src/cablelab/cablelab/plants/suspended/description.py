@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...description import _check_keys, _fail, _mapping, _number, _vector
+from ...fields import check_keys, fail, mapping, number, vector
 from .params import VARIANTS, VirtualParams, parameter_set
 
 __all__ = ["SuspendedDescription", "parse_section", "KEYS"]
@@ -56,31 +56,31 @@ def parse_section(obj, path: str = "suspended") -> SuspendedDescription:
         CablelabError: unknown key or variant, negative length/mass, inconsistent inertia (one
             line naming the key).
     """
-    obj = _mapping(obj, path)
-    _check_keys(obj, path, ("variant",), KEYS[1:])
+    obj = mapping(obj, path)
+    check_keys(obj, path, ("variant",), KEYS[1:])
     variant = obj["variant"]
     if variant not in VARIANTS:
-        raise _fail(f"{path}.variant", f"unknown variant {variant!r} (expected one of {', '.join(VARIANTS)})")
+        raise fail(f"{path}.variant", f"unknown variant {variant!r} (expected one of {', '.join(VARIANTS)})")
     pset = obj.get("parameter_set", "repo")
     if pset not in ("repo", "table5"):
-        raise _fail(f"{path}.parameter_set", f"unknown parameter set {pset!r} (expected repo or table5)")
+        raise fail(f"{path}.parameter_set", f"unknown parameter set {pset!r} (expected repo or table5)")
     nominal = parameter_set(variant, "repo")
-    L = _number(obj, "cable_length", path, positive=True, default=nominal.L)
-    S = _vector(obj, "suspension_point", path, default=nominal.S)
-    sep = _number(obj, "cable_separation", path, positive=True)
-    mp = _number(obj, "platform_mass", path, positive=True)
-    com = _vector(obj, "platform_com", path, default=nominal.c_plat)
-    payload = _number(obj, "payload_mass", path, nonneg=True, default=0.0)
+    L = number(obj, "cable_length", path, positive=True, default=nominal.L)
+    S = vector(obj, "suspension_point", path, default=nominal.S)
+    sep = number(obj, "cable_separation", path, positive=True)
+    mp = number(obj, "platform_mass", path, positive=True)
+    com = vector(obj, "platform_com", path, default=nominal.c_plat)
+    payload = number(obj, "payload_mass", path, nonneg=True, default=0.0)
     mount_default = [nominal.arm_mount, tuple(np.array(nominal.arm_mount) * [1, -1, 1])]
     mounts = obj.get("arm_mount", mount_default)
     if not isinstance(mounts, (list, tuple)) or len(mounts) != 2:
-        raise _fail(f"{path}.arm_mount", f"expected two 3-vectors (left, right), got {mounts!r}")
-    arm_mount = np.stack([_vector({"m": m}, "m", f"{path}.arm_mount[{i}]") for i, m in enumerate(mounts)])
+        raise fail(f"{path}.arm_mount", f"expected two 3-vectors (left, right), got {mounts!r}")
+    arm_mount = np.stack([vector({"m": m}, "m", f"{path}.arm_mount[{i}]") for i, m in enumerate(mounts)])
     inertia = None
     if "platform_inertia" in obj:
-        inertia = _vector(obj, "platform_inertia", path)
+        inertia = vector(obj, "platform_inertia", path)
         a, b, c = inertia
         if min(inertia) <= 0 or a + b < c or a + c < b or b + c < a:
-            raise _fail(f"{path}.platform_inertia", f"inconsistent principal inertia {list(map(float, inertia))} "
+            raise fail(f"{path}.platform_inertia", f"inconsistent principal inertia {list(map(float, inertia))} "
                         "kg m^2 (each must be > 0 and A + B >= C, spec D8)")
     return SuspendedDescription(variant, float(L), S, sep, mp, com, arm_mount, float(payload), pset, inertia)

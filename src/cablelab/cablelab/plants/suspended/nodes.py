@@ -6,18 +6,14 @@
   (spec 5.2): yaw from its orientation and yaw rate from its gyro for poses within
   ``imu_max_lag`` s (stamps) of an IMU sample, else from the pose; a stale (``imu_timeout`` s
   wall) or NaN IMU is reported on /diagnostics once the IMU has been seen. NaN, wrong-length and frozen-stamp
-  poses are held and counted on /diagnostics. ROS parameters: ``suspension_point`` [x, y, z] m
-  (default: the LiCAS repo set), ``rest_position`` [x, y, z] m and ``rest_yaw`` rad (default NaN:
-  the mean over the first ``rest_window`` s), ``velocity_tau`` s, ``pose_timeout`` s wall.
+  poses are held and counted on /diagnostics.
 * ``sim`` (``cable_sim_node --plant suspended``): the virtual-joint model (``model:=virtual``)
   or the truth plant (``model:=truth``) of ``variant`` in real time; arm position servos follow
   ``/suspended/reference`` (JointTrajectory, arm joint names; unknown names / wrong lengths are
   rejected and counted). Publishes ``/suspended/joint_states`` (effort = servo torque),
   ``/suspended/platform_pose`` (``pose_noise`` m), ``/suspended/ground_truth/swing``,
   ``/suspended/ground_truth/virtual_joints`` (virtual model), ``/clock``,
-  ``/plant_description``. ROS parameters: ``variant``, ``model``, ``rate`` Hz,
-  ``start_swing_x``, ``start_swing_y``, ``start_yaw`` rad, ``pose_noise`` m.
-  ``arm_input:=effort``: torque motors driven by ``/suspended/effort_commands`` instead (a
+  ``/plant_description``. ``arm_input:=effort``: torque motors driven by ``/suspended/effort_commands`` instead (a
   stale command, older than ``command_timeout`` s wall, means zero torque and WARN).
   ``lockstep`` (default false; needs ``arm_input:=effort``): after publishing a state the
   simulation waits for the command answering it and advances one period (``rate``) as soon as
@@ -26,19 +22,15 @@
   resent every ``lockstep_resend`` s while waiting; ``lockstep_timeout`` s without an answer:
   real time with zero torque until commands flow again). Use ``rate:=1000`` (one physics step
   per command): the LiCAS joint-3 loop (k_d / I ~ 1000 1/s) is unstable with a 10 ms hold.
-  ``wait_for_subscribers`` (time starts when ``/suspended/joint_states`` has that many
-  subscribers), ``duration`` s (sim time; the node exits when reached, 0 = run for ever),
-  ``imu`` (default true: ``/suspended/imu``, the platform's orientation, gyro and accelerometer
-  in the platform frame).
 * ``controller`` (``pd_feedforward --plant suspended``): on each ``/suspended/joint_states``
   publishes ``/suspended/effort_commands`` = :func:`~.controller.pd_gravity` with the gravity
   under the attitude of ``/suspended/platform_pose``; reference from ``/suspended/reference``
-  plus the built-in ``excitation`` (none | x | y | z, ``excitation_level`` 0..2, 000 Fig. 7) and
-  ``sway_damping`` k_s (r_y rate of ``/suspended/swing_estimate``; older than
-  ``estimate_stale`` s = off). Parameters: ``variant``, ``pose_sync`` (default false; true with
-  a simulator: a joint state is answered only once the pose of the same stamp arrived, so the
-  gravity term uses the attitude of that instant however DDS orders the two topics; while
-  poses do not flow, at once).
+  plus the built-in ``excitation`` (000 Fig. 7) and ``sway_damping`` k_s (r_y rate of
+  ``/suspended/swing_estimate``). ``pose_sync``: a joint state is answered only once the pose of
+  the same stamp arrived, so the gravity term uses the attitude of that instant however DDS
+  orders the two topics.
+
+ROS parameters of each role: :data:`PARAMETERS` (``cable_sim_node --plant suspended --help``, ...).
 """
 from __future__ import annotations
 
@@ -46,12 +38,71 @@ import math
 import time
 
 from ...errors import CablelabError
-from .params import parameter_set
+from ...ros.params import START_GATE, Param, executor_params, merge
+from .params import VARIANTS, parameter_set
 from .swing import CHANNELS, SwingEstimator
 
-__all__ = ["make_node", "add_arguments", "ROLES"]
+__all__ = ["make_node", "add_arguments", "ROLES", "PARAMETERS"]
 
 ROLES = ("estimator", "sim", "controller")
+
+_VARIANT = Param("variant", "licas", "which platform: LiCAS or CRANEbot", choices=VARIANTS)
+PARAMETERS = {
+    "estimator": merge((
+        Param("suspension_point", [float(x) for x in parameter_set("licas").S], "suspension point "
+              "S [x, y, z] (default: the LiCAS repo set)", "m", length=(3,), ge=-1e3, le=1e3),
+        Param("rest_position", [float("nan")] * 3, "rest position [x, y, z] (NaN: the mean over the "
+              "first rest_window s)", "m", length=(3,), ge=-1e3, le=1e3, nan=True),
+        Param("rest_yaw", float("nan"), "rest yaw (NaN: the mean over the first rest_window s)", "rad",
+              ge=-10.0, le=10.0, nan=True),
+        Param("rest_window", 2.0, "time the rest pose is averaged over", "s", gt=0.0, le=3600.0),
+        Param("imu_max_lag", 0.05, "yaw and yaw rate come from the IMU for poses within this of an "
+              "IMU sample (stamps)", "s", ge=0.0, le=10.0),
+        Param("velocity_tau", 0.05, "time constant smoothing the swing rates", "s", gt=0.0, le=10.0),
+        Param("pose_timeout", 0.5, "a pose older than this is stale", "s wall", gt=0.0),
+        Param("imu_timeout", 0.5, "an IMU sample older than this is stale (once the IMU was seen)",
+              "s wall", gt=0.0),
+    ), executor_params(True)),
+    "sim": merge((
+        _VARIANT,
+        Param("model", "virtual", "the virtual-joint model or the four-tendon truth plant",
+              choices=("virtual", "truth")),
+        Param("start_swing_x", 0.0, "initial swing about x", "rad", ge=-1.5, le=1.5),
+        Param("start_swing_y", 0.0, "initial swing about y", "rad", ge=-1.5, le=1.5),
+        Param("start_yaw", 0.0, "initial yaw", "rad", ge=-3.2, le=3.2),
+        Param("arm_input", "reference", "arm drives: position servos following /suspended/reference "
+              "or torque motors driven by /suspended/effort_commands", choices=("reference", "effort")),
+        Param("pose_noise", 0.0, "standard deviation of the measured platform position", "m",
+              ge=0.0, le=10.0),
+        Param("rate", 100.0, "publishing rate = command sampling (use 1000 with arm_input effort)",
+              "Hz", ge=1.0, le=10000.0),
+        Param("duration", 0.0, "simulated time after which the node exits (0 = run for ever)", "s",
+              ge=0.0),
+        Param("lockstep", False, "after a state, wait for the command answering it (needs "
+              "arm_input effort)"),
+        Param("lockstep_timeout", 10.0, "lock-step: without an answer for this long, real time with "
+              "zero torque until commands flow again", "s wall", gt=0.0),
+        Param("lockstep_resend", 0.25, "lock-step: the state is resent this often while waiting",
+              "s wall", gt=0.0, le=60.0),
+        Param("command_timeout", 0.5, "an effort command older than this means zero torque (WARN)",
+              "s wall", gt=0.0),
+        Param("imu", True, "publish /suspended/imu (orientation, gyro, accelerometer in the "
+              "platform frame)"),
+    ), START_GATE, executor_params(True)),
+    "controller": merge((
+        _VARIANT,
+        Param("excitation", "none", "built-in excitation of 000 Fig. 7 added to the reference",
+              choices=("none", "x", "y", "z"),
+              convert=lambda v: "y" if v is True else v),     # (YAML reads a bare y as true)
+        Param("excitation_level", 1, "level of the built-in excitation", ge=0, le=2),
+        Param("sway_damping", 0.0, "sway damping gain k_s on the r_y rate of /suspended/swing_estimate",
+              ge=0.0, le=1e3),
+        Param("estimate_stale", 0.2, "a swing estimate older than this (stamps) turns sway damping "
+              "off", "s", gt=0.0),
+        Param("pose_sync", False, "answer a joint state only once the pose of the same stamp "
+              "arrived (while poses flow)"),
+    ), executor_params(True)),
+}
 
 
 def _estimator_class():
@@ -67,21 +118,16 @@ def _estimator_class():
     class SuspendedSwingEstimator(PlantNode):
         def __init__(self):
             super().__init__("payload_estimator")
-            p = self.declare_parameter
-            S = [float(v) for v in p("suspension_point", list(parameter_set("licas").S)).value]
-            rest = [float(v) for v in p("rest_position", [float("nan")] * 3).value]
-            rest_yaw = float(p("rest_yaw", float("nan")).value)
-            if len(rest) != 3:
-                raise CablelabError(f"payload_estimator suspended: parameter rest_position={rest!r} "
-                                    "(expected [x, y, z] m)")
-            self.est = SwingEstimator(S, rest_window=float(p("rest_window", 2.0).value),
-                                      imu_max_lag=float(p("imu_max_lag", 0.05).value),
+            v = self.declare_params(PARAMETERS["estimator"])
+            rest, rest_yaw = v.rest_position, v.rest_yaw
+            self.est = SwingEstimator(v.suspension_point, rest_window=v.rest_window,
+                                      imu_max_lag=v.imu_max_lag,
                                       rest_pos=rest if all(map(math.isfinite, rest)) else None,
                                       rest_yaw=rest_yaw if math.isfinite(rest_yaw) else None,
-                                      velocity_tau=float(p("velocity_tau", 0.05).value))
+                                      velocity_tau=v.velocity_tau)
             self.use_fast_executor()
-            self.inputs.add("platform_pose", timeout=float(p("pose_timeout", 0.5).value), length=3)
-            self.imu_timeout = float(p("imu_timeout", 0.5).value)
+            self.inputs.add("platform_pose", timeout=v.pose_timeout, length=3)
+            self.imu_timeout = v.imu_timeout
             self.imu_used = 0            # estimates whose yaw came from the IMU
             self.rejected = 0
             self.last_problem = ""
@@ -148,16 +194,13 @@ def _sim_class():
     class SuspendedSimNode(PlantNode):
         def __init__(self):
             super().__init__("cable_sim_node")
-            p = self.declare_parameter
-            variant = str(p("variant", "licas").value)
-            self.kind = str(p("model", "virtual").value)
+            v = self.declare_params(PARAMETERS["sim"])
+            variant = v.variant
+            self.kind = v.model
             self.description = load_description(description_yaml(variant, name=f"simulated {variant}"))
             self.params = parameter_set(variant)
-            sx, sy, yw = (float(p(k, 0.0).value) for k in ("start_swing_x", "start_swing_y", "start_yaw"))
-            self.arm_input = str(p("arm_input", "reference").value)
-            if self.arm_input not in ("reference", "effort"):
-                raise CablelabError(f"cable_sim_node suspended: parameter arm_input={self.arm_input!r} "
-                                    "(expected reference or effort)")
+            sx, sy, yw = v.start_swing_x, v.start_swing_y, v.start_yaw
+            self.arm_input = v.arm_input
             motors = self.arm_input == "effort"
             if self.kind == "truth":
                 self.model = build_truth(self.params, arm_motors=motors)
@@ -169,8 +212,7 @@ def _sim_class():
                     q0.update({"J11": -sx, "J12": -sy})
                 x0 = initial_state(self.model, q0)
             else:
-                raise CablelabError(f"cable_sim_node suspended: parameter model={self.kind!r} "
-                                    "(expected virtual or truth)")
+                raise AssertionError(self.kind)       # (choices of the model parameter)
             self.data = mujoco.MjData(self.model)
             mujoco.mj_setState(self.model, self.data, x0, STATE_SPEC)
             mujoco.mj_forward(self.model, self.data)
@@ -179,31 +221,30 @@ def _sim_class():
             self.jv = [self.model.joint(n).dofadr[0] for n in self.names]
             self.vq = ([self.model.joint(j).qposadr[0] for j in VJ] if self.kind == "virtual" else [])
             self.rest = np.array(self.params.S) - [0, 0, self.params.L]
-            self.noise = float(p("pose_noise", 0.0).value)
+            self.noise = v.pose_noise
             self.rng = np.random.default_rng(0)
-            self.rate = float(p("rate", 100.0).value)
+            self.rate = v.rate
             self.steps = max(1, int(round(1.0 / (self.rate * self.model.opt.timestep))))
-            self.duration = float(p("duration", 0.0).value)
+            self.duration = v.duration
             self.done = False
-            lockstep = bool(p("lockstep", False).value)
+            lockstep = v.lockstep
             if lockstep and not motors:
                 raise CablelabError("cable_sim_node suspended: parameter lockstep=true needs "
                                     "arm_input=effort (lock-step waits for effort commands)")
             self.lock = LockStep(lockstep, wait_first=True,
-                                 timeout=float(p("lockstep_timeout", 10.0).value),
-                                 resend=float(p("lockstep_resend", 0.25).value))
+                                 timeout=v.lockstep_timeout, resend=v.lockstep_resend)
             self.start_gate()
             self.use_fast_executor()
             self.site = self.model.site("platform").id
             self.inputs.add("reference", timeout=1e9, length=len(self.names))
-            self.inputs.add("effort_commands", timeout=float(p("command_timeout", 0.5).value),
+            self.inputs.add("effort_commands", timeout=v.command_timeout,
                             length=len(self.names))
             self.pub_js = self.create_publisher(JointState, "/suspended/joint_states", publisher_qos())
             self.pub_pose = self.create_publisher(PoseStamped, "/suspended/platform_pose", publisher_qos())
             self.pub_sw = self.create_publisher(JointState, "/suspended/ground_truth/swing", publisher_qos())
             self.pub_vj = self.create_publisher(JointState, "/suspended/ground_truth/virtual_joints", publisher_qos())
             self.pub_imu = (self.create_publisher(Imu, "/suspended/imu", publisher_qos())
-                            if bool(p("imu", True).value) else None)
+                            if v.imu else None)
             self.clock = ClockPublisher(self)
             self.publish_description(self.description)
             if motors:
@@ -312,24 +353,18 @@ def _controller_class():
     class SuspendedController(PlantNode):
         def __init__(self):
             super().__init__("pd_feedforward")
-            p = self.declare_parameter
-            self.params = parameter_set(str(p("variant", "licas").value))
+            v = self.declare_params(PARAMETERS["controller"])
+            self.params = parameter_set(v.variant)
             self.names = list(arm_joint_names(self.params))
             n = len(self.names)
             self.kp, self.kd, self.lim = gains(self.params)
             self.use_fast_executor()
             self.gravity = ArmGravity(self.params)
-            from rcl_interfaces.msg import ParameterDescriptor
-
-            exc = p("excitation", "none", ParameterDescriptor(dynamic_typing=True)).value
-            self.excitation = "y" if exc is True else str(exc)    # (YAML reads a bare y as true)
-            if self.excitation not in ("none", "x", "y", "z"):
-                raise CablelabError(f"pd_feedforward suspended: parameter excitation={exc!r} "
-                                    "(expected none, x, y or z)")
-            self.level = int(p("excitation_level", 1).value)
-            self.k_s = float(p("sway_damping", 0.0).value)
-            self.stale = float(p("estimate_stale", 0.2).value)
-            self.pose_sync = bool(p("pose_sync", False).value)
+            self.excitation = v.excitation
+            self.level = v.excitation_level
+            self.k_s = v.sway_damping
+            self.stale = v.estimate_stale
+            self.pose_sync = v.pose_sync
             self.pose_t = -np.inf
             self.pending = None          # pose_sync: joint state waiting for its pose
             self.q_ref, self.qd_ref = np.zeros(n), np.zeros(n)

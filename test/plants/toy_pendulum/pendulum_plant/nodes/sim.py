@@ -3,9 +3,7 @@
 Publishes ``/pendulum/joint_states`` (hinge angle, rate, applied torque), ``/clock`` and
 ``/plant_description`` at ``rate`` Hz of simulated time, as fast as ``realtime_factor`` allows, and
 exits after ``duration`` s of simulated time. The measured torque carries white noise
-(``torque_noise``, N m), like a current-based torque estimate. ROS parameters: ``damping``
-(N m s/rad, the hidden effect), ``torque_noise``, ``seed``, ``rate``, ``duration``,
-``realtime_factor``, ``wait_for_subscribers``.
+(``torque_noise``, N m), like a current-based torque estimate. ROS parameters: :data:`PARAMETERS`.
 """
 from __future__ import annotations
 
@@ -18,6 +16,7 @@ from sensor_msgs.msg import JointState
 from cablelab.description import load_description
 from cablelab.ros import convert
 from cablelab.ros.clock import ClockPublisher
+from cablelab.ros.params import START_GATE, Param
 from cablelab.ros.plant_node import PlantNode
 from cablelab.ros.qos import publisher_qos
 
@@ -32,19 +31,30 @@ def mjcf(mass: float, length: float, damping: float) -> str:
   <actuator><motor joint="hinge" name="tau"/></actuator></mujoco>"""
 
 
+PARAMETERS = (
+    Param("description", "", "plant description: YAML file or text (empty = a 0.5 kg, 0.4 m pendulum)"),
+    Param("damping", 0.05, "hinge damping (the hidden effect)", "N m s/rad", ge=0.0, le=100.0),
+    Param("rate", 200.0, "publishing rate", "Hz", ge=1.0, le=1000.0),
+    Param("duration", 8.0, "simulated time after which the node exits", "s", gt=0.0, le=3600.0),
+    Param("realtime_factor", 4.0, "simulated seconds per wall second", gt=0.0, le=1000.0),
+    Param("torque_noise", 0.01, "standard deviation of the measured torque", "N m", ge=0.0, le=100.0),
+    Param("seed", 0, "seed of the noise generator", ge=0),
+) + START_GATE
+
+
 class PendulumSim(PlantNode):
     def __init__(self):
         super().__init__("cable_sim_node")
-        desc = load_description(self.param("description", "") or DESCRIPTION)
+        v = self.declare_params(PARAMETERS)
+        desc = load_description(v.description or DESCRIPTION)
         sec = desc.pendulum
-        self.model = mujoco.MjModel.from_xml_string(mjcf(sec.mass, sec.length,
-                                                         float(self.param("damping", 0.05))))
+        self.model = mujoco.MjModel.from_xml_string(mjcf(sec.mass, sec.length, v.damping))
         self.data = mujoco.MjData(self.model)
-        self.rate = float(self.param("rate", 200.0))
-        self.duration = float(self.param("duration", 8.0))
-        self.speed = float(self.param("realtime_factor", 4.0))
-        self.noise = float(self.param("torque_noise", 0.01))
-        self.rng = np.random.default_rng(int(self.param("seed", 0)))
+        self.rate = v.rate
+        self.duration = v.duration
+        self.speed = v.realtime_factor
+        self.noise = v.torque_noise
+        self.rng = np.random.default_rng(v.seed)
         self.steps = max(1, int(round(1.0 / (self.rate * self.model.opt.timestep))))
         self.done = False
         self.start_gate()

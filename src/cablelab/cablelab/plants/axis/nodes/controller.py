@@ -7,9 +7,7 @@ computes ``u = M_ff qdd_ref + Kp (q_ref - q) + Kd (qd_ref - qd)``
 topic``, default) or a built-in sine evaluated at the measurement stamp (``reference_source:
 sine``, also published on ``/axis/reference`` so recordings hold it).
 
-ROS parameters: ``kp`` (N/m), ``kd`` (N s/m), ``inertia`` (feedforward M_ff; default the
-description's ``axis.inertia`` from /plant_description, else 0), ``reference_source``,
-``amplitude``, ``frequency`` (Hz), ``offset``, ``reference_timeout`` (s wall).
+ROS parameters: :data:`PARAMETERS` (``pd_feedforward --plant axis --help``).
 
 Each command names the stamp of the state it answers (``layout.dim[0].label = 'joint stamp=<t>'``,
 :func:`cablelab.ros.convert.command_msg`): a lock-step simulator applies only the answer to its
@@ -26,25 +24,41 @@ from trajectory_msgs.msg import JointTrajectory
 
 from ..control import pd_feedforward, sine_reference
 from ....ros import convert
+from ....ros.params import Param
 from ....ros.plant_node import PlantNode
 from ....ros.qos import publisher_qos, stream_qos
+
+
+PARAMETERS = (
+    Param("kp", 400.0, "proportional gain", "N/m or N m/rad", ge=0.0, le=1e9),
+    Param("kd", 40.0, "derivative gain", "N s/m or N m s/rad", ge=0.0, le=1e9),
+    Param("inertia", float("nan"), "feedforward inertia M_ff (NaN = the description's axis.inertia "
+          "from /plant_description, else 0)", "kg or kg m^2", ge=0.0, le=1e6, nan=True),
+    Param("reference_source", "topic", "the reference: /axis/reference (topic) or a built-in sine "
+          "evaluated at the measurement stamp and published on /axis/reference (sine)",
+          choices=("topic", "sine")),
+    Param("amplitude", 0.2, "amplitude of the built-in sine", "m or rad", ge=0.0, le=1e3),
+    Param("frequency", 0.5, "frequency of the built-in sine", "Hz", gt=0.0, le=1e3),
+    Param("offset", 0.0, "offset of the built-in sine", "m or rad", ge=-1e3, le=1e3),
+    Param("reference_timeout", 0.5, "a reference older than this is stale", "s wall", gt=0.0),
+)
 
 
 class AxisController(PlantNode):
     def __init__(self):
         super().__init__("pd_feedforward")
-        p = self.param
-        self.kp = float(p("kp", 400.0))
-        self.kd = float(p("kd", 40.0))
-        self.inertia_param = float(p("inertia", float("nan")))
+        v = self.declare_params(PARAMETERS)
+        self.kp = v.kp
+        self.kd = v.kd
+        self.inertia_param = v.inertia
         self.inertia = 0.0 if np.isnan(self.inertia_param) else self.inertia_param
-        self.source = self.choice("reference_source", "topic", ("topic", "sine"))
-        self.amplitude = float(p("amplitude", 0.2))
-        self.frequency = float(p("frequency", 0.5))
-        self.offset = float(p("offset", 0.0))
+        self.source = v.reference_source
+        self.amplitude = v.amplitude
+        self.frequency = v.frequency
+        self.offset = v.offset
         self.ref = None  # (q, qd, qdd) from the topic
         self.inputs.add("joint_states", timeout=0.5, length=1)
-        self.inputs.add("reference", timeout=float(p("reference_timeout", 0.5)), length=1,
+        self.inputs.add("reference", timeout=v.reference_timeout, length=1,
                         required=self.source == "topic")
 
         self.pub_cmd = self.create_publisher(Float64MultiArray, "/axis/effort_command", publisher_qos())

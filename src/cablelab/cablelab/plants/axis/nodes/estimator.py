@@ -8,8 +8,7 @@ over the period ending there). A sample repeating the previous stamp is ignored.
 (std_msgs/Float64MultiArray ``[M, Fv, Fc, offset]``, an addition to the contract, see
 docs/nodes.md) every ``publish_every`` samples.
 
-ROS parameters: ``forgetting`` (lambda, default 1.0), ``publish_every`` (samples, default 20),
-``stiction_velocity`` (|qd| below which sign(qd) counts as 0, default 1e-3).
+ROS parameters: :data:`PARAMETERS` (``payload_estimator --plant axis --help``).
 """
 from __future__ import annotations
 
@@ -22,17 +21,27 @@ from std_msgs.msg import Float64MultiArray
 from ..control import gravity_load, regressor
 from ....rls import RecursiveLeastSquares
 from ....ros import convert
+from ....ros.params import Param
 from ....ros.plant_node import PlantNode
 from ....ros.qos import catch_up_qos, publisher_qos
+
+
+PARAMETERS = (
+    Param("forgetting", 1.0, "forgetting factor lambda of the recursive least squares (1 = none)",
+          gt=0.0, le=1.0),
+    Param("publish_every", 20, "publish the estimate every this many samples", ge=1, le=10 ** 9),
+    Param("stiction_velocity", 1e-3, "|qd| below which sign(qd) counts as 0", "m/s or rad/s",
+          ge=0.0, le=1e3),
+)
 
 
 class AxisEstimator(PlantNode):
     def __init__(self):
         super().__init__("payload_estimator")
-        p = self.param
-        self.rls = RecursiveLeastSquares(4, lam=float(p("forgetting", 1.0)), p0=1e4)
-        self.every = max(1, int(p("publish_every", 20)))
-        self.eps = float(p("stiction_velocity", 1e-3))
+        v = self.declare_params(PARAMETERS)
+        self.rls = RecursiveLeastSquares(4, lam=v.forgetting, p0=1e4)
+        self.every = v.publish_every
+        self.eps = v.stiction_velocity
         self.gravity_moment, self.gravity = 0.0, 9.81
         self.prev = None  # (t, q, qd, effort)
         self.count = 0

@@ -4,15 +4,9 @@ Publishes ``/axis/joint_states`` (name ``joint``: position, velocity, effort = a
 sensor offset), ``/axis/ground_truth/joint_states`` (effort = true applied force), ``/clock``
 and ``/plant_description`` (transient-local). Physics: :mod:`cablelab.plants.axis.sim`.
 
-ROS parameters: ``description`` (YAML file or text; default a prismatic 2 kg axis),
-``inertia``, ``viscous``, ``coulomb``, ``offset`` (true values, SI), ``timestep`` (s),
-``rate`` (Hz of publishing = command sampling), ``command_timeout`` (s wall; a stale command
-falls back to 0 and the node reports WARN), ``lockstep`` (bool, default false: the simulation
-advances one period only after the command answering the last published state arrived, so a
-loaded machine slows the run down instead of delaying the control loop; the state is
-republished every ``lockstep_resend`` s while waiting, e.g. before the controller connected),
-``wait_for_subscribers`` (int, default 0: time starts only when ``/axis/joint_states`` has that
-many matched subscriptions, at most 60 s, so a recorder started with the run misses nothing).
+ROS parameters: :data:`PARAMETERS` (``cable_sim_node --plant axis --help``). ``lockstep``: the
+simulation advances one period only after the command answering the last published state
+arrived, so a loaded machine slows the run down instead of delaying the control loop.
 
 Lock-step matching (:class:`cablelab.ros.lockstep.LockStep`, ``wait_first``): a command that
 names the stamp of the state it answers is applied only if it answers the latest state; answers
@@ -34,6 +28,7 @@ from ..sim import AxisSim, AxisTruth
 from ....ros import convert
 from ....ros.clock import ClockPublisher
 from ....ros.lockstep import ADVANCE, FREE, RESEND, LockStep
+from ....ros.params import DESCRIPTION, START_GATE, Param, merge
 from ....ros.plant_node import PlantNode
 from ....ros.qos import publisher_qos, stream_qos
 
@@ -41,24 +36,40 @@ DEFAULT_DESCRIPTION = ("plant: axis\nname: simulated linear axis\ngravity: 9.81\
                        "axis:\n  joint_type: prismatic\n  inertia: 2.0\n")
 
 
+PARAMETERS = merge((
+    DESCRIPTION,
+    Param("inertia", float("nan"), "true inertia M (NaN = the description's axis.inertia, else 2)",
+          "kg or kg m^2", gt=0.0, le=1e6, nan=True),
+    Param("viscous", 5.0, "true viscous friction Fv", "N s/m or N m s/rad", ge=0.0, le=1e6),
+    Param("coulomb", 1.0, "true Coulomb friction Fc", "N or N m", ge=0.0, le=1e6),
+    Param("offset", 0.0, "bias added to the reported effort", "N or N m", ge=-1e6, le=1e6),
+    Param("timestep", 0.001, "physics step", "s", ge=1e-5, le=0.01),
+    Param("rate", 200.0, "publishing rate = command sampling", "Hz", ge=1.0, le=10000.0),
+    Param("command_timeout", 0.5, "a command older than this falls back to 0 (WARN)", "s wall", gt=0.0),
+    Param("lockstep", False, "advance one period only once the command answering the last state "
+          "arrived"),
+    Param("lockstep_resend", 0.25, "lock-step: the state is republished this often while waiting",
+          "s wall", gt=0.0, le=60.0),
+), START_GATE)
+
+
 class AxisSimNode(PlantNode):
     def __init__(self):
         super().__init__("cable_sim_node")
-        p = self.declare_parameter
-        text = p("description", "").value or DEFAULT_DESCRIPTION
-        self.description = load_description(text)
+        v = self.declare_params(PARAMETERS)
+        self.description = load_description(v.description or DEFAULT_DESCRIPTION)
         nominal = self.description.axis.inertia if self.description.axis else None
-        truth = AxisTruth(inertia=p("inertia", float(nominal or 2.0)).value,
-                          viscous=p("viscous", 5.0).value, coulomb=p("coulomb", 1.0).value,
-                          offset=p("offset", 0.0).value, timestep=p("timestep", 0.001).value)
-        self.rate = float(p("rate", 200.0).value)
-        self.resend = float(p("lockstep_resend", 0.25).value)
-        self.lock = LockStep(bool(p("lockstep", False).value), wait_first=True, resend=self.resend)
+        inertia = v.inertia if v.inertia == v.inertia else float(nominal or 2.0)
+        truth = AxisTruth(inertia=inertia, viscous=v.viscous, coulomb=v.coulomb, offset=v.offset,
+                          timestep=v.timestep)
+        self.rate = v.rate
+        self.resend = v.lockstep_resend
+        self.lock = LockStep(v.lockstep, wait_first=True, resend=self.resend)
         self.start_gate()
         self.last_publish = time.monotonic()
         self.sim = AxisSim(self.description, truth)
         self.u = 0.0
-        self.inputs.add("effort_command", timeout=float(p("command_timeout", 0.5).value), length=1)
+        self.inputs.add("effort_command", timeout=v.command_timeout, length=1)
 
         self.pub_js = self.create_publisher(JointState, "/axis/joint_states", publisher_qos())
         self.pub_truth = self.create_publisher(JointState, "/axis/ground_truth/joint_states", publisher_qos())

@@ -12,18 +12,13 @@ it publishes what the three-process loop has on its topics: ``/cdpr/joint_states
 ``/cdpr/payload_estimate`` of the separate ``payload_estimator`` without waiting; without a
 fresh one the feedforward uses the nominal mass and /diagnostics says so (WARN).
 
-ROS parameters: the loop's (``rate`` 1000, ``duration``, ``warmup``, ``publish_thread``,
-``input_period``, placement: :mod:`cablelab.ros.control_loop`); ``hardware`` (``sim``: the
-MuJoCo CAROCA, :class:`~cablelab.plants.cdpr.hardware.SimulatedCdpr`; ``stub``:
-:class:`cablelab.hardware.DriverStub`, which stops with what a driver must implement;
-``package.module:Class``: your driver, built as ``Class(joint_names, description)``); the
-controller's, as ``pd_feedforward --plant cdpr``: ``feedforward``, ``nominal_mass``, ``kp``, ``kd``,
-``coulomb``, ``viscous``, ``min_tension``, ``preload``, ``max_torque``, ``model``,
-``estimate_timeout``, ``reference_timeout`` (s wall: the estimate input's staleness for
-/diagnostics is ``estimate_timeout``); the reference's: ``trajectory_speed``, ``settle``; the
-simulator's, as ``cable_sim_node --plant cdpr``: ``description``, ``payload_mass``,
-``payload_com``, ``pulleys``, ``winch_coulomb``, ``winch_viscous``, ``motor_inertia``,
-``tension_noise``, ``torque_noise``, ``pose_noise``, ``timestep``, ``seed``, ``extras_every``.
+ROS parameters: :data:`PARAMETERS` (``control_loop --plant cdpr --help``): the loop's
+(:data:`cablelab.ros.control_loop.LOOP_PARAMETERS`), ``hardware``, the controller's as
+``pd_feedforward --plant cdpr``, the reference's and the simulator's as ``cable_sim_node --plant
+cdpr``. ``hardware``: ``sim`` (the MuJoCo CAROCA, :class:`~cablelab.plants.cdpr.hardware.
+SimulatedCdpr`), ``stub`` (:class:`cablelab.hardware.DriverStub`, which stops with what a driver
+must implement) or ``package.module:Class`` (your driver, built as ``Class(joint_names,
+description)``).
 """
 from __future__ import annotations
 
@@ -38,7 +33,8 @@ from ....description import load_description
 from ....errors import CablelabError
 from ....hardware import DriverStub, load_hardware_class
 from ....ros import convert
-from ....ros.control_loop import ControlLoopNode
+from ....ros.control_loop import LOOP_PARAMETERS, ControlLoopNode
+from ....ros.params import Param, executor_params, merge
 from ....ros.fastspin import take_newest
 from ....ros.qos import publisher_qos, stream_qos
 from ....ros.rawmsg import CommandTemplate, RawTemplate
@@ -49,35 +45,49 @@ from ..live import ControllerConfig, LiveController
 from ..loop import ReferenceLaw
 from ..sim import CdprTruth, default_description_path
 from ..trajectory import ReferenceTable
+from . import controller as _controller
+from . import sim as _sim
 
-__all__ = ["CdprControlLoop", "make_node"]
+__all__ = ["CdprControlLoop", "make_node", "PARAMETERS"]
+
+
+def _of(specs, *names):
+    by = {s.name: s for s in specs}
+    return tuple(by[n] for n in names)
+
+
+PARAMETERS = merge(
+    LOOP_PARAMETERS,
+    (Param("hardware", "sim", "the winches: sim (the MuJoCo CAROCA), stub (a driver stub that says "
+           "what a driver must implement) or package.module:Class (your driver)"),),
+    _of(_controller.PARAMETERS, "feedforward", "nominal_mass", "kp", "kd", "coulomb", "viscous",
+        "min_tension", "preload", "max_torque", "model", "estimate_timeout"),
+    _of(_sim.PARAMETERS, "trajectory_speed", "settle", "description", "payload_mass", "payload_com",
+        "pulleys", "winch_coulomb", "winch_viscous", "motor_inertia", "tension_noise", "tension_bias",
+        "torque_noise", "pose_noise", "timestep", "seed", "extras_every"),
+    executor_params(True))
 
 
 class CdprControlLoop(ControlLoopNode):
     def __init__(self):
         super().__init__("control_loop")
-        p = self.param
-        desc = load_description(str(p("description", "")) or default_description_path())
+        v = self.v = self.declare_params(PARAMETERS)
+        desc = load_description(v.description or default_description_path())
         c = desc.cdpr
         if c is None:
             raise CablelabError("control_loop --plant cdpr: the description has no cdpr section")
         self.n = len(c.cables)
-        d = PdffConfig()
-        gains = PdffConfig(kp=float(p("kp", d.kp)), kd=float(p("kd", d.kd)), coulomb=float(p("coulomb", 0.3)),
-                           viscous=float(p("viscous", 0.002)), min_tension=float(p("min_tension", d.min_tension)),
-                           preload=float(p("preload", d.preload)), max_torque=float(p("max_torque", d.max_torque)))
-        model = self.choice("model", "II", ("I", "II"))
-        self.estimate_timeout = float(p("estimate_timeout", 2.0))
-        nominal = float(p("nominal_mass", 0.0)) or c.platform_mass or 366.0
-        cfg = ControllerConfig(feedforward=bool(p("feedforward", True)), nominal_mass=nominal,
-                               estimate_timeout=self.estimate_timeout, gains=gains, model=model)
-        speed, settle = float(p("trajectory_speed", 1.0)), float(p("settle", 1.0))
-        if speed <= 0 or settle < 0:
-            raise CablelabError("control_loop: parameters trajectory_speed > 0 and settle >= 0 expected")
+        gains = PdffConfig(kp=v.kp, kd=v.kd, coulomb=v.coulomb, viscous=v.viscous,
+                           min_tension=v.min_tension, preload=v.preload, max_torque=v.max_torque)
+        self.estimate_timeout = v.estimate_timeout
+        nominal = v.nominal_mass or c.platform_mass or 366.0
+        cfg = ControllerConfig(feedforward=v.feedforward, nominal_mass=nominal,
+                               estimate_timeout=self.estimate_timeout, gains=gains, model=v.model)
+        speed, settle = v.trajectory_speed, v.settle
         self.reference = ReferenceTable(self.rate, settle, speed)
         self.law = ReferenceLaw(LiveController(c, desc.gravity, cfg), self.reference.at)
-        self.extras_every = max(1, int(p("extras_every", 1)))
-        self.hardware = hardware = self._hardware(str(p("hardware", "sim")), desc)
+        self.extras_every = v.extras_every
+        self.hardware = hardware = self._hardware(v.hardware, desc)
         self.simulated = isinstance(hardware, SimulatedCdpr)
         self.estimates_rejected = 0
 
@@ -103,18 +113,20 @@ class CdprControlLoop(ControlLoopNode):
     def _hardware(self, spec: str, desc):
         names = [f"winch_{i}" for i in range(1, self.n + 1)]
         if spec == "sim":
-            p = self.param
-            bias = [float(b) for b in p("tension_bias", [0.0])]
+            v = self.v
+            bias = v.tension_bias
             if len(bias) not in (1, self.n):
-                raise CablelabError(f"control_loop: parameter tension_bias: expected 1 or {self.n} values")
+                raise CablelabError(f"{self.get_name()}: parameter tension_bias:={bias}: expected 1 or "
+                                    f"{self.n} numbers (one per cable) [N]")
+            if 0 < v.timestep < 1e-5:
+                raise CablelabError(f"{self.get_name()}: parameter timestep:={v.timestep!r}: expected 0 "
+                                    "(auto) or a step of at least 1e-05 [s]")
             truth = CdprTruth(
-                pulleys=bool(p("pulleys", True)), payload_mass=float(p("payload_mass", 0.0)),
-                payload_com=tuple(float(x) for x in p("payload_com", [0.15, 0.0, -0.6])),
-                winch_coulomb=float(p("winch_coulomb", 0.3)), winch_viscous=float(p("winch_viscous", 0.002)),
-                motor_inertia=float(p("motor_inertia", 2e-4)), tension_noise=float(p("tension_noise", 5.0)),
-                tension_bias=tuple(bias) if any(bias) else None, torque_noise=float(p("torque_noise", 0.02)),
-                pose_noise=float(p("pose_noise", 0.0)),
-                timestep=float(p("timestep", 0.0)) or min(0.002, 1.0 / self.rate), seed=int(p("seed", 0)))
+                pulleys=v.pulleys, payload_mass=v.payload_mass, payload_com=tuple(v.payload_com),
+                winch_coulomb=v.winch_coulomb, winch_viscous=v.winch_viscous,
+                motor_inertia=v.motor_inertia, tension_noise=v.tension_noise,
+                tension_bias=tuple(bias) if any(bias) else None, torque_noise=v.torque_noise,
+                pose_noise=v.pose_noise, timestep=v.timestep or min(0.002, 1.0 / self.rate), seed=v.seed)
             return SimulatedCdpr(desc, truth, self.rate, self.reference.at(0.0)[0])
         cls = DriverStub if spec == "stub" else load_hardware_class(spec)
         return cls(names, desc)

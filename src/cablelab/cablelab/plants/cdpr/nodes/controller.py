@@ -9,16 +9,7 @@ mass (WARN on /diagnostics). Each command carries the stamp of the state it answ
 ``layout.dim[0].label`` (``winch stamp=<s>``, optional; a lock-step simulator matches it). Without a reference (or with a bad motor state) nothing is
 published (the simulator's brakes hold) and /diagnostics says why.
 
-ROS parameters: ``description``, ``feedforward`` (bool), ``nominal_mass`` (kg, 0 = the
-description's platform_mass), ``kp`` (N m/rad), ``kd`` (N m s/rad), ``coulomb``, ``viscous``
-(friction compensation), ``min_tension`` (N), ``preload`` (N), ``max_torque`` (N m), ``model``
-("II" | "I"), ``estimate_timeout`` (s of stamps), ``reference_timeout``, ``state_timeout`` (s wall),
-``sync_wait`` (s wall a state waits for the reference of its stamp before the latest one is used),
-``estimate_wait`` (s wall a state waits for the estimate of its stamp, 0 = never: use the latest;
-set it with a lock-step simulator to make sim -> estimator -> controller one deterministic chain),
-``fast_executor`` (default true: :class:`cablelab.ros.fastspin.FastExecutor`; false = rclpy's
-SingleThreadedExecutor), ``rt_priority`` (0 = normal scheduling; 1-99 = SCHED_FIFO, see
-:func:`cablelab.ros.fastspin.set_realtime_priority`). Commands go out as pre-serialised messages
+ROS parameters: :data:`PARAMETERS` (``pd_feedforward --plant cdpr --help``). Commands go out as pre-serialised messages
 (:class:`cablelab.ros.rawmsg.CommandTemplate`).
 """
 from __future__ import annotations
@@ -31,7 +22,6 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 from trajectory_msgs.msg import MultiDOFJointTrajectory
 
-from ....errors import CablelabError
 from ..control import PdffConfig
 from ..live import ControllerConfig, LiveController
 from ....ros import convert
@@ -39,29 +29,55 @@ from ....rotations import xyzw_to_wxyz
 from ....ros.inputs import ERROR, WARN
 from ....ros.fastspin import drain, poll
 from ....stamped import StampedBuffer
+from ....ros.params import DESCRIPTION, Param, executor_params, merge
 from ....ros.plant_node import PlantNode
 from ....ros.qos import stream_qos
 from ....ros import rawmsg
 from ....ros.rawmsg import CommandTemplate, RawReader
 
 
+_D = PdffConfig()
+PARAMETERS = merge((
+    Param("description", "", "plant description: YAML file or text (empty = the first valid "
+          "/plant_description)"),
+    Param("feedforward", True, "mass feedforward of 001 eq. 14 with the live payload estimate "
+          "(PDFF; false: PD)"),
+    Param("nominal_mass", 0.0, "mass used without a valid estimate (0 = the description's "
+          "platform_mass)", "kg", ge=0.0, le=1e5),
+    Param("kp", _D.kp, "proportional gain on the motor angles", "N m/rad", ge=0.0, le=1e4),
+    Param("kd", _D.kd, "derivative gain on the motor rates", "N m s/rad", ge=0.0, le=1e3),
+    Param("coulomb", 0.3, "Coulomb friction compensation F_c (001 eq. 15)", "N m", ge=0.0, le=1e3),
+    Param("viscous", 0.002, "viscous friction compensation F_v (001 eq. 15)", "N m s/rad", ge=0.0, le=1e3),
+    Param("min_tension", _D.min_tension, "floor on the commanded tensions (cables stay taut)", "N",
+          ge=0.0, le=1e6),
+    Param("preload", _D.preload, "uniform tension the feedforward distribution stays nearest to", "N",
+          ge=0.0, le=1e6),
+    Param("max_torque", _D.max_torque, "saturation of the motor torques", "N m", gt=0.0, le=1e5),
+    Param("model", "II", "dynamic model of the feedforward: II (with the platform's inertia) or I",
+          choices=("II", "I")),
+    Param("estimate_timeout", 2.0, "a payload estimate older than this (in stamps) falls back to the "
+          "nominal mass", "s", gt=0.0),
+    Param("reference_timeout", 0.5, "a reference older than this is stale (nothing published)",
+          "s wall", gt=0.0),
+    Param("state_timeout", 0.5, "a joint state older than this is stale", "s wall", gt=0.0),
+    Param("sync_wait", 0.005, "a state waits this long for the reference of its stamp before the "
+          "latest one is used", "s wall", ge=0.0, le=1.0),
+    Param("estimate_wait", 0.0, "a state waits this long for the estimate of its stamp (0 = never: "
+          "use the latest; with a lock-step simulator: one deterministic chain)", "s wall",
+          ge=0.0, le=10.0),
+), executor_params(True))
+
+
 class CdprController(PlantNode):
     def __init__(self):
         super().__init__("pd_feedforward", start_parameter_services=False)  # smaller wait set
-        p = self.declare_parameter
-        d = PdffConfig()
-        self.gains = PdffConfig(kp=float(p("kp", d.kp).value), kd=float(p("kd", d.kd).value),
-                                coulomb=float(p("coulomb", 0.3).value),
-                                viscous=float(p("viscous", 0.002).value),
-                                min_tension=float(p("min_tension", d.min_tension).value),
-                                preload=float(p("preload", d.preload).value),
-                                max_torque=float(p("max_torque", d.max_torque).value))
-        self.feedforward = bool(p("feedforward", True).value)
-        self.nominal = float(p("nominal_mass", 0.0).value)
-        self.model = str(p("model", "II").value)
-        if self.model not in ("I", "II"):
-            raise CablelabError("pd_feedforward: parameter model must be I or II")
-        self.estimate_timeout = float(p("estimate_timeout", 2.0).value)
+        v = self.declare_params(PARAMETERS)
+        self.gains = PdffConfig(kp=v.kp, kd=v.kd, coulomb=v.coulomb, viscous=v.viscous,
+                                min_tension=v.min_tension, preload=v.preload, max_torque=v.max_torque)
+        self.feedforward = v.feedforward
+        self.nominal = v.nominal_mass
+        self.model = v.model
+        self.estimate_timeout = v.estimate_timeout
         self.controller = None
         self.refs = StampedBuffer()     # the reference may run ahead of the states
         self.sent = 0
@@ -70,14 +86,14 @@ class CdprController(PlantNode):
         self.last_problem = ""
         self.last_skip = -1e9     # wall time of the last skipped sample
         self.latency = []
-        self.inputs.add("joint_states", timeout=float(p("state_timeout", 0.5).value))
-        self.inputs.add("reference", timeout=float(p("reference_timeout", 0.5).value))
+        self.inputs.add("joint_states", timeout=v.state_timeout)
+        self.inputs.add("reference", timeout=v.reference_timeout)
         self.inputs.add("payload_estimate", timeout=self.estimate_timeout, length=1,
                         required=False)
         q = stream_qos(1000)     # deep queue: a busy moment delays samples instead of dropping them
         self.pub_cmd = self.create_publisher(Float64MultiArray, "/cdpr/effort_commands", q)
         self.keep_first_description = True   # the first valid description configures the law
-        self.listen_for_description(p("description", "").value)
+        self.listen_for_description(v.description)
         # the 1 kHz inputs arrive as bytes, decoded without rclpy message objects (RawReader)
         self.readers = {"state": RawReader(JointState), "reference": RawReader(MultiDOFJointTrajectory)}
         ref_sub = self.create_subscription(MultiDOFJointTrajectory, "/cdpr/reference", self.on_reference, q, raw=True)
@@ -86,8 +102,8 @@ class CdprController(PlantNode):
         self.pending = None
         self.prepared = None        # LiveController.ReferenceTerms of the next stamp (prepare_next)
         self.prepared_used = 0      # commands whose reference terms were prepared ahead
-        self.sync_wait = float(p("sync_wait", 0.005).value)
-        self.estimate_wait = float(p("estimate_wait", 0.0).value)
+        self.sync_wait = v.sync_wait
+        self.estimate_wait = v.estimate_wait
         # only a state wakes the node: the reference (published before the state of its stamp)
         # and the estimate wait queued until a state or the timer takes them (one wake-up per
         # cycle at 1 kHz instead of three); an awaited estimate (estimate_wait) still wakes it

@@ -9,17 +9,7 @@ from the ``description`` parameter or ``/plant_description``. Each tension sampl
 Bad input (NaN, wrong length, negative tension, ill-conditioned W, stale pose) publishes nothing
 and is reported on /diagnostics; slack cables are reported as WARN.
 
-ROS parameters: ``description``, ``model`` ("II" | "I"), ``tensions`` ("dynamometer" |
-``"motor"``), ``pose`` ("desired" | "measured"), ``platform_inertia`` (bool), ``coulomb``,
-``viscous`` (friction compensation, N m, N m s/rad), ``pulley_radius`` (m, 0 = the
-description's), ``stale_after`` (s of stamps between tension and pose), ``input_timeout`` (s wall),
-``poll_period`` (s, default 0: every input sample wakes the node and gives one estimate; > 0:
-batch mode for 1 kHz loops on small machines: every ``poll_period`` s the newest tension sample
-(its queue keeps only that one) is checked, estimated and published: a ``1/poll_period`` Hz
-estimator on the 1 kHz stream),
-``fast_executor`` (default true: :class:`cablelab.ros.fastspin.FastExecutor`; false = rclpy's
-SingleThreadedExecutor), ``rt_priority`` (0 = normal scheduling; 1-99 = SCHED_FIFO, see
-:func:`cablelab.ros.fastspin.set_realtime_priority`). The estimate goes out as a pre-serialised message
+ROS parameters: :data:`PARAMETERS` (``payload_estimator --plant cdpr --help``). The estimate goes out as a pre-serialised message
 (:class:`cablelab.ros.rawmsg.RawTemplate`); only the topic the ``tensions`` source needs is
 subscribed (``/cdpr/cable_tensions`` or ``/cdpr/joint_states``).
 """
@@ -32,34 +22,53 @@ from geometry_msgs.msg import InertiaStamped, PoseStamped
 from sensor_msgs.msg import JointState
 from trajectory_msgs.msg import MultiDOFJointTrajectory
 
-from ....errors import CablelabError
 from ..live import EstimatorConfig, LiveEstimator
 from ....ros import convert
 from ....rotations import xyzw_to_wxyz
 from ....ros.inputs import ERROR, WARN
 from ....ros.fastspin import drain, poll
 from ....stamped import StampedBuffer
+from ....ros.params import Param, executor_params, merge
 from ....ros.plant_node import PlantNode
 from ....ros.qos import stream_qos
 from ....ros import rawmsg
 from ....ros.rawmsg import RawReader, RawTemplate
 
 
+PARAMETERS = merge((
+    Param("description", "", "plant description: YAML file or text (empty = the first valid "
+          "/plant_description)"),
+    Param("model", "II", "dynamic model: II (with the platform's inertia terms, 001 eq. 13) or I",
+          choices=("II", "I")),
+    Param("tensions", "dynamometer", "tension source: the dynamometers (/cdpr/cable_tensions) or "
+          "the motor torques, friction compensated (/cdpr/joint_states)",
+          choices=("dynamometer", "motor")),
+    Param("pose", "desired", "pose of the wrench matrix: the reference (desired, 001's real-time "
+          "choice) or /cdpr/platform_pose (measured)", choices=("desired", "measured")),
+    Param("platform_inertia", False, "include the platform's own inertia terms"),
+    Param("coulomb", 0.0, "Coulomb friction compensation of the motor torques", "N m", ge=0.0, le=1e3),
+    Param("viscous", 0.0, "viscous friction compensation of the motor torques", "N m s/rad",
+          ge=0.0, le=1e3),
+    Param("pulley_radius", 0.0, "pulley radius of the model (0 = the description's)", "m",
+          ge=0.0, le=10.0),
+    Param("stale_after", 0.5, "largest stamp difference between a tension sample and its pose", "s",
+          gt=0.0),
+    Param("input_timeout", 0.5, "an input older than this is stale", "s wall", gt=0.0),
+    Param("poll_period", 0.0, "0: every input sample gives one estimate; > 0: batch mode, the newest "
+          "tension sample estimated every poll_period s (a 1/poll_period Hz estimator on the 1 kHz "
+          "stream)", "s", ge=0.0, le=0.1),
+), executor_params(True))
+
+
 class CdprPayloadEstimator(PlantNode):
     def __init__(self):
         super().__init__("payload_estimator", start_parameter_services=False)  # smaller wait set
-        p = self.declare_parameter
-        r = float(p("pulley_radius", 0.0).value)
+        v = self.declare_params(PARAMETERS)
         self.config = EstimatorConfig(
-            model=str(p("model", "II").value), tensions=str(p("tensions", "dynamometer").value),
-            pose=str(p("pose", "desired").value), platform_inertia=bool(p("platform_inertia", False).value),
-            coulomb=float(p("coulomb", 0.0).value), viscous=float(p("viscous", 0.0).value),
-            stale_after=float(p("stale_after", 0.5).value), pulley_radius=r if r > 0 else None)
-        if self.config.model not in ("I", "II") or self.config.tensions not in ("dynamometer", "motor") \
-                or self.config.pose not in ("desired", "measured"):
-            raise CablelabError("payload_estimator: parameters model in {I, II}, tensions in "
-                                "{dynamometer, motor}, pose in {desired, measured}")
-        timeout = float(p("input_timeout", 0.5).value)
+            model=v.model, tensions=v.tensions, pose=v.pose, platform_inertia=v.platform_inertia,
+            coulomb=v.coulomb, viscous=v.viscous, stale_after=v.stale_after,
+            pulley_radius=v.pulley_radius if v.pulley_radius > 0 else None)
+        timeout = v.input_timeout
         self.estimator = None
         self.poses = StampedBuffer()    # t -> (position, quat wxyz, acceleration); may run ahead
         self.motor = None       # (t, velocity, effort)
@@ -76,15 +85,13 @@ class CdprPayloadEstimator(PlantNode):
         q = stream_qos(1000)     # deep queue: a busy moment delays samples instead of dropping them
         self.pub = self.create_publisher(InertiaStamped, "/cdpr/payload_estimate", q)
         self.keep_first_description = True   # the first valid description configures the law
-        self.listen_for_description(p("description", "").value)
+        self.listen_for_description(v.description)
         # batch mode: the inputs wake nobody; a timer takes what queued every poll_period s and
         # estimates the newest tension sample, one estimate per period. The tension queue keeps
         # only that newest sample (keep-last 1: the samples in between are overwritten inside
         # DDS, never decoded in Python) and the pose queue the stamps around it (the newest
         # tension's and a reference lead of two periods)
-        self.poll_period = float(p("poll_period", 0.0).value)
-        if self.poll_period < 0 or self.poll_period > 0.1:
-            raise CablelabError("payload_estimator: parameter poll_period must be in [0, 0.1] s")
+        self.poll_period = v.poll_period
         q_pose, q_tension = (stream_qos(4), stream_qos(1)) if self.poll_period > 0 else (q, q)
         # the pose first: when both wait in one wake-up, a tension sample meets the pose of its
         # stamp (FastExecutor and rclpy's executor take ready topics in creation order)

@@ -14,24 +14,7 @@ arrived, or after ``lockstep_timeout`` s without one). Without a fresh command t
 lock the motor angles (the last torque + a stiff PD about the locked angles), reported as WARN on
 /diagnostics; slack cables are reported too.
 
-ROS parameters: ``description`` (YAML file or text; default CAROCA), ``payload_mass`` (kg),
-``payload_com`` [x, y, z] (m), ``pulleys`` (bool), ``winch_coulomb`` (N m), ``winch_viscous``
-(N m s/rad), ``motor_inertia`` (kg m^2), ``tension_noise`` (N), ``tension_bias`` [n] (N),
-``torque_noise`` (N m), ``pose_noise`` (m), ``timestep`` (s; 0 = min(2 ms, 1/rate)), ``rate`` (Hz), ``real_time``,
-``publish_reference``, ``reference_lead`` (s the published reference runs ahead of the state:
-default two periods in real time, 0 in lock-step), ``publish_pose``, ``trajectory_speed`` (time scale of the s-curve),
-``settle`` (s held at A before the trajectory starts), ``mass_change`` (kg put on the platform at
-its centre of mass at sim time ``mass_change_time`` s, < 0 = never: a payload change while
-running, e.g. to test a model monitor; the ground truth follows), ``duration`` (s of simulated time after
-which the node exits; 0 = run until stopped), ``command_timeout`` (s wall, real time),
-``lockstep_timeout`` (s wall, lock-step), ``markers_rate`` (Hz of wall time of the 3D view
-``/cdpr/markers``, visualization_msgs/MarkerArray in ``world``: cables coloured by tension,
-platform, exit points and frame; 0 = off; on its own timer, after the state), ``extras_every`` (publish /clock, the measured pose and
-the ground truth every k-th step: lighter at 1 kHz), ``wait_for_subscribers`` (time starts only
-once /cdpr/joint_states has this many subscribers, max 60 s: no sample lost to discovery), ``seed``,
-``fast_executor`` (default true: spun by :class:`cablelab.ros.fastspin.FastExecutor`; false = rclpy's
-SingleThreadedExecutor), ``rt_priority`` (0 = normal scheduling; 1-99 = SCHED_FIFO in real-time
-mode, ignored in lock-step, see :func:`cablelab.ros.fastspin.set_realtime_priority`). Outgoing messages are pre-serialised templates
+ROS parameters: :data:`PARAMETERS` (``cable_sim_node --plant cdpr --help``). Outgoing messages are pre-serialised templates
 (:class:`cablelab.ros.rawmsg.RawTemplate`): each step only patches stamps and numbers.
 """
 from __future__ import annotations
@@ -53,61 +36,106 @@ from ....rotations import wxyz_to_xyzw
 from ....ros.inputs import WARN
 from ....ros.fastspin import poll, take_newest
 from ....ros.markers import start_markers
+from ....ros.params import DESCRIPTION, START_GATE, Param, executor_params, merge
 from ....ros.plant_node import PlantNode
 from ....ros.qos import stream_qos
 from ....ros import rawmsg
 from ....ros.rawmsg import RawTemplate
+from ..geometry import check_pulley_radius
 from ..hardware import WinchBrakes
 from ..sim import CdprSim, CdprTruth, default_description_path
+
+
+PARAMETERS = merge((
+    DESCRIPTION,
+    Param("payload_mass", 0.0, "payload carried by the platform (truth)", "kg", ge=0.0, le=1e5),
+    Param("payload_com", [0.15, 0.0, -0.6], "payload centre of mass [x, y, z] in the platform frame "
+          "(truth)", "m", length=(3,), ge=-100.0, le=100.0),
+    Param("pulleys", True, "simulate the real pulleys (false: cables leave from fixed exit points)"),
+    Param("winch_coulomb", 0.3, "Coulomb friction of each winch (truth)", "N m", ge=0.0, le=1e3),
+    Param("winch_viscous", 0.002, "viscous friction of each winch (truth)", "N m s/rad", ge=0.0, le=1e3),
+    Param("motor_inertia", 2e-4, "rotor inertia of each winch motor (truth)", "kg m^2", gt=0.0, le=10.0),
+    Param("tension_noise", 5.0, "standard deviation of the dynamometer noise", "N", ge=0.0, le=1e5),
+    Param("tension_bias", [0.0], "dynamometer bias: one value for all cables or one per cable", "N",
+          ge=-1e5, le=1e5),
+    Param("torque_noise", 0.02, "standard deviation of the motor-torque (current) noise", "N m",
+          ge=0.0, le=1e4),
+    Param("pose_noise", 0.0, "standard deviation of the measured platform position", "m", ge=0.0, le=10.0),
+    Param("timestep", 0.0, "physics step (0 = min(2 ms, 1/rate); else at least 10 us)", "s",
+          ge=0.0, le=0.01),
+    Param("rate", 100.0, "publishing rate of the state = command sampling", "Hz", ge=1.0, le=10000.0),
+    Param("real_time", True, "step at rate Hz of wall time (false: as fast as possible in lock-step "
+          "with the controller)"),
+    Param("publish_reference", True, "publish /cdpr/reference, the pick-and-place s-curve of 001 "
+          "sec. II-C (false: another node publishes it)"),
+    Param("reference_lead", -1.0, "time the published reference runs ahead of the state (negative "
+          "= two periods in real time, 0 in lock-step)", "s", ge=-1.0, le=1.0),
+    Param("publish_pose", True, "publish the measured pose /cdpr/platform_pose"),
+    Param("trajectory_speed", 1.0, "time scale of the s-curve (2 = twice as fast)", gt=0.0, le=100.0),
+    Param("settle", 1.0, "time held at A before the trajectory starts", "s", ge=0.0, le=3600.0),
+    Param("duration", 0.0, "simulated time after which the node exits (0 = run until stopped)", "s",
+          ge=0.0),
+    Param("command_timeout", 0.5, "a command older than this is stale and the winch brakes hold "
+          "(real time)", "s wall", gt=0.0),
+    Param("lockstep_timeout", 10.0, "lock-step: the step goes ahead (brakes holding) after this long "
+          "without the answering command", "s wall", gt=0.0),
+    Param("extras_every", 1, "publish /clock, the measured pose and the ground truth every k-th step "
+          "(lighter at 1 kHz)", ge=1, le=1000000),
+    Param("mass_change", 0.0, "mass put on the platform at its centre of mass at sim time "
+          "mass_change_time (a payload change while running, e.g. to test a model monitor; the "
+          "ground truth follows)", "kg", ge=-1e5, le=1e5),
+    Param("mass_change_time", -1.0, "sim time of the mass change (negative = never)", "s", le=1e9),
+    Param("markers_rate", 30.0, "rate of the 3D view /cdpr/markers (visualization_msgs/MarkerArray "
+          "in world: cables coloured by tension, platform, exit points; 0 = off)", "Hz wall",
+          ge=0.0, le=1000.0),
+    Param("seed", 0, "seed of the noise generator", ge=0),
+), START_GATE, executor_params(True))
 
 
 class CdprSimNode(PlantNode):
     def __init__(self):
         super().__init__("cable_sim_node", start_parameter_services=False)  # smaller wait set
-        p = self.declare_parameter
-        self.description = load_description(p("description", "").value or default_description_path())
+        v = self.declare_params(PARAMETERS)
+        self.description = load_description(v.description or default_description_path())
         c = self.description.cdpr
         if c is None:
             raise CablelabError("cable_sim_node --plant cdpr: the description has no cdpr section")
         self.n = len(c.cables)
-        bias = list(p("tension_bias", [0.0]).value)
+        bias = v.tension_bias
         if len(bias) not in (1, self.n):
-            raise CablelabError(f"cable_sim_node: parameter tension_bias: expected 1 or {self.n} values")
+            raise CablelabError(f"{self.get_name()}: parameter tension_bias:={bias}: expected 1 or "
+                                f"{self.n} numbers (one per cable) [N]")
+        if 0 < v.timestep < 1e-5:
+            raise CablelabError(f"{self.get_name()}: parameter timestep:={v.timestep!r}: expected 0 (auto) "
+                                "or a step of at least 1e-05 [s]")
         truth = CdprTruth(
-            pulleys=bool(p("pulleys", True).value),
-            payload_mass=float(p("payload_mass", 0.0).value),
-            payload_com=tuple(float(x) for x in p("payload_com", [0.15, 0.0, -0.6]).value),
-            winch_coulomb=float(p("winch_coulomb", 0.3).value),
-            winch_viscous=float(p("winch_viscous", 0.002).value),
-            motor_inertia=float(p("motor_inertia", 2e-4).value),
-            tension_noise=float(p("tension_noise", 5.0).value),
-            tension_bias=tuple(float(b) for b in bias) if any(bias) else None,
-            torque_noise=float(p("torque_noise", 0.02).value),
-            pose_noise=float(p("pose_noise", 0.0).value),
-            timestep=float(p("timestep", 0.0).value) or min(0.002, 1.0 / float(p("rate", 100.0).value)),
-            seed=int(p("seed", 0).value))
-        self.rate = float(self.get_parameter("rate").value)
-        self.real_time = bool(p("real_time", True).value)
-        self.publish_reference = bool(p("publish_reference", True).value)
-        self.publish_pose = bool(p("publish_pose", True).value)
-        self.speed = float(p("trajectory_speed", 1.0).value)
-        self.settle = float(p("settle", 1.0).value)
-        self.duration = float(p("duration", 0.0).value)
-        self.mass_change = float(p("mass_change", 0.0).value)
-        self.mass_change_time = float(p("mass_change_time", -1.0).value)
-        self.extras_every = max(1, int(p("extras_every", 1).value))
+            pulleys=v.pulleys, payload_mass=v.payload_mass, payload_com=tuple(v.payload_com),
+            winch_coulomb=v.winch_coulomb, winch_viscous=v.winch_viscous,
+            motor_inertia=v.motor_inertia, tension_noise=v.tension_noise,
+            tension_bias=tuple(bias) if any(bias) else None, torque_noise=v.torque_noise,
+            pose_noise=v.pose_noise, timestep=v.timestep or min(0.002, 1.0 / v.rate), seed=v.seed)
+        self.rate = v.rate
+        self.real_time = v.real_time
+        self.publish_reference = v.publish_reference
+        self.publish_pose = v.publish_pose
+        self.speed = v.trajectory_speed
+        self.settle = v.settle
+        self.duration = v.duration
+        self.extras_every = v.extras_every
+        self.mass_change = v.mass_change
+        self.mass_change_time = v.mass_change_time
         # real time: the reference two steps ahead goes out right after the state (off the
         # state -> command critical path; the consumers look it up by stamp, and a controller
         # prepares the reference terms of the next stamp while the plant steps)
-        lead = float(p("reference_lead", -1.0).value)
+        lead = v.reference_lead
         self.reference_lead = (2.0 / self.rate if self.real_time else 0.0) if lead < 0 else lead
         self._ref_sent = None
         self.start_gate()
-        self.command_timeout = float(p("command_timeout", 0.5).value)
-        self.lockstep_timeout = float(p("lockstep_timeout", 10.0).value)
-        if self.rate <= 0 or self.speed <= 0:
-            raise CablelabError("cable_sim_node: parameters rate and trajectory_speed must be > 0")
+        self.command_timeout = v.command_timeout
+        self.lockstep_timeout = v.lockstep_timeout
         start = pick_and_place(np.array([0.0])).position[0]
+        check_pulley_radius(c.exit_points, c.anchor_points, start[None], None, c.pulley_radius,
+                            c.swivel_axes, f"{self.get_name()}: description cdpr.pulley_radius")
         self.sim = CdprSim(self.description, truth, start)
         self.nstep = max(1, int(round(1.0 / (self.rate * self.sim.truth.timestep))))
         # winch brakes: lock each motor angle where it was when the commands stopped, holding the
@@ -150,7 +178,7 @@ class CdprSimNode(PlantNode):
         self.pub_tpay = self.create_publisher(InertiaStamped, "/cdpr/ground_truth/payload", q)
         self.pub_clock = self.create_publisher(Clock, "/clock", stream_qos(10))
         self.publish_description(self.description)
-        if not self.real_time and int(p("rt_priority", 0).value) > 0:
+        if not self.real_time and v.rt_priority > 0:
             self.get_logger().warning("rt_priority ignored: lock-step mode runs as fast as possible")
         self.use_fast_executor()
         self._templates()
@@ -165,7 +193,7 @@ class CdprSimNode(PlantNode):
         self.start_diagnostics()
         self.timer = self.create_timer(1.0 / self.rate if self.real_time else 0.0002, self.tick)
         start_markers(self, "/cdpr/markers", self._marker_frame, lambda: self.sim.time,
-                      float(p("markers_rate", 30.0).value))
+                      v.markers_rate)
         self.publish_state()
 
     def _marker_frame(self):

@@ -10,8 +10,7 @@ excitation (``reference_source: excitation``, published on ``/crane/reference`` 
 Fallback: with a stale reference the node holds the crane where it is (gravity compensation +
 damping, :func:`~cablelab.plants.crane.control.hold_command`) and reports WARN.
 
-ROS parameters: ``kp``, ``kd`` ([slew, luff, hoist]), ``feedforward`` (bool),
-``reference_source``, ``excitation_seed``, ``reference_timeout`` (s wall).
+ROS parameters: :data:`PARAMETERS` (``pd_feedforward --plant crane --help``).
 
 Each command names the stamp of the state it answers (``layout.dim[0].label = 'joints stamp=<t>'``,
 :func:`cablelab.ros.convert.command_msg`): a lock-step simulator applies only the answer to its
@@ -26,38 +25,49 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 from trajectory_msgs.msg import JointTrajectory
 
-from ....errors import CablelabError
 from ..control import LIVE_GAINS, Gains, control_law, hold_command
 from ..model import JOINTS, CraneParams
 from ....ros import convert
 from ....ros.inputs import WARN
+from ....ros.params import Param
 from ....ros.plant_node import PlantNode
 from ....ros.qos import publisher_qos, stream_qos
 from ..sim import reference_trajectory
 
 
+PARAMETERS = (
+    Param("kp", [float(x) for x in LIVE_GAINS.kp], "proportional gains [slew, luff, hoist]",
+          "N m/rad, N m/rad, N/m", length=(3,), ge=0.0, le=1e9),
+    Param("kd", [float(x) for x in LIVE_GAINS.kd], "derivative gains [slew, luff, hoist]",
+          "N m s/rad, N m s/rad, N s/m", length=(3,), ge=0.0, le=1e9),
+    Param("feedforward", True, "reference-acceleration feedforward"),
+    Param("slew_inertia", 0.05, "slew inertia the description does not hold", "kg m^2", gt=0.0, le=1e6),
+    Param("luff_inertia", 0.02, "luff inertia the description does not hold", "kg m^2", gt=0.0, le=1e6),
+    Param("reference_source", "topic", "the reference: /crane/reference (topic) or the built-in "
+          "multi-sine excitation, published on /crane/reference too (excitation)",
+          choices=("topic", "excitation")),
+    Param("excitation_seed", 0, "seed of the built-in multi-sine excitation", ge=0),
+    Param("reference_timeout", 0.5, "a reference older than this is stale: the crane is held",
+          "s wall", gt=0.0),
+)
+
+
 class CraneController(PlantNode):
     def __init__(self):
         super().__init__("pd_feedforward")
-        p = self.declare_parameter
-        kp = [float(x) for x in p("kp", list(LIVE_GAINS.kp)).value]
-        kd = [float(x) for x in p("kd", list(LIVE_GAINS.kd)).value]
-        if len(kp) != 3 or len(kd) != 3:
-            raise CablelabError("pd_feedforward --plant crane: parameters kp and kd need 3 values "
-                                "[slew, luff, hoist]")
-        self.gains = Gains(tuple(kp), tuple(kd))
-        self.feedforward = bool(p("feedforward", True).value)
-        self.inertias = {"slew_inertia": float(p("slew_inertia", 0.05).value),
-                         "luff_inertia": float(p("luff_inertia", 0.02).value)}
+        v = self.declare_params(PARAMETERS)
+        self.gains = Gains(tuple(v.kp), tuple(v.kd))
+        self.feedforward = v.feedforward
+        self.inertias = {"slew_inertia": v.slew_inertia, "luff_inertia": v.luff_inertia}
         self.params = None
-        self.source = self.choice("reference_source", "topic", ("topic", "excitation"))
-        self.seed = int(p("excitation_seed", 0).value)
+        self.source = v.reference_source
+        self.seed = v.excitation_seed
         self.ref = None
         self.swing = None
         self.fallbacks = 0
         self.t0 = None
         self.inputs.add("joint_states", timeout=0.5, length=3)
-        self.inputs.add("reference", timeout=float(p("reference_timeout", 0.5).value), length=3,
+        self.inputs.add("reference", timeout=v.reference_timeout, length=3,
                         required=self.source == "topic")
         self.inputs.add("swing_estimate", timeout=0.5, length=2, required=False)
         self.pub_cmd = self.create_publisher(Float64MultiArray, "/crane/effort_commands", publisher_qos())

@@ -7,8 +7,7 @@ slewing frame, 002 sec. 6.3; velocities by smoothed differences) and publishes
 ``/crane/swing_estimate`` (names theta1, theta2, rope_length; position and velocity) stamped like
 the poses. Dropouts (NaN poses), frozen stamps and gaps are counted and reported on /diagnostics.
 
-ROS parameters: ``velocity_tau`` (s, smoothing of the rates), ``pose_timeout``,
-``slew_timeout`` (s wall).
+ROS parameters: :data:`PARAMETERS` (``payload_estimator --plant crane --help``).
 """
 from __future__ import annotations
 
@@ -22,27 +21,37 @@ from sensor_msgs.msg import JointState
 from ..swing import SwingTracker
 from ....ros import convert
 from ....ros.inputs import WARN
+from ....ros.params import Param
 from ....ros.plant_node import PlantNode
 from ....ros.qos import catch_up_qos, publisher_qos
 
 NAMES = ["theta1", "theta2", "rope_length"]
 
 
+PARAMETERS = (
+    Param("velocity_tau", 0.02, "time constant smoothing the swing rates", "s", gt=0.0, le=10.0),
+    Param("max_wait", 0.2, "a pose pair waits this long (in stamps) for the slew angle of its "
+          "stamp before the latest one is used", "s", ge=0.0, le=10.0),
+    Param("pose_timeout", 0.5, "a pose older than this is stale", "s wall", gt=0.0),
+    Param("slew_timeout", 0.5, "a slew angle older than this is stale", "s wall", gt=0.0),
+)
+
+
 class CraneSwingEstimator(PlantNode):
     def __init__(self):
         super().__init__("payload_estimator")
-        p = self.declare_parameter
-        self.tracker = SwingTracker(tau=float(p("velocity_tau", 0.02).value))
+        v = self.declare_params(PARAMETERS)
+        self.tracker = SwingTracker(tau=v.velocity_tau)
         self.slews = deque(maxlen=400)      # (stamp, slew angle) of /crane/joint_states
         self.pending = deque(maxlen=100)    # pose pairs waiting for the slew angle of their stamp
         self.tip = None  # (t, position)
         self.unpaired = 0
         self.unsynced = 0
-        self.max_wait = float(p("max_wait", 0.2).value)
-        pose_timeout = float(p("pose_timeout", 0.5).value)
+        self.max_wait = v.max_wait
+        pose_timeout = v.pose_timeout
         self.inputs.add("boom_tip_pose", timeout=pose_timeout, length=3)
         self.inputs.add("payload_pose", timeout=pose_timeout, length=3)
-        self.inputs.add("slew", timeout=float(p("slew_timeout", 0.5).value), length=1)
+        self.inputs.add("slew", timeout=v.slew_timeout, length=1)
         self.pub = self.create_publisher(JointState, "/crane/swing_estimate", publisher_qos())
         self.create_subscription(JointState, "/crane/joint_states", self.on_joints, catch_up_qos())
         self.create_subscription(PoseStamped, "/crane/boom_tip_pose", self.on_tip, catch_up_qos())

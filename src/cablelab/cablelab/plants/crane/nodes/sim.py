@@ -6,20 +6,12 @@ Publishes (CONTRACT sec. 2) ``/crane/joint_states`` (slew, luff, hoist: position
 rope_length), ``/clock`` and ``/plant_description`` (transient-local). Physics:
 :class:`cablelab.plants.crane.sim.CraneSim`.
 
-ROS parameters: ``description`` (YAML file or text; default ``cablelab/plants/crane/data/crane.yaml``),
-``slew_inertia``, ``luff_inertia`` (kg m^2), truth switches ``base_tilt`` [x, y] rad,
-``viscous`` / ``coulomb`` / ``offset`` [slew, luff, hoist], ``mocap_noise`` (m),
-``mocap_dropout`` (probability), ``markers_rate`` (Hz of wall time of the 3D view
-``/crane/markers``, visualization_msgs/MarkerArray: mast, boom, rope, payload; 0 = off), ``timestep`` (s), ``rate`` (Hz of publishing = command
-sampling), ``command_timeout`` (s wall, real-time mode), ``lockstep`` (default true: once
-commands flow, after publishing a state the simulation waits for the command that answers it
-before advancing, so a slow or loaded controller slows the simulation down instead of
-destabilising it with delayed commands; an answer is applied however late it comes),
-``lockstep_timeout`` (s wall, default 10: without an answer for that long the simulation drops
-back to real time, holding the crane, until commands flow again), ``wait_for_subscribers``
-(int, default 0: time starts only when ``/crane/joint_states`` has that many matched
-subscriptions, at most 60 s, the initial state resent every 0.5 s meanwhile; DDS discovery on a
-busy machine can take seconds, which a recorder would otherwise miss). Without a fresh command the
+ROS parameters: :data:`PARAMETERS` (``cable_sim_node --plant crane --help``). ``lockstep``
+(default true): once commands flow, after publishing a state the simulation waits for the command
+that answers it before advancing, so a slow or loaded controller slows the simulation down
+instead of destabilising it with delayed commands; an answer is applied however late it comes;
+without an answer for ``lockstep_timeout`` s the simulation drops back to real time, holding the
+crane, until commands flow again. Without a fresh command the
 drives hold the crane (gravity compensation + damping, like a brake) and the node reports WARN
 on /diagnostics.
 
@@ -34,7 +26,6 @@ from __future__ import annotations
 import os
 import time
 
-import numpy as np
 from geometry_msgs.msg import PoseStamped
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
@@ -47,6 +38,7 @@ from ..model import JOINTS, CraneParams
 from ....ros.markers import start_markers
 from ....ros import convert
 from ....ros.lockstep import ADVANCE, FREE, LockStep
+from ....ros.params import DESCRIPTION, START_GATE, Param, merge
 from ....ros.plant_node import PlantNode
 from ....ros.qos import publisher_qos, stream_qos
 from ..sim import CraneSim, CraneTruth
@@ -55,41 +47,60 @@ DEFAULT_DESCRIPTION = os.path.join(os.path.dirname(os.path.dirname(__file__)), "
 SWING = ["theta1", "theta2", "rope_length"]
 
 
-def _vec(value, n: int, name: str) -> tuple:
-    v = [float(x) for x in value]
-    if len(v) != n or not np.all(np.isfinite(v)):
-        raise CablelabError(f"cable_sim_node: parameter {name}: expected {n} finite numbers, got {value!r}")
-    return tuple(v)
+PARAMETERS = merge((
+    DESCRIPTION,
+    Param("slew_inertia", 0.05, "slew inertia the description does not hold", "kg m^2", gt=0.0, le=1e6),
+    Param("luff_inertia", 0.02, "luff inertia the description does not hold", "kg m^2", gt=0.0, le=1e6),
+    Param("base_tilt", [0.0, 0.0], "true tilt of the base [about x, about y]", "rad", length=(2,),
+          ge=-0.5, le=0.5),
+    Param("viscous", [0.0, 0.0, 0.0], "true viscous friction [slew, luff, hoist]",
+          "N m s/rad, N m s/rad, N s/m", length=(3,), ge=0.0, le=1e6),
+    Param("coulomb", [0.0, 0.0, 0.0], "true Coulomb friction [slew, luff, hoist]", "N m, N m, N",
+          length=(3,), ge=0.0, le=1e6),
+    Param("offset", [0.0, 0.0, 0.0], "true effort sensor offset [slew, luff, hoist]", "N m, N m, N",
+          length=(3,), ge=-1e6, le=1e6),
+    Param("mocap_noise", 0.0, "standard deviation of the motion-capture positions", "m", ge=0.0, le=10.0),
+    Param("mocap_dropout", 0.0, "probability of a motion-capture dropout (NaN pose)", ge=0.0, le=1.0),
+    Param("timestep", 0.001, "physics step", "s", ge=1e-5, le=0.01),
+    Param("initial", [0.0, 0.5, 0.6], "initial [slew rad, luff rad, hoist rope length m]", length=(3,),
+          ge=-10.0, le=100.0),
+    Param("rate", 100.0, "publishing rate = command sampling", "Hz", ge=1.0, le=10000.0),
+    Param("command_timeout", 0.5, "a command older than this is stale: the drives hold (real time)",
+          "s wall", gt=0.0),
+    Param("lockstep", True, "once commands flow, advance only when the command answering the last "
+          "state arrived"),
+    Param("lockstep_timeout", 10.0, "lock-step: without an answer for this long, back to real time "
+          "holding the crane", "s wall", gt=0.0),
+    Param("markers_rate", 30.0, "rate of the 3D view /crane/markers (visualization_msgs/MarkerArray: "
+          "mast, boom, rope, payload; 0 = off)", "Hz wall", ge=0.0, le=1000.0),
+), START_GATE)
 
 
 class CraneSimNode(PlantNode):
     def __init__(self):
         super().__init__("cable_sim_node")
-        p = self.declare_parameter
-        self.description = load_description(p("description", "").value or DEFAULT_DESCRIPTION)
+        v = self.declare_params(PARAMETERS)
+        self.description = load_description(v.description or DEFAULT_DESCRIPTION)
         if self.description.crane is None:
             raise CablelabError("cable_sim_node --plant crane: the description has no crane section")
-        params = CraneParams.from_description(self.description,
-                                              slew_inertia=float(p("slew_inertia", 0.05).value),
-                                              luff_inertia=float(p("luff_inertia", 0.02).value))
-        truth = CraneTruth(params=params,
-                           base_tilt=_vec(p("base_tilt", [0.0, 0.0]).value, 2, "base_tilt"),
-                           viscous=_vec(p("viscous", [0.0, 0.0, 0.0]).value, 3, "viscous"),
-                           coulomb=_vec(p("coulomb", [0.0, 0.0, 0.0]).value, 3, "coulomb"),
-                           torque_offset=_vec(p("offset", [0.0, 0.0, 0.0]).value, 3, "offset"),
-                           mocap_noise=float(p("mocap_noise", 0.0).value),
-                           mocap_dropout=float(p("mocap_dropout", 0.0).value),
-                           timestep=float(p("timestep", 0.001).value))
-        q0 = _vec(p("initial", [0.0, 0.5, 0.6]).value, 3, "initial")
-        self.rate = float(p("rate", 100.0).value)
-        self.lock = LockStep(bool(p("lockstep", True).value), wait_first=False,
-                             timeout=float(p("lockstep_timeout", 10.0).value))
+        params = CraneParams.from_description(self.description, slew_inertia=v.slew_inertia,
+                                              luff_inertia=v.luff_inertia)
+        truth = CraneTruth(params=params, base_tilt=tuple(v.base_tilt), viscous=tuple(v.viscous),
+                           coulomb=tuple(v.coulomb), torque_offset=tuple(v.offset),
+                           mocap_noise=v.mocap_noise, mocap_dropout=v.mocap_dropout,
+                           timestep=v.timestep)
+        q0 = tuple(v.initial)
+        if q0[2] <= 0:
+            raise CablelabError(f"{self.get_name()}: parameter initial:={list(q0)}: expected a rope "
+                                "length (third value) > 0 [m]")
+        self.rate = v.rate
+        self.lock = LockStep(v.lockstep, wait_first=False, timeout=v.lockstep_timeout)
         self.start_gate()
         self.published_at = time.monotonic()
         self.sim = CraneSim(truth, q0)
         self.u = None
         self.fallbacks = 0
-        self.inputs.add("effort_commands", timeout=float(p("command_timeout", 0.5).value), length=3)
+        self.inputs.add("effort_commands", timeout=v.command_timeout, length=3)
 
         self.pub_js = self.create_publisher(JointState, "/crane/joint_states", publisher_qos())
         self.pub_tip = self.create_publisher(PoseStamped, "/crane/boom_tip_pose", publisher_qos())
@@ -103,7 +114,7 @@ class CraneSimNode(PlantNode):
         from ..markers import state_markers
 
         start_markers(self, "/crane/markers", lambda: state_markers(self.description, self.sim.state()[1]),
-                      lambda: self.sim.state()[0], float(p("markers_rate", 30.0).value))
+                      lambda: self.sim.state()[0], v.markers_rate)
         self.publish_state()
 
     def extend_status(self, level, msg, values):
