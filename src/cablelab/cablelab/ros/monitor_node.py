@@ -9,15 +9,8 @@ stamped like the inputs) is published, the same topics as the overlay bag of ``c
 ``error_factor`` bands) with the channel, the residual's size and the stamps when one stays
 outside longer than ``hold`` s; published at once when the level changes.
 
-ROS parameters: ``identify_json`` (file written by ``cablelab identify BAG --json``: the model's
-effects, parameters and the residual RMS per channel; "" = identify the description's nominal
-model on the first ``calibrate`` s of the stream), ``description`` (YAML file or text; default:
-``/plant_description``), ``band_sigma`` (band = this x the residual RMS, default 4), ``hold`` (s
-outside the band before an alarm, default 0.5), ``window`` (s of stream conditioned per
-evaluation, default 3), ``period`` (s wall between evaluations, default 0.25), ``calibrate``
-(s, default 10), ``error_factor`` (default 3), ``tensions`` (CDPR: dynamometer or motor),
-``niceness`` and the other placement parameters of :meth:`PlantNode.use_fast_executor` (the
-monitor is off every critical path: run it with a positive niceness beside a 1 kHz loop).
+ROS parameters: :data:`PARAMETERS` (``model_monitor --plant P --help``). The monitor is off every
+critical path: run it with a positive niceness beside a 1 kHz loop.
 """
 from __future__ import annotations
 
@@ -30,8 +23,26 @@ from sensor_msgs.msg import JointState
 
 from ..errors import CablelabError
 from . import convert
+from .params import DESCRIPTION, Param, executor_params, help_text, merge
 from .plant_node import PlantNode
 from .qos import stream_qos
+
+PARAMETERS = merge((
+    Param("identify_json", "", "file written by `cablelab identify BAG --json` (the model's effects, "
+          "parameters and residual RMS per channel); empty = identify the description's nominal "
+          "model on the first `calibrate` s of the stream"),
+    DESCRIPTION,
+    Param("band_sigma", 4.0, "band = this x the residual RMS of each channel", gt=0.0, le=1e6),
+    Param("hold", 0.5, "time outside the band before an alarm (and inside before it clears)", "s",
+          gt=0.0, le=3600.0),
+    Param("window", 3.0, "stream conditioned per evaluation", "s", gt=0.0, le=3600.0),
+    Param("period", 0.25, "wall time between evaluations", "s wall", gt=0.0, le=3600.0),
+    Param("calibrate", 10.0, "stream used to fit the nominal model when no identify_json is given", "s",
+          gt=0.0, le=1e6),
+    Param("error_factor", 3.0, "ERROR instead of WARN beyond this many bands", gt=0.0, le=1e6),
+    Param("tensions", "dynamometer", "CDPR: which tension measurement the model uses",
+          choices=("dynamometer", "motor")),
+), executor_params(False))
 
 
 def _msg_class(msgtype: str):
@@ -47,19 +58,11 @@ class ModelMonitorNode(PlantNode):
 
         self.plant_name = plant
         self.plant = get_plant(plant)
-        self.band_sigma = float(self.param("band_sigma", 4.0))
-        self.hold = float(self.param("hold", 0.5))
-        self.window = float(self.param("window", 3.0))
-        self.period = float(self.param("period", 0.25))
-        self.calibrate = float(self.param("calibrate", 10.0))
-        self.error_factor = float(self.param("error_factor", 3.0))
-        self.tensions = self.choice("tensions", "dynamometer", ("dynamometer", "motor"))
-        for name, v in (("band_sigma", self.band_sigma), ("hold", self.hold), ("window", self.window),
-                        ("period", self.period), ("calibrate", self.calibrate),
-                        ("error_factor", self.error_factor)):
-            if not (np.isfinite(v) and v > 0):
-                raise CablelabError(f"model_monitor: parameter {name}: expected a number > 0, got {v!r}")
-        path = str(self.param("identify_json", ""))
+        v = self.declare_params(PARAMETERS)
+        self.band_sigma, self.hold, self.window = v.band_sigma, v.hold, v.window
+        self.period, self.calibrate, self.error_factor = v.period, v.calibrate, v.error_factor
+        self.tensions = v.tensions
+        path = v.identify_json
         if path:
             try:
                 text = Path(path).read_text()
@@ -73,7 +76,7 @@ class ModelMonitorNode(PlantNode):
         q = stream_qos()
         self.pubs = {k: self.create_publisher(JointState, f"/{plant}/model/{k}", q)
                      for k in ("measured", "prediction", "residual")}
-        self.listen_for_description(str(self.param("description", "")))
+        self.listen_for_description(v.description)
         from ..monitor import ResidualMonitor
 
         topics = ResidualMonitor.input_topics(self.plant)
@@ -154,8 +157,9 @@ def main(argv=None) -> int:
         prog="model_monitor", description="Live model monitor: the plant's identified model on the live "
         "topics; publishes /<plant>/model/{measured,prediction,residual} and raises WARN/ERROR on "
         "/diagnostics when a channel's residual leaves its band for longer than a set time.",
-        epilog="ROS parameters: identify_json, description, band_sigma, hold, window, period, calibrate, "
-               "error_factor, tensions (--ros-args -p name:=value). Stops cleanly on SIGINT/SIGTERM.")
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        epilog="ROS parameters (--ros-args -p name:=value, or --params-file FILE.yaml):\n"
+               f"{help_text(PARAMETERS)}\n\nStops cleanly on SIGINT/SIGTERM.")
     parser.add_argument("--plant", choices=available_plants(), required=True, help="which plant")
     args = parser.parse_args(user)
     return run_node(make_node, args, ros_args, "model_monitor")
