@@ -35,6 +35,10 @@ def section() -> str:
             node = f"{package} --plant {plant}"
             parts += [f"### `{node}`", "", f"<!-- parameters: {node} -->",
                       markdown_table(parameters_of(module, role)), "<!-- end parameters -->", ""]
+    from cablelab.ros.monitor_node import PARAMETERS as MONITOR
+
+    parts += ["### `model_monitor --plant P` (any plant)", "", "<!-- parameters: model_monitor -->",
+              markdown_table(MONITOR), "<!-- end parameters -->", ""]
     parts.append(END)
     return "\n".join(parts)
 
