@@ -56,7 +56,7 @@ def repair_bag(path, out=None, *, overwrite: bool = False) -> dict:
     t_all = np.concatenate(times)
     k_all = np.concatenate(order_topic)
     order = np.argsort(t_all, kind="stable")          # one log-time order over all topics
-    with atomic_output(out, overwrite=overwrite, inputs=[path], option="-o") as tmp:
+    with atomic_output(out, overwrite=overwrite, inputs=[path], option="-o", verb="repair") as tmp:
         with BagWriter(tmp) as w:
             for topic in topics:
                 w.add_topic(topic, bag.topics[topic], transient_local=topic == DESCRIPTION_TOPIC)
