@@ -66,10 +66,31 @@ def is_uniform(t: np.ndarray, max_jitter: float = 0.05) -> bool:
     return bool(med > 0 and np.all(dt > 0) and np.max(np.abs(dt - med)) <= max_jitter * med)
 
 
+#: a step longer than this many grid periods splits the grid (as the time base's gap factor)
+GAP_PERIODS = 5.0
+
+
+def segment_grid(t_s: np.ndarray, rate_hz: float) -> np.ndarray:
+    """Uniform grid at ``rate_hz`` over each contiguous segment of the sorted distinct stamps
+    ``t_s`` (segments split at steps > :data:`GAP_PERIODS` periods), concatenated."""
+    cut = np.flatnonzero(np.diff(t_s) > GAP_PERIODS / rate_hz) + 1
+    first = np.concatenate([[0], cut])
+    last = np.concatenate([cut - 1, [t_s.size - 1]])
+    t0 = t_s[first]
+    counts = np.floor((t_s[last] - t0) * rate_hz + 1e-9).astype(np.int64) + 1
+    offsets = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    k = np.arange(int(counts.sum())) - np.repeat(offsets, counts)
+    return np.repeat(t0, counts) + k / rate_hz
+
+
 def uniform_grid(t: np.ndarray, *signals: np.ndarray, rate_hz: float | None = None):
     """Resample irregularly sampled signals onto a uniform time grid (linear interpolation).
 
     Non-increasing / duplicate stamps are sorted and merged; NaN samples are skipped per column.
+    The grid is uniform within each contiguous segment and never spans a gap (a step longer than
+    :data:`GAP_PERIODS` periods, e.g. a forward clock jump): each segment gets its own grid
+    from its first stamp, so the grid has at most ``GAP_PERIODS x N + segments`` points whatever
+    the stamps say (the samples next to a gap are masked by :func:`cablelab.timebase.gap_mask`).
 
     Args:
         t: (N,) sample times, s.
@@ -87,8 +108,8 @@ def uniform_grid(t: np.ndarray, *signals: np.ndarray, rate_hz: float | None = No
         raise CablelabError("fewer than 2 distinct sample times")
     if rate_hz is None:
         rate_hz = 1.0 / np.median(np.diff(t_s))
-    n = int(np.floor((t_s[-1] - t_s[0]) * rate_hz + 1e-9)) + 1
-    tu = t_s[0] + np.arange(n) / rate_hz
+    tu = segment_grid(t_s, rate_hz)
+    n = tu.size
     out = []
     for s in signals:
         s = np.asarray(s, dtype=float)[order][keep]
