@@ -206,12 +206,12 @@ def salvage_mcap(path, expected_messages: int | None = None) -> Salvage:
     pending = None            # (offset, messages or None if damaged) of the last chunk
     pending_index = 0         # messages its MessageIndex records list
 
-    def settle():
+    def settle(index_complete: bool = True):
         nonlocal pending, pending_index, good_chunks, lost_by_index, lost_unknown
         if pending is None:
             return
         off, got = pending
-        if got is not None and pending_index and len(got) != pending_index:
+        if got is not None and index_complete and pending_index and len(got) != pending_index:
             got = None        # the index after the chunk disagrees with what decoded
         if got is None:
             out.damaged += 1
@@ -289,7 +289,7 @@ def salvage_mcap(path, expected_messages: int | None = None) -> Salvage:
     else:
         if pos < len(data) and not complete:
             out.truncated = True
-    settle()
+    settle(index_complete=not out.truncated)   # a cut inside the index after the last chunk
     out.chunks = max(len(chunk_starts), good_chunks + out.damaged)
     total = stat_count if stat_count is not None else expected_messages
     for cid, (topic, sid) in channels.items():
