@@ -298,3 +298,15 @@ def test_stale_lock_file_of_a_killed_writer_does_not_block(cli, tmp_path):
     (tmp_path / ".out.lock").write_text("999999\n")   # left by a SIGKILLed run: no flock on it
     assert cli(*_verb_args("import", tmp_path, out)).code == 0
     assert _no_litter(tmp_path) == []
+
+
+def test_a_verb_failing_after_its_check_leaves_no_lock(cli, tmp_path):
+    """The lock is taken before the work; a verb failing in the work leaves no lock file and
+    holds nothing (the next writer, in this same process or another, goes ahead)."""
+    out = tmp_path / "rep"
+    res = cli("report", EMPS, "-o", out, "--effects", "no_such_effect")
+    assert res.code == 2 and "no_such_effect" in res.err, res.err
+    assert list(tmp_path.iterdir()) == []
+    from cablelab.atomic import _HELD
+
+    assert _HELD == {}

@@ -172,24 +172,14 @@ def release_target(path) -> None:
 
 
 @atexit.register
-def _release_all() -> None:
+def release_all() -> None:
+    """Give up every output lock this process holds (the CLI does at the end of each verb)."""
     for fd, lock in list(_HELD.values()):
         with contextlib.suppress(OSError):
             lock.unlink()
         with contextlib.suppress(OSError):
             os.close(fd)
     _HELD.clear()
-
-
-@contextlib.contextmanager
-def holding(path):
-    """Hold the lock of ``path`` inside the block (released after it if taken here)."""
-    taken = lock_target(path)
-    try:
-        yield
-    finally:
-        if taken:
-            release_target(path)
 
 
 def _check_inputs(target: Path, inputs, option: str) -> None:
