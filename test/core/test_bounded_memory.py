@@ -159,3 +159,28 @@ def test_replay_does_not_wait_through_a_clock_jump(tmp_path, domain_id):
         node.destroy_node()
     finally:
         rclpy.try_shutdown()
+
+
+@FUZZ
+@given(n=st.integers(1, 500), gaps=st.lists(st.tuples(st.floats(-5, 105), st.floats(0, 20)), max_size=40),
+       margin=st.floats(0, 3))
+def test_fuzz_gap_mask_is_the_interval_test(n, gaps, margin):
+    """The gap mask (searchsorted, O(N log G) memory O(N + G)) equals the direct (N, G) test."""
+    from cablelab.timebase import Gap, gap_mask
+
+    t = np.sort(np.random.default_rng(n).uniform(0, 100, n))
+    gl = [Gap(0, a, a + d, "recording gap") for a, d in gaps]
+    lo = np.array([g.start for g in gl]) - margin
+    hi = np.array([g.end for g in gl]) + margin
+    want = ~((t[:, None] > lo[None, :]) & (t[:, None] < hi[None, :])).any(axis=1) if gl else np.ones(n, bool)
+    assert np.array_equal(gap_mask(t, gl, margin), want)
+
+
+def test_gap_mask_of_many_gaps_is_small():
+    """10^6 samples, 10^5 gaps: the mask costs O(N + G), not an (N, G) matrix of 10^11 bools."""
+    from cablelab.timebase import Gap, gap_mask
+
+    t = np.arange(1_000_000) * 1e-3
+    gl = [Gap(0, a, a + 2e-3, "recording gap") for a in np.arange(100_000) * 1e-2]
+    keep = gap_mask(t, gl, 0.0)
+    assert keep.shape == t.shape and 0 < (~keep).sum() < t.size
