@@ -310,3 +310,14 @@ def test_a_verb_failing_after_its_check_leaves_no_lock(cli, tmp_path):
     from cablelab.atomic import _HELD
 
     assert _HELD == {}
+
+
+def test_repair_default_output_of_a_bag_mcap_is_beside_the_bag(cli, tmp_path):
+    """`repair run/run.mcap` writes run_repaired next to the bag, never inside it."""
+    bag = tmp_path / "run"
+    shutil.copytree(EMPS, bag)
+    before = tree_snapshot(bag)
+    res = cli("repair", bag / "emps.mcap")
+    assert res.code == 0, res.err
+    assert (tmp_path / "run_repaired" / "metadata.yaml").exists()
+    assert tree_snapshot(bag) == before

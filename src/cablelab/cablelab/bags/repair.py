@@ -22,8 +22,13 @@ from .writer import BagWriter
 
 
 def default_output(path) -> Path:
-    """``run`` -> ``run_repaired`` (a ``.mcap`` file: its name without the suffix)."""
+    """``run`` -> ``run_repaired``; a bag's ``run/run_0.mcap`` -> ``run_repaired`` too (never
+    inside the input bag); a lone ``x.mcap`` -> ``x_repaired`` beside it."""
+    from ..atomic import input_paths
+
     p = Path(path)
+    if p.suffix == ".mcap" and len(input_paths(p)) > 1:   # the .mcap of a bag directory
+        p = p.resolve().parent
     stem = p.stem if p.suffix == ".mcap" else p.name
     return p.with_name(f"{stem}_repaired")
 
