@@ -325,3 +325,17 @@ def test_fuzz_truncation_is_not_damage(tmp_path_factory, cut):
     whole = set().union(*(m for (a, b), m in zip(spans, per_chunk) if b <= n))
     assert whole <= set(got)
     assert all(clean[k] == v for k, v in got.items())
+
+
+def test_split_bag_with_a_damaged_chunk(tmp_path):
+    """Each file of a split bag is checked on its own: a damaged chunk in the second file is
+    named, and --recover keeps the first file and the intact chunks of the second."""
+    bag, _ = _split_bag(tmp_path)
+    mcap = bag / "split_1.mcap"
+    _, b = _chunk_spans(mcap)[-1]
+    _corrupt(mcap, b - 1000, b"\xee" * 300)          # inside the messages of its last chunk
+    with pytest.raises(CablelabError, match="damaged MCAP file: 1 of 2 chunks"):
+        open_bag(bag)
+    got = open_bag(bag, recover=True)
+    assert got.counts[TOPIC] == 4 * PER_CHUNK and got.recovered
+    assert len(got.warnings) == 1 and "skipped 1 damaged chunk of 2" in got.warnings[0]

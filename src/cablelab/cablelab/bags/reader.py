@@ -397,7 +397,10 @@ def open_bag(path, *, recover: bool = False) -> Bag:
         files = [target / f for f in listed] if listed else sorted(target.glob("*.mcap"))
         if len(files) == 1 and files[0].suffix == ".mcap":
             mcap_file = files[0]
-        # several .mcap files (split bag) or sqlite3 (.db3) storage: rosbags' general reader
+        elif len(files) > 1 and all(f.suffix == ".mcap" for f in files):
+            # a split bag: each file read and checked on its own (damaged chunks are named)
+            return _merged(given, files, warnings, recover=recover, expected=expected)
+        # sqlite3 (.db3) storage: rosbags' general reader
     if mcap_file is not None:
         return _open_mcap(given, mcap_file, recover, expected, warnings)
 
