@@ -105,6 +105,23 @@ def test_overwrite_replaces_what_the_verb_wrote(cli, tmp_path, verb):
     assert _no_litter(tmp_path) == []
 
 
+@pytest.mark.parametrize("added", ["notes.txt", "sub/mine.tex"])
+def test_overwrite_keeps_what_the_user_added_to_an_output(cli, tmp_path, added):
+    """An output the verb wrote, with a file of the user's added since: refused, file kept."""
+    out = tmp_path / "out"
+    assert cli(*_verb_args("import", tmp_path, out)).code == 0
+    (out / added).parent.mkdir(exist_ok=True)
+    (out / added).write_text("mine")
+    before = tree_snapshot(out)
+    _refused(cli(*_verb_args("import", tmp_path, out), "--overwrite"), str(out), "did not write",
+             added.split("/")[0])
+    assert tree_snapshot(out) == before
+    (out / added).unlink()           # taken away again: the output is the verb's own once more
+    if "/" in added:
+        (out / added).parent.rmdir()
+    assert cli(*_verb_args("import", tmp_path, out), "--overwrite").code == 0
+
+
 def test_a_bag_of_another_recorder_is_not_replaced(cli, tmp_path):
     """A copy of a shipped bag (no marker: ros2 bag record wrote it) is the user's data."""
     out = tmp_path / "theirs"
@@ -171,13 +188,21 @@ def _make(path: Path, node) -> None:
 
 
 @FUZZ
-@given(tree=st.one_of(st.just({}), _tree), verb=st.sampled_from(["import", "repair"]))
-def test_fuzz_overwrite_never_deletes_what_the_verb_did_not_write(cli, tree, verb):
-    """Random trees of user files at the target: --overwrite refuses (or, for an empty
-    directory, replaces) and no byte the verb did not write is lost."""
+@given(tree=st.one_of(st.just({}), _tree), verb=st.sampled_from(["import", "repair"]),
+       inside_output=st.booleans())
+def test_fuzz_overwrite_never_deletes_what_the_verb_did_not_write(cli, tree, verb, inside_output):
+    """Random trees of user files at the target, or added inside an output the verb wrote:
+    --overwrite refuses (or, for an empty directory, replaces) and no byte the verb did not
+    write is lost."""
     with tempfile.TemporaryDirectory() as d:
         out = Path(d) / "target"
-        _make(out, tree)
+        if inside_output and isinstance(tree, dict):
+            assert cli(*_verb_args(verb, d, out)).code == 0
+            for name, kid in tree.items():
+                if not (out / name).exists():
+                    _make(out / name, kid)
+        else:
+            _make(out, tree)
         before = tree_snapshot(out)
         res = cli(*_verb_args(verb, d, out), "--overwrite")
         if tree == {}:
@@ -321,3 +346,11 @@ def test_repair_default_output_of_a_bag_mcap_is_beside_the_bag(cli, tmp_path):
     assert res.code == 0, res.err
     assert (tmp_path / "run_repaired" / "metadata.yaml").exists()
     assert tree_snapshot(bag) == before
+
+
+def test_batch_never_writes_into_another_verbs_output(cli, fleet_root, tmp_path):
+    out = tmp_path / "rep"
+    assert cli(*_verb_args("import", tmp_path, out)).code == 0
+    before = tree_snapshot(out)
+    _refused(cli("batch", fleet_root, "-o", out), "is the output of cablelab import")
+    assert tree_snapshot(out) == before

@@ -10,9 +10,10 @@ read-only file system or a kill part-way leaves no partial output (the temporary
 errors; a SIGKILL leaves only a hidden ``.NAME.partial-PID`` entry) and the old output intact.
 
 Only what cablelab wrote is ever replaced: every output directory carries the marker file
-:data:`MARKER` (``.cablelab-output``, naming the verb), and ``--overwrite`` replaces a target only
-if it is a real directory holding that marker (or an empty directory). A plain file, a symlink or
-a directory of the user's own is refused with one line naming it; nothing is deleted.
+:data:`MARKER` (``.cablelab-output``: the verb, then every entry it wrote), and ``--overwrite``
+replaces a target only if it is a real directory holding that marker and nothing the marker does
+not list (or an empty directory). A plain file, a symlink, a directory of the user's own or an
+output the user added files to is refused with one line naming it; nothing is deleted.
 
 An input bag given as its ``.mcap`` file counts as its whole bag directory (the directory holding
 the file and its ``metadata.yaml``): an output may not be written inside it.
@@ -60,41 +61,69 @@ def input_paths(inp) -> list[Path]:
     return out
 
 
+def _entries(d: Path) -> list[str]:
+    """Relative paths of every file, directory and link under ``d`` (but the marker)."""
+    return sorted(p.relative_to(d).as_posix() for p in d.rglob("*") if p.name != MARKER or p.parent != d)
+
+
 def write_marker(directory, verb: str) -> None:
-    """Mark ``directory`` as an output cablelab wrote (``verb`` names the writer)."""
-    (Path(directory) / MARKER).write_text(f"{verb}\n", encoding="utf-8")
+    """Mark ``directory`` as an output cablelab wrote: the marker names the verb, then lists
+    every entry the directory holds now (what a later ``--overwrite`` may delete)."""
+    d = Path(directory)
+    (d / MARKER).write_text("".join(f"{line}\n" for line in [verb] + _entries(d)), encoding="utf-8")
 
 
 def marker_of(path) -> str | None:
     """The verb named by the marker of ``path`` (a real directory), or None if it has none."""
+    lines = _marker_lines(path)
+    return (lines[0].strip() or "cablelab") if lines else None
+
+
+def _marker_lines(path) -> list[str] | None:
     p = Path(path)
     m = p / MARKER
     if p.is_symlink() or not p.is_dir() or m.is_symlink() or not m.is_file():
         return None
     try:
-        return m.read_text(encoding="utf-8", errors="replace").strip() or "cablelab"
+        return m.read_text(encoding="utf-8", errors="replace").split("\n")[:-1] or [""]
     except OSError:
         return None
 
 
+def foreign_entries(path) -> list[str]:
+    """Entries under the marked directory ``path`` that its marker does not list (put there by
+    someone else after the verb wrote it); every entry if it has no marker."""
+    p = Path(path)
+    lines = _marker_lines(p)
+    listed = set(lines[1:]) if lines else set()
+    try:
+        return [e for e in _entries(p) if e not in listed]
+    except OSError:
+        return ["?"]
+
+
 def replaceable(path) -> bool:
-    """True if ``--overwrite`` may delete ``path``: a real directory cablelab wrote (marker) or
-    an empty directory."""
+    """True if ``--overwrite`` may delete ``path``: a real directory cablelab wrote (marker) that
+    holds nothing else, or an empty directory."""
     p = Path(path)
     if p.is_symlink() or not p.is_dir():
         return False
-    if marker_of(p) is not None:
-        return True
     try:
-        return not any(p.iterdir())
+        if not any(p.iterdir()):
+            return True
     except OSError:
         return False
+    return marker_of(p) is not None and not foreign_entries(p)
 
 
 def refuse_replacing(target: Path) -> CablelabError:
     """The one-line error for an existing ``target`` that is not a cablelab output."""
     if target.is_symlink():
         what = "is a symbolic link"
+    elif target.is_dir() and marker_of(target) is not None:
+        extra = foreign_entries(target)
+        what = (f"holds {len(extra)} entr{'y' if len(extra) == 1 else 'ies'} cablelab did not write "
+                f"({extra[0]}{', ...' if len(extra) > 1 else ''})")
     elif target.is_dir():
         what = f"is a directory cablelab did not write (no {MARKER} file)"
     else:
@@ -248,7 +277,11 @@ def claim_output_dir(path, *, inputs=(), option: str = "-o", verb: str = "cablel
     taken = lock_target(target)
     try:
         if target.exists() or target.is_symlink():
-            if not replaceable(target):
+            mark = marker_of(target)
+            if mark is not None and mark != verb:
+                raise CablelabError(f"{target}: is the output of cablelab {mark}, not of {verb}; "
+                                    f"choose a new or empty directory")
+            if mark is None and not replaceable(target):   # (adds to it, never deletes)
                 if target.is_dir() and not target.is_symlink():
                     raise CablelabError(f"{target}: is a directory cablelab did not write (no {MARKER} "
                                         f"file); not writing into it (choose a new or empty directory)")

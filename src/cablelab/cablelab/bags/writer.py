@@ -124,6 +124,12 @@ class BagWriter:
         if self._writer is not None:
             self._writer.close()
             self._writer = None
+            import contextlib
+
+            from ..atomic import write_marker
+
+            with contextlib.suppress(OSError):   # (full disk: the marker of open() stays)
+                write_marker(self.path, "bag")   # now also listing metadata.yaml
 
     def __enter__(self) -> "BagWriter":
         return self.open()
