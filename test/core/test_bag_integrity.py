@@ -339,3 +339,14 @@ def test_split_bag_with_a_damaged_chunk(tmp_path):
     got = open_bag(bag, recover=True)
     assert got.counts[TOPIC] == 4 * PER_CHUNK and got.recovered
     assert len(got.warnings) == 1 and "skipped 1 damaged chunk of 2" in got.warnings[0]
+
+
+@pytest.mark.parametrize("info", [5, "text", {"relative_file_paths": "x"}, {"files": 3},
+                                  {"relative_file_paths": ["/etc/passwd", "../other.mcap"]}])
+def test_odd_metadata_is_never_a_traceback(tmp_path, info):
+    """Metadata of another shape than rosbag2's (or listing files outside the bag): the bag's
+    own .mcap is read, or one line; never a traceback, never a file outside the bag."""
+    bag = _chunked_bag(tmp_path / "bag", chunks=2)
+    (bag / "metadata.yaml").write_text(yaml.safe_dump({"rosbag2_bagfile_information": info}))
+    got = open_bag(bag)
+    assert got.counts[TOPIC] == 2 * PER_CHUNK

@@ -428,10 +428,14 @@ def open_bag(path, *, recover: bool = False) -> Bag:
 
 def _listed_files(meta: dict) -> tuple[list[str], int | None, dict[str, int | None]]:
     """(relative file paths, message count, {file: its message count}) of rosbag2 metadata."""
-    info = meta.get("rosbag2_bagfile_information") or {}
-    listed = [str(f) for f in (info.get("relative_file_paths") or []) if isinstance(f, str)]
+    info = meta.get("rosbag2_bagfile_information")
+    info = info if isinstance(info, dict) else {}
+    paths = info.get("relative_file_paths")
+    listed = [f for f in (paths if isinstance(paths, list) else []) if isinstance(f, str)
+              and f and not os.path.isabs(f) and ".." not in Path(f).parts]   # inside the bag only
     per_file = {}
-    for f in info.get("files") or []:
+    files = info.get("files")
+    for f in files if isinstance(files, list) else []:
         if isinstance(f, dict) and isinstance(f.get("path"), str):
             n = f.get("message_count")
             per_file[f["path"]] = n if isinstance(n, int) and n >= 0 else None
