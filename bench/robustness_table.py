@@ -142,15 +142,124 @@ def main() -> int:
             ("repair the killed recording", ["repair", trunc, "-o", d / "repaired"]),
             ("unknown option", ["compare", EMPS, "--frob"]),
         ]
+        cases += output_and_integrity_cases(d)
         print("| case | command | exit | stderr line / warnings |")
         print("|---|---|---|---|")
         for name, argv in cases:
             print(table_row(name, argv, d))
         silent_table(d)
     finally:
+        for p in _HOLDERS:
+            p.kill()
+            p.wait()
         shutil.rmtree(d, ignore_errors=True)
     print()
     return validation_table()
+
+
+# ----------------------------------------------------------------------------- outputs, memory, bag integrity
+# (data loss at output targets, bounds by the data, bags checked against themselves; the tests
+# are test/core/test_output_safety.py, test_bounded_memory.py, test_bag_integrity.py)
+_HOLDERS: list = []
+
+
+def _chunked_emps(dst, per_chunk=500, edit=None):
+    """The EMPS recording rewritten with a flush every ``per_chunk`` messages (50 chunks)."""
+    from cablelab.bags import BagWriter, open_bag
+
+    bag = open_bag(EMPS)
+    js = bag.joint_state("/axis/joint_states")
+    t = js.t.copy() if edit is None else edit(js.t.copy())
+    with BagWriter(dst) as w:
+        w.write_description(bag.description_yaml, t=0.0)
+        for a in range(0, t.size, per_chunk):
+            s = slice(a, a + per_chunk)
+            w.write_joint_states("/axis/joint_states", t[s], js.names, js.position[s], js.velocity[s],
+                                 js.effort[s])
+            w.flush()
+    return dst
+
+
+def output_and_integrity_cases(d: Path) -> list:
+    import subprocess
+
+    import yaml as _yaml
+
+    from cablelab.bags.salvage import _summary
+
+    mydocs = d / "mydocs"
+    (mydocs / "sub").mkdir(parents=True)
+    (mydocs / "thesis.tex").write_text("\\chapter{mine}")
+    precious = d / "precious.txt"
+    precious.write_text("precious")
+    inbag = d / "inbag"
+    shutil.copytree(EMPS, inbag)
+    fleet = d / "fleet"
+    shutil.copytree(EMPS, fleet / "emps")
+    site = d / "site"
+    site.mkdir()
+    (site / "index.html").write_text("<h1>mine</h1>")
+    busy = d / "busy"
+    holder = subprocess.Popen([sys.executable, "-c", "import sys, time; from cablelab.atomic import "
+                               "lock_target; lock_target(sys.argv[1]); print(1, flush=True); time.sleep(600)",
+                               str(busy)], stdout=subprocess.PIPE, text=True)
+    holder.stdout.readline()
+    _HOLDERS.append(holder)
+    jump = axis_bag(d / "jump_1e6", stamps=lambda t: np.where(t > 10, t + 1e6, t), log=True)
+    chunked = _chunked_emps(d / "chunked")
+    mcap = next(chunked.glob("*.mcap"))
+    data = bytearray(mcap.read_bytes())
+    start = _summary(bytes(data))[2][20]
+    data[start + 3000:start + 3400] = np.random.default_rng(0).integers(0, 256, 400, dtype=np.uint8).tobytes()
+    mcap.write_bytes(bytes(data))
+    split = d / "split"
+    split.mkdir()
+    a_bag = _chunked_emps(d / "a_part")
+    shutil.copy(next(a_bag.glob("*.mcap")), split / "split_0.mcap")
+    meta = _yaml.safe_load((a_bag / "metadata.yaml").read_text())
+    info = meta["rosbag2_bagfile_information"]
+    info["relative_file_paths"] = ["split_0.mcap", "split_1.mcap"]
+    info["files"] = [dict(info["files"][0], path="split_0.mcap"),
+                     dict(info["files"][0], path="split_1.mcap", message_count=12000)]
+    info["message_count"] += 12000
+    (split / "metadata.yaml").write_text(_yaml.safe_dump(meta))
+    from cablelab.bags import BagWriter, open_bag
+
+    js = open_bag(EMPS).joint_state("/axis/joint_states")
+    desc = open_bag(EMPS).description_yaml
+    two = d / "two_descriptions"
+    with BagWriter(two) as w:
+        w.write_strings("/plant_description", [0.0, 12.0], [desc, desc.replace("prismatic", "revolute")],
+                        transient_local=True)
+        w.write_joint_states("/axis/joint_states", js.t, js.names, js.position, js.velocity, js.effort)
+    junk = d / "junk_description"
+    with BagWriter(junk) as w:
+        w.write_strings("/plant_description", [0.0], ["hello world"], transient_local=True)
+        w.write_joint_states("/axis/joint_states", js.t, js.names, js.position, js.velocity, js.effort)
+    imp = ["import", d / "x.csv", "--plant", "axis", "--map", "time=t,position=q,effort=f", "--description", DESC]
+    (d / "x.csv").write_text("t,q,f\n" + "\n".join(f"{0.001 * i:.3f},{i},{i}" for i in range(300)))
+    return [
+        ("--overwrite onto a user's directory (thesis.tex, sub/)",
+         ["report", EMPS, "-o", mydocs, "--overwrite"]),
+        ("--overwrite onto a file", ["report", EMPS, "-o", precious, "--overwrite"]),
+        ("output inside the bag of an .mcap input", ["report", inbag / "emps.mcap", "-o", inbag / "rep"]),
+        ("--overwrite of the verb's own output", imp + ["-o", d / "own"]),
+        ("(again, replacing it)", imp + ["-o", d / "own", "--overwrite"]),
+        ("batch OUT = ROOT", ["batch", fleet, "-o", fleet]),
+        ("batch OUT inside ROOT", ["batch", fleet, "-o", fleet / "out"]),
+        ("batch into a user's directory with index.html", ["batch", fleet, "-o", site]),
+        ("output being written by another process", imp + ["-o", busy]),
+        ("1e6 s forward clock jump in a 25 s bag", ["identify", jump, "--json"]),
+        ("--description /dev/zero", ["compare", EMPS, "--description", "/dev/zero"]),
+        ("400 corrupted bytes in one of 50 chunks", ["compare", chunked]),
+        ("(the same, --recover)", ["compare", chunked, "--recover", "--json"]),
+        ("(the same, repair)", ["repair", chunked, "-o", d / "chunked_fixed"]),
+        ("split bag missing one of its 2 files", ["compare", split]),
+        ("(the same, --recover)", ["compare", split, "--recover", "--json"]),
+        ("(the same, repair)", ["repair", split, "-o", d / "split_fixed"]),
+        ("two different /plant_description messages", ["compare", two]),
+        ("/plant_description that is not a mapping", ["compare", junk]),
+    ]
 
 
 # ============================================================ block: contradicting measurements and

@@ -74,7 +74,8 @@ def check_bag(bag, plant, desc, options: dict | None = None, limits: Limits = Li
     if getattr(desc, plant.name, "absent") is None:     # e.g. "axis: null" parses to no section
         raise CablelabError(f"{bag.path}: plant description for plant {plant.name} has no '{plant.name}' "
                             f"section (key {plant.name}: is missing or empty)")
-    if getattr(bag, "recovered", False):
+    out.warnings.extend(getattr(bag, "warnings", ()))    # damaged chunks, missing split files
+    if getattr(bag, "recovered", False) and not getattr(bag, "warnings", ()):
         out.warnings.append(f"{bag.path}: unfinished bag (recorder killed?), read up to its last "
                             f"complete chunk")
     checked = list(plant.topics) + [(t, bag.topics[t]) for t in plant.checked_topics

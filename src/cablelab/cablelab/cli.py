@@ -86,6 +86,10 @@ def main(argv: list[str] | None = None) -> int:
 
         print(f"cablelab {args.verb}: error: {os_error_message(exc.filename or '?', exc)}", file=sys.stderr)
         return 2
+    finally:   # the verb's output locks end with the verb (also when main runs in-process)
+        from .atomic import release_all
+
+        release_all()
 
 
 _ENVIRONMENT_ERRNOS = {errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EACCES, errno.EPERM}

@@ -66,10 +66,44 @@ def is_uniform(t: np.ndarray, max_jitter: float = 0.05) -> bool:
     return bool(med > 0 and np.all(dt > 0) and np.max(np.abs(dt - med)) <= max_jitter * med)
 
 
+#: a step longer than this many grid periods may split the grid (as the time base's gap factor)
+GAP_PERIODS = 5.0
+#: a grid over the whole span may have at most this many points per sample
+GRID_FACTOR = 4.0
+
+
+def segment_grid(t_s: np.ndarray, rate_hz: float) -> np.ndarray:
+    """Uniform grid at ``rate_hz`` over the sorted distinct stamps ``t_s``: one grid over the
+    span if it has at most ``GRID_FACTOR x N`` points, else one per segment, the segments split
+    at the longest steps > :data:`GAP_PERIODS` periods until that bound holds (or at all of them)."""
+    dt = np.diff(t_s)
+    cut = np.zeros(0, dtype=np.int64)
+    excess = (t_s[-1] - t_s[0]) * rate_hz + 1 - GRID_FACTOR * t_s.size
+    if excess > 0:
+        cand = np.flatnonzero(dt > GAP_PERIODS / rate_hz)
+        cand = cand[np.argsort(-dt[cand], kind="stable")]
+        saved = np.cumsum(dt[cand] * rate_hz - 1)
+        k = min(int(np.searchsorted(saved, excess)) + 1, cand.size)
+        cut = np.sort(cand[:k]) + 1
+    first = np.concatenate([[0], cut])
+    last = np.concatenate([cut - 1, [t_s.size - 1]])
+    t0 = t_s[first]
+    counts = np.floor((t_s[last] - t0) * rate_hz + 1e-9).astype(np.int64) + 1
+    offsets = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    k = np.arange(int(counts.sum())) - np.repeat(offsets, counts)
+    return np.repeat(t0, counts) + k / rate_hz
+
+
 def uniform_grid(t: np.ndarray, *signals: np.ndarray, rate_hz: float | None = None):
     """Resample irregularly sampled signals onto a uniform time grid (linear interpolation).
 
     Non-increasing / duplicate stamps are sorted and merged; NaN samples are skipped per column.
+    The grid is bounded by the data, not by the stamps: if one uniform grid over the whole span
+    would have more than :data:`GRID_FACTOR` x N points (e.g. a forward clock jump of 1e6 s), it
+    is split at the longest gaps (steps longer than :data:`GAP_PERIODS` periods) until it has no
+    more, each segment getting its own uniform grid from its first stamp (at most
+    ``GAP_PERIODS x N + segments`` points whatever the stamps say; the samples next to a gap are
+    masked by :func:`cablelab.timebase.gap_mask`).
 
     Args:
         t: (N,) sample times, s.
@@ -87,8 +121,8 @@ def uniform_grid(t: np.ndarray, *signals: np.ndarray, rate_hz: float | None = No
         raise CablelabError("fewer than 2 distinct sample times")
     if rate_hz is None:
         rate_hz = 1.0 / np.median(np.diff(t_s))
-    n = int(np.floor((t_s[-1] - t_s[0]) * rate_hz + 1e-9)) + 1
-    tu = t_s[0] + np.arange(n) / rate_hz
+    tu = segment_grid(t_s, rate_hz)
+    n = tu.size
     out = []
     for s in signals:
         s = np.asarray(s, dtype=float)[order][keep]

@@ -159,11 +159,12 @@ def load_description(src: str | os.PathLike) -> Description:
     text = str(src)
     origin = "description"
     if "\n" not in text and not text.lstrip().startswith(("plant", "{")):
-        if not os.path.exists(text):
-            raise CablelabError(f"{text}: description file not found")
+        from .inputs import DESCRIPTION_MAX_BYTES, check_regular_file
+
+        check_regular_file(text, "description", DESCRIPTION_MAX_BYTES)   # never /dev/zero, a FIFO
         try:
             with open(text, encoding="utf-8") as fh:
-                text = fh.read()
+                text = fh.read(DESCRIPTION_MAX_BYTES + 1)
         except OSError as exc:
             raise CablelabError(f"{src}: cannot read description ({exc.strerror})") from None
         except UnicodeDecodeError as exc:

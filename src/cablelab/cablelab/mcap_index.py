@@ -8,7 +8,9 @@ message's payload position and length in a few vectorised operations, so reading
 one file read plus numpy work. Uncompressed, zstd and lz4 chunks are supported.
 
 :func:`read_index` returns None when a file cannot be read this way (no summary, no chunk
-index, no message indexes, unknown compression); the caller then falls back to a general reader.
+index, no message indexes, unknown compression, or message records that disagree with the index
+about their log time or lie outside the file: damage); the caller then falls back to a general
+reader and, for a damaged file, to :mod:`cablelab.bags.salvage`.
 """
 from __future__ import annotations
 
@@ -153,6 +155,13 @@ def read_index(path) -> Index | None:
                 lens |= arr[rec + 1 + k].astype(np.uint64) << np.uint64(8 * k)
             length = lens.astype(np.int64) - 22  # channel id, sequence, log time, publish time
             offset = rec + 9 + 22
+            if np.any(length < 0) or np.any(offset + length > arr.size):
+                return None   # damaged record lengths: the salvaging reader decides
+            logged = np.zeros(rec.size, dtype=np.uint64)
+            for k in range(8):
+                logged |= arr[rec + 15 + k].astype(np.uint64) << np.uint64(8 * k)
+            if np.any(logged.astype(np.int64) != t):
+                return None   # index and message disagree: damaged chunk or index
         else:
             length = offset = np.zeros(0, np.int64)
         msgtype = schemas.get(sid, "")

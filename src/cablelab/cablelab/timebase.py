@@ -234,7 +234,10 @@ def gap_mask(t, gaps, margin: float = 0.0) -> np.ndarray:
     keep = np.ones(t.shape, dtype=bool)
     if not gaps:
         return keep
-    lo = np.array([g.start for g in gaps]) - margin
-    hi = np.array([g.end for g in gaps]) + margin
-    inside = (t[:, None] > lo[None, :]) & (t[:, None] < hi[None, :])
-    return keep & ~inside.any(axis=1)
+    lo = np.array([g.start for g in gaps], dtype=float) - margin
+    hi = np.array([g.end for g in gaps], dtype=float) + margin
+    order = np.argsort(lo, kind="stable")        # O(N log G), not an (N, G) matrix
+    lo, reach = lo[order], np.maximum.accumulate(hi[order])
+    k = np.searchsorted(lo, t, side="left") - 1  # the last gap starting before t
+    inside = (k >= 0) & (t < reach[np.maximum(k, 0)])
+    return keep & ~inside

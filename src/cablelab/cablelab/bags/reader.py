@@ -53,36 +53,6 @@ def _mcap_truncated(path: Path) -> bool:
         return fh.read(8) != b"\x89MCAP0\r\n"
 
 
-def _read_stream(path: Path) -> tuple[dict[str, str], dict[str, list], dict[str, list]]:
-    """Read the complete records of an unfinished .mcap file (no footer, no index)."""
-    from mcap.records import Channel, Message, Schema
-    from mcap.stream_reader import StreamReader
-
-    topics: dict[str, str] = {}
-    times: dict[str, list] = {}
-    raws: dict[str, list] = {}
-    channels: dict[int, tuple[str, str]] = {}
-    schemas: dict[int, str] = {}
-    with open(path, "rb") as fh:
-        reader = StreamReader(fh, skip_magic=False, emit_chunks=False)
-        try:
-            for rec in reader.records:
-                if isinstance(rec, Schema):
-                    schemas[rec.id] = rec.name
-                elif isinstance(rec, Channel):
-                    channels[rec.id] = (rec.topic, schemas.get(rec.schema_id, ""))
-                    topics[rec.topic] = channels[rec.id][1]
-                    times.setdefault(rec.topic, [])
-                    raws.setdefault(rec.topic, [])
-                elif isinstance(rec, Message) and rec.channel_id in channels:
-                    topic = channels[rec.channel_id][0]
-                    times[topic].append(rec.log_time)
-                    raws[topic].append(bytes(rec.data))
-        except Exception:  # noqa: BLE001 - the truncated tail: keep what was complete
-            pass
-    return topics, times, raws
-
-
 class Bag:
     """An opened bag: topic list, counts, time range and per-topic numpy readers.
 
@@ -91,8 +61,9 @@ class Bag:
         topics: topic name -> message type, e.g. ``'sensor_msgs/msg/JointState'``
         counts: topic name -> number of messages
         start, end: first and last log time, s
-        recovered: True if the bag was unfinished (writer killed) and read up to its last
-            complete record
+        recovered: True if the bag was unfinished (writer killed), damaged or incomplete and
+            only its intact part was read (``--recover``)
+        warnings: what was not read and why (one line each, with counts)
     """
 
     def __init__(self, path, topics: dict[str, str], times: dict[str, np.ndarray], buffer,
@@ -110,6 +81,9 @@ class Bag:
         self.start = float(min(a[0] for a in all_t)) * 1e-9 if all_t else 0.0
         self.end = float(max(a[-1] for a in all_t)) * 1e-9 if all_t else 0.0
         self.recovered = recovered
+        #: integrity findings of the read (damaged chunks skipped, files of a split bag missing,
+        #: message count against metadata.yaml): one line each
+        self.warnings: list[str] = []
         self._cache: dict[object, object] = {}
 
     def __repr__(self) -> str:
@@ -183,23 +157,54 @@ class Bag:
     # ---- description
     @property
     def description_yaml(self) -> str | None:
-        """YAML text of the last /plant_description message, or None."""
+        """YAML text of the /plant_description messages, or None.
+
+        Raises:
+            CablelabError: two messages with different descriptions (naming both log times); a
+                later re-publication of the same content is fine.
+        """
         if self.topics.get(DESCRIPTION_TOPIC) != STRING or not self.counts[DESCRIPTION_TOPIC]:
             return None
-        return self.strings(DESCRIPTION_TOPIC)[-1]
+        texts = self.strings(DESCRIPTION_TOPIC)
+        first = texts[0]
+        for i, text in enumerate(texts):
+            if text != first and not _same_yaml(text, first):
+                t = self._times[DESCRIPTION_TOPIC] * 1e-9
+                raise CablelabError(
+                    f"{self.path}: {DESCRIPTION_TOPIC}: two different descriptions in one bag (messages at "
+                    f"{t[0]:.3f} s and {t[i]:.3f} s); give the right one with --description FILE")
+        return texts[-1]
 
     @property
     def description(self):
-        """The parsed /plant_description (:class:`~cablelab.description.Description`) or None."""
+        """The parsed /plant_description (:class:`~cablelab.description.Description`) or None.
+
+        Raises:
+            CablelabError: the message is not YAML, not a mapping of description keys, or an
+                invalid description (naming the bag, the topic and the problem).
+        """
         text = self.description_yaml
         if text is None:
             return None
+        import yaml
+
         from ..description import load_description
 
+        where = f"{self.path}: {DESCRIPTION_TOPIC}"
         try:
-            return load_description(text)
+            data = yaml.safe_load(text)
+        except yaml.YAMLError as exc:
+            mark = getattr(exc, "problem_mark", None)
+            line = f" (line {mark.line + 1})" if mark is not None else ""
+            raise CablelabError(f"{where}: the message is not valid YAML{line}; give --description FILE") from None
+        if not isinstance(data, dict):
+            shown = " ".join(text.split())[:40]
+            raise CablelabError(f"{where}: the message is not a YAML mapping of description keys "
+                                f"(a {type(data).__name__}: {shown!r}); give --description FILE")
+        try:   # a newline: always read as YAML text, never as a file name
+            return load_description(text if "\n" in text else text + "\n")
         except CablelabError as exc:
-            raise CablelabError(f"{self.path}: {DESCRIPTION_TOPIC}: {exc}") from None
+            raise CablelabError(f"{where}: {exc}") from None
 
     # ---- typed readers
     def joint_state(self, topic: str, names: list[str] | None = None) -> JointStateSeries:
@@ -294,6 +299,16 @@ class Bag:
         return _stamps(self._groups(topic, CLOCK), self.counts[topic], "clock"), self._log_s(topic)
 
 
+def _same_yaml(a: str, b: str) -> bool:
+    """True if two description texts parse to the same data (a re-publication)."""
+    import yaml
+
+    try:
+        return yaml.safe_load(a) == yaml.safe_load(b)
+    except yaml.YAMLError:
+        return False
+
+
 def _names(layout: cdr.Layout, path: str) -> list[str]:
     return [layout.strings[f"{path}[{i}]"] for i in range(layout.seqlen.get(path, 0))]
 
@@ -358,37 +373,36 @@ def open_bag(path, *, recover: bool = False) -> Bag:
     """
     given = Path(path)
     target = _locate(given)
+    warnings: list[str] = []
     mcap_file = target if target.suffix == ".mcap" else None
+    expected = None
     if mcap_file is None:
-        files = sorted(target.glob("*.mcap"))
-        if len(files) == 1:
+        meta = _check_metadata(target)
+        listed, expected, per_file = _listed_files(meta)
+        missing = [f for f in listed if not (target / f).is_file()]
+        if missing:
+            lost = sum(per_file.get(f) or 0 for f in missing)
+            lost_text = f"{lost} messages" if all(per_file.get(f) is not None for f in missing) \
+                else "an unknown number of messages"
+            names = ", ".join(missing[:3]) + (", ..." if len(missing) > 3 else "")
+            what = (f"split bag missing {len(missing)} of its {len(listed)} files listed in metadata.yaml "
+                    f"({names}; {lost_text})")
+            if not recover:
+                raise _bag_error(given, f"{what}; read the files that are there with --recover")
+            warnings.append(f"{given}: {what} not read")
+            present = [target / f for f in listed if (target / f).is_file()]
+            if not present:
+                raise _bag_error(given, f"{what}; no file of the bag is left")
+            return _merged(given, present, warnings, expected=expected and expected - lost)
+        files = [target / f for f in listed] if listed else sorted(target.glob("*.mcap"))
+        if len(files) == 1 and files[0].suffix == ".mcap":
             mcap_file = files[0]
-        # several .mcap files (split bag) or sqlite3 (.db3) storage: rosbags' general reader
-    if mcap_file is not None and (not mcap_file.exists() or mcap_file.stat().st_size == 0):
-        raise _bag_error(mcap_file, "empty MCAP file")
-    if mcap_file is not None and _mcap_truncated(mcap_file):
-        with open(mcap_file, "rb") as fh:
-            if fh.read(8) != b"\x89MCAP0\r\n":
-                raise _bag_error(mcap_file, "not an MCAP file (bad magic bytes)")
-        if not recover:
-            raise _bag_error(mcap_file, "truncated MCAP file (writer killed before closing?); "
-                                        "read its complete part with --recover")
-        topics, times, raws = _read_stream(mcap_file)
-        return _make_bag(given, topics, times, raws, recovered=True)
-    if target.is_dir():
-        _check_metadata(target)
+        elif len(files) > 1 and all(f.suffix == ".mcap" for f in files):
+            # a split bag: each file read and checked on its own (damaged chunks are named)
+            return _merged(given, files, warnings, recover=recover, expected=expected)
+        # sqlite3 (.db3) storage: rosbags' general reader
     if mcap_file is not None:
-        from ..mcap_index import read_index
-
-        try:
-            index = read_index(mcap_file)
-        except (struct.error, ValueError, IndexError, OSError):
-            index = None
-        if index is not None:
-            ti = index.topics
-            return Bag(given, {k: v.msgtype for k, v in ti.items()},
-                       {k: v.log_time for k, v in ti.items()}, index.buffer,
-                       {k: v.offset for k, v in ti.items()}, {k: v.length for k, v in ti.items()})
+        return _open_mcap(given, mcap_file, recover, expected, warnings)
 
     from rosbags.rosbag2 import Reader
 
@@ -404,12 +418,131 @@ def open_bag(path, *, recover: bool = False) -> Bag:
     except CablelabError:
         raise
     except Exception as exc:  # rosbags raises several error types for corrupt files
+        mcaps = sorted(target.glob("*.mcap"))
+        if mcaps:   # a damaged file of a split bag: read each file on its own
+            return _merged(given, mcaps, warnings, recover=recover, expected=expected)
         text = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
         raise _bag_error(given, f"unreadable bag ({text})") from None
     return _make_bag(given, topics, times, raws)
 
 
-def _check_metadata(bag_dir: Path) -> None:
+def _listed_files(meta: dict) -> tuple[list[str], int | None, dict[str, int | None]]:
+    """(relative file paths, message count, {file: its message count}) of rosbag2 metadata."""
+    info = meta.get("rosbag2_bagfile_information")
+    info = info if isinstance(info, dict) else {}
+    paths = info.get("relative_file_paths")
+    listed = [f for f in (paths if isinstance(paths, list) else []) if isinstance(f, str)
+              and f and not os.path.isabs(f) and ".." not in Path(f).parts]   # inside the bag only
+    per_file = {}
+    files = info.get("files")
+    for f in files if isinstance(files, list) else []:
+        if isinstance(f, dict) and isinstance(f.get("path"), str):
+            n = f.get("message_count")
+            per_file[f["path"]] = n if isinstance(n, int) and n >= 0 else None
+    n = info.get("message_count")
+    return listed, (n if isinstance(n, int) and n >= 0 else None), per_file
+
+
+def _read_mcap(given, mcap_file: Path, recover: bool, expected=None):
+    """(topics, times, raws or None, Bag or None, warnings, recovered) of one .mcap file: its
+    fast index when intact, else rosbags, else (``recover``) the intact chunks."""
+    from .salvage import salvage_mcap
+
+    if not mcap_file.exists() or mcap_file.stat().st_size == 0:
+        raise _bag_error(mcap_file, "empty MCAP file")
+    with open(mcap_file, "rb") as fh:
+        if fh.read(8) != b"\x89MCAP0\r\n":
+            raise _bag_error(mcap_file, "not an MCAP file (bad magic bytes)")
+    if _mcap_truncated(mcap_file):
+        if not recover:
+            raise _bag_error(mcap_file, "truncated MCAP file (writer killed before closing?); "
+                                        "read its complete part with --recover")
+        s = salvage_mcap(mcap_file, expected)
+        warn = [f"{given}: {s.describe()}"] if s.damaged else []
+        return s.topics, s.times, s.raws, warn, True
+    from ..mcap_index import read_index
+
+    try:
+        index = read_index(mcap_file)
+    except (struct.error, ValueError, IndexError, OSError):
+        index = None
+    if index is not None:
+        return index, None, None, [], False
+    s = salvage_mcap(mcap_file, expected)   # no usable index: is the file damaged?
+    if s.damaged:
+        if not recover:
+            lost = "an unknown number of" if s.lost is None else s.lost
+            raise _bag_error(given, f"damaged MCAP file: {s.damaged} of {s.chunks} chunks do not decode "
+                                    f"({lost} messages); read the intact chunks with --recover (or "
+                                    f"rewrite them with cablelab repair)")
+        return s.topics, s.times, s.raws, [f"{given}: {s.describe()}"], True
+    try:
+        topics, times, raws = _rosbags_file(mcap_file)
+    except Exception as exc:  # noqa: BLE001 - rosbags raises several error types for corrupt files
+        first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise _bag_error(given, f"unreadable bag ({first})") from None
+    return topics, times, raws, [], False
+
+
+def _rosbags_file(mcap_file: Path):
+    """(topics, times, raws) of one .mcap file through rosbags' general reader."""
+    from rosbags.rosbag2 import Reader
+
+    with Reader(mcap_file) as reader:
+        conns = reader.connections
+        topics = {c.topic: c.msgtype for c in conns}
+        times = {c.topic: [] for c in conns}
+        raws = {c.topic: [] for c in conns}
+        for conn, stamp, data in reader.messages():
+            times[conn.topic].append(stamp)
+            raws[conn.topic].append(bytes(data))
+    return topics, times, raws
+
+
+def _open_mcap(given, mcap_file: Path, recover: bool, expected, warnings: list[str]) -> "Bag":
+    got, times, raws, warn, recovered = _read_mcap(given, mcap_file, recover, expected)
+    if times is None:   # the fast index
+        ti = got.topics
+        bag = Bag(given, {k: v.msgtype for k, v in ti.items()}, {k: v.log_time for k, v in ti.items()},
+                  got.buffer, {k: v.offset for k, v in ti.items()}, {k: v.length for k, v in ti.items()})
+    else:
+        bag = _make_bag(given, got, times, raws, recovered=recovered)
+    bag.warnings = warnings + warn
+    _check_count(bag, expected)
+    return bag
+
+
+def _merged(given, files: list[Path], warnings: list[str], *, recover: bool = True, expected=None) -> "Bag":
+    """One Bag of several .mcap files (a split bag read file by file)."""
+    topics, times, raws, recovered = {}, {}, {}, False
+    for f in files:
+        got, t, r, warn, rec = _read_mcap(given, f, recover)
+        if t is None:   # an Index: back to per-message lists
+            t = {k: v.log_time.tolist() for k, v in got.topics.items()}
+            buf = got.buffer
+            r = {k: [bytes(buf[o:o + n]) for o, n in zip(v.offset.tolist(), v.length.tolist())]
+                 for k, v in got.topics.items()}
+            got = {k: v.msgtype for k, v in got.topics.items()}
+        for k, v in got.items():
+            topics.setdefault(k, v)
+            times.setdefault(k, []).extend(t.get(k, []))
+            raws.setdefault(k, []).extend(r.get(k, []))
+        warnings = warnings + warn
+        recovered = recovered or rec
+    bag = _make_bag(given, topics, times, raws, recovered=recovered or bool(warnings))
+    bag.warnings = warnings
+    _check_count(bag, expected)
+    return bag
+
+
+def _check_count(bag: "Bag", expected) -> None:
+    """A bag holding another number of messages than its metadata.yaml lists: a warning."""
+    n = int(sum(bag.counts.values()))
+    if expected is not None and n != expected and not bag.warnings:
+        bag.warnings.append(f"{bag.path}: metadata.yaml lists {expected} messages, the bag holds {n}")
+
+
+def _check_metadata(bag_dir: Path) -> dict:
     """metadata.yaml must be a rosbag2 bag description (one-line error otherwise)."""
     import yaml
 
@@ -420,6 +553,7 @@ def _check_metadata(bag_dir: Path) -> None:
         raise _bag_error(meta, f"unreadable metadata ({type(exc).__name__})") from None
     if not isinstance(data, dict) or "rosbag2_bagfile_information" not in data:
         raise _bag_error(meta, "not rosbag2 metadata (no rosbag2_bagfile_information)")
+    return data
 
 
 def _make_bag(path, topics, times, raws, recovered: bool = False) -> Bag:
@@ -444,7 +578,11 @@ def bag_info(path, *, recover: bool = False) -> dict:
     "count"}], "plant"}`` (plant = the description's plant id or None)."""
     bag = open_bag(path, recover=recover)
     plant = None
-    text = bag.description_yaml
+    try:
+        text = bag.description_yaml
+    except CablelabError as exc:   # disagreeing descriptions: say so, show the rest
+        text = None
+        bag.warnings.append(str(exc))
     if text is not None:
         import yaml
 
@@ -462,6 +600,8 @@ def bag_info(path, *, recover: bool = False) -> dict:
     }
     if bag.recovered:
         info["recovered"] = True
+    if bag.warnings:
+        info["warnings"] = list(bag.warnings)
     info["contract_mismatches"] = [{"topic": t, "type": have, "contract_type": want}
                                    for t, have, want in bag.contract_mismatches()]
     return info

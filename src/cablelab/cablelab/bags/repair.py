@@ -1,8 +1,10 @@
 """``cablelab repair BAG``: rewrite an unfinished recording (recorder killed: MCAP without footer,
 summary or index, maybe no metadata.yaml) as a complete rosbag2 bag.
 
-The complete records up to the last flushed chunk are read with the bags reader's recover path
-(:func:`~cablelab.bags.reader.open_bag` ``recover=True``) and written again, byte for byte, with
+The complete records up to the last flushed chunk, every intact chunk of a damaged file and
+every file of a split bag that is there are read with the bags reader's recover path
+(:func:`~cablelab.bags.reader.open_bag` ``recover=True``, :mod:`cablelab.bags.salvage`) and
+written again, byte for byte, with
 :meth:`~cablelab.bags.writer.BagWriter.write_raw` in log-time order: the result has a
 ``metadata.yaml``, an MCAP summary and chunk index, and opens in rosbags, the indexed ``mcap``
 reader and every cablelab verb. The output appears whole or not at all (:mod:`cablelab.atomic`).
@@ -20,8 +22,13 @@ from .writer import BagWriter
 
 
 def default_output(path) -> Path:
-    """``run`` -> ``run_repaired`` (a ``.mcap`` file: its name without the suffix)."""
+    """``run`` -> ``run_repaired``; a bag's ``run/run_0.mcap`` -> ``run_repaired`` too (never
+    inside the input bag); a lone ``x.mcap`` -> ``x_repaired`` beside it."""
+    from ..atomic import input_paths
+
     p = Path(path)
+    if p.suffix == ".mcap" and len(input_paths(p)) > 1:   # the .mcap of a bag directory
+        p = p.resolve().parent
     stem = p.stem if p.suffix == ".mcap" else p.name
     return p.with_name(f"{stem}_repaired")
 
@@ -34,7 +41,9 @@ def repair_bag(path, out=None, *, overwrite: bool = False) -> dict:
         out: bag directory to create (default :func:`default_output`); never the input.
         overwrite: replace an existing ``out``.
     Returns:
-        ``{"bag", "source", "recovered", "messages", "topics": {topic: count}, "duration"}``.
+        ``{"bag", "source", "recovered", "messages", "topics": {topic: count}, "duration",
+        "warnings"}``; ``warnings`` says what could not be saved (damaged chunks skipped, files of
+        a split bag missing, with counts): the output then holds only the intact part.
     Raises:
         CablelabError: unreadable input, nothing to recover, unwritable output (one line).
     """
@@ -56,11 +65,12 @@ def repair_bag(path, out=None, *, overwrite: bool = False) -> dict:
     t_all = np.concatenate(times)
     k_all = np.concatenate(order_topic)
     order = np.argsort(t_all, kind="stable")          # one log-time order over all topics
-    with atomic_output(out, overwrite=overwrite, inputs=[path], option="-o") as tmp:
+    with atomic_output(out, overwrite=overwrite, inputs=[path], option="-o", verb="repair") as tmp:
         with BagWriter(tmp) as w:
             for topic in topics:
                 w.add_topic(topic, bag.topics[topic], transient_local=topic == DESCRIPTION_TOPIC)
             for i in order.tolist():                  # one write per message: the writer's API
                 w.write_raw(topics[k_all[i]], int(t_all[i]), payloads[i])
     return {"bag": str(out), "source": str(path), "recovered": bool(bag.recovered), "messages": total,
-            "topics": {t: bag.counts[t] for t in topics}, "duration": bag.end - bag.start}
+            "topics": {t: bag.counts[t] for t in topics}, "duration": bag.end - bag.start,
+            "warnings": list(bag.warnings)}

@@ -81,8 +81,10 @@ class BagWriter:
 
     Args:
         path: bag directory to create
-        overwrite: replace an existing bag directory; without it an existing path is an error and
-            nothing is touched. A path that exists but is not a bag is never replaced.
+        overwrite: replace an existing bag directory cablelab wrote (it carries the marker
+            :data:`cablelab.atomic.MARKER`, written into every bag on open); without it an
+            existing path is an error and nothing is touched. Anything else (a bag of another
+            recorder, a user's directory, a file) is never replaced.
     """
 
     def __init__(self, path, overwrite: bool = False):
@@ -92,8 +94,11 @@ class BagWriter:
         if self.path.exists():
             if not overwrite:
                 raise _bag_error(self.path, "exists already (use --overwrite to replace it)")
-            if not _looks_like_bag(self.path):
-                raise _bag_error(self.path, "exists and is not a bag; not overwriting it")
+            from ..atomic import MARKER, replaceable
+
+            if not replaceable(self.path):
+                raise _bag_error(self.path, f"exists and is not a bag cablelab wrote (no {MARKER}); "
+                                            f"not overwriting it")
             if self.path.is_dir():
                 shutil.rmtree(self.path)
             else:
@@ -108,14 +113,23 @@ class BagWriter:
 
         if not self.path.parent.exists():
             raise _bag_error(self.path, f"parent directory {self.path.parent} does not exist")
+        from ..atomic import write_marker
+
         self._writer = Writer(self.path, version=9, storage_plugin=StoragePlugin.MCAP)
         self._writer.open()
+        write_marker(self.path, "bag")   # what cablelab wrote, it may replace with overwrite
         return self
 
     def close(self) -> None:
         if self._writer is not None:
             self._writer.close()
             self._writer = None
+            import contextlib
+
+            from ..atomic import write_marker
+
+            with contextlib.suppress(OSError):   # (full disk: the marker of open() stays)
+                write_marker(self.path, "bag")   # now also listing metadata.yaml
 
     def __enter__(self) -> "BagWriter":
         return self.open()
@@ -337,11 +351,3 @@ class BagWriter:
             if arr is not None:
                 fills.update(_axes_fills(f"points[0].{path}", arr))
         self._write_encoded(topic, MULTIDOF_TRAJECTORY, tmpl, fills, self._log(ns, log_time))
-
-
-def _looks_like_bag(path: Path) -> bool:
-    if path.is_dir():
-        entries = list(path.iterdir())
-        return not entries or (path / "metadata.yaml").exists() or any(
-            e.suffix == ".mcap" for e in entries)
-    return path.suffix == ".mcap"

@@ -38,6 +38,23 @@ def run(args) -> int:
 
     if args.workers is not None and args.workers < 1:
         raise CablelabError(f"--workers {args.workers}: must be at least 1")
+    from ..atomic import claim_output_dir, release_target
+
+    # OUT is checked against ROOT and locked for the whole run (diagnosis and report)
+    taken = claim_output_dir(args.out, inputs=[args.root], option="-o", verb="batch")
+    try:
+        return _run(args)
+    finally:
+        if taken:
+            release_target(args.out)
+
+
+def _run(args) -> int:
+    from ..fleet import analyse
+    from ..fleet.engine import run_batch
+    from ..fleet.report import summary, write_report
+    from ..model import parse_effect_list
+
     res = run_batch(args.root, args.out, effects=parse_effect_list(args.effects), greedy=args.greedy,
                     folds=args.folds, scheduler=args.scheduler, workers=args.workers,
                     group_by=args.group_by, reports=args.reports, progress=not args.json)

@@ -73,7 +73,8 @@ def run(args) -> int:
     accepted = inspect.signature(fn).parameters
     if not any(p.kind == p.VAR_KEYWORD for p in accepted.values()):
         kwargs = {k: v for k, v in kwargs.items() if k in accepted}
-    writing = atomic_output(args.out, overwrite=args.overwrite, inputs=[args.bag, args.description]) \
+    writing = atomic_output(args.out, overwrite=args.overwrite, inputs=[args.bag, args.description],
+                           verb="estimate") \
         if args.out else contextlib.nullcontext(None)
     with writing as tmp:   # the estimates bag appears whole under --out, or not at all
         if tmp is not None:

@@ -265,7 +265,7 @@ def run(args) -> int:
 
     tb = check_stamps(s["t"], topic=f"{args.file}: time column", limits=limits_from_args(args))
     raise_if_impossible(tb)                 # stamps in ms: refuse with the --map fix
-    with atomic_output(args.out, overwrite=args.overwrite, inputs=inputs, option="-o") as tmp:
+    with atomic_output(args.out, overwrite=args.overwrite, inputs=inputs, option="-o", verb="import") as tmp:
         with BagWriter(tmp) as w:
             w.write_description(desc.to_yaml(), t=float(s["t"][0]))
             w.write_joint_states(s["topic"], s["t"], s["names"], s["position"], s["velocity"], s["effort"])

@@ -26,6 +26,8 @@ def run(args) -> int:
             print(f"  {t['name']:<40} {t['type']:<40} {t['count']:>9}")
         if info.get("recovered"):
             print("note:     unfinished bag, read up to its last complete chunk")
+        for w in info.get("warnings", []):
+            print(f"warning:  {w}")
         for m in info.get("contract_mismatches", []):
             print(f"warning:  {m['topic']} has type {m['type']}, the contract says {m['contract_type']}")
         if info.get("plant"):

@@ -22,7 +22,10 @@ def run(args) -> int:
     if args.json:
         print(dump_json(info))
     else:
-        state = "unfinished" if info["recovered"] else "complete"
+        for w in info["warnings"]:
+            print(f"warning: {w}")
+        state = "damaged or incomplete: only its intact part was saved" if info["warnings"] else \
+            "unfinished" if info["recovered"] else "complete"
         print(f"wrote {info['bag']}: {info['messages']} messages on {len(info['topics'])} topics over "
               f"{info['duration']:.3f} s (input was {state})")
     return 0

@@ -34,7 +34,7 @@ def run(args) -> int:
     inputs = [args.bag, args.description]
     check_target(args.out, overwrite=args.overwrite, inputs=inputs, option="-o")  # before the work
     plant, desc, ds, model = load_from_args(args)
-    with atomic_output(args.out, overwrite=args.overwrite, inputs=inputs, option="-o") as tmp:
+    with atomic_output(args.out, overwrite=args.overwrite, inputs=inputs, option="-o", verb="report") as tmp:
         res = build_report(ds, model, plant.candidates(desc), str(tmp), folds=args.folds,
                            title=f"cablelab report: {desc.name or plant.name}", quiet=args.json,
                            warnings=getattr(args, "warnings", ()), overlay="overlay")

@@ -86,12 +86,26 @@ def run_batch(root, out, *, effects=(), greedy: bool = False, folds: int = 5, sc
     """Diagnose every bag under ``root`` into ``out`` (the dashboard link always goes to stderr,
     the progress bar when ``progress``); returns ``{"refs", "hashes", "ran",
     "skipped", "table", "seconds", "dashboard"}`` (the table: :mod:`cablelab.fleet.table`).
-    ``max_group``: most bags per task (default :data:`MAX_GROUP`; 1: one task per bag)."""
+    ``max_group``: most bags per task (default :data:`MAX_GROUP`; 1: one task per bag).
+
+    ``out`` may not be, contain or lie inside ``root``; an existing ``out`` must be empty or an
+    earlier batch output (marker file); it is locked against a second batch for the run
+    (:func:`cablelab.atomic.claim_output_dir`)."""
+    from ..atomic import claim_output_dir, release_target
+
     out = Path(out)
+    taken = claim_output_dir(out, inputs=[root], option="-o", verb="batch")
     try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise CablelabError(f"{out}: cannot create output directory ({exc.strerror})") from None
+        return _run_batch(root, out, effects=effects, greedy=greedy, folds=folds, scheduler=scheduler,
+                          workers=workers, group_by=group_by, reports=reports, progress=progress,
+                          client=client, max_group=max_group)
+    finally:
+        if taken:
+            release_target(out)
+
+
+def _run_batch(root, out: Path, *, effects, greedy, folds, scheduler, workers, group_by, reports,
+               progress, client, max_group) -> dict:
     refs = find_bags(root, group_by)
     t0 = time.monotonic()
     own = client is None

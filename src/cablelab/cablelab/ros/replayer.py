@@ -5,6 +5,9 @@ bytes, no re-encoding), paced by the bag's log times divided by ``rate``. ``/pla
 is published first on a transient-local publisher (late joiners still get it). ``/clock``: a bag
 that recorded /clock is replayed as recorded; otherwise the node publishes /clock itself (the
 log time being replayed, every ``clock_period`` s) so ``use_sim_time`` nodes follow the replay.
+A gap in the log times (a forward clock jump, a long pause) is not waited through: it is replayed
+as one typical step, with one warning, and the /clock published jumps over it
+(:mod:`cablelab.pacing`).
 """
 from __future__ import annotations
 
@@ -15,6 +18,7 @@ import time
 from rclpy.node import Node
 
 from ..bags import CLOCK_TOPIC, DESCRIPTION_TOPIC, open_bag
+from ..pacing import replay_times
 from .convert import clock_msg, message_class
 from .qos import DESCRIPTION_QOS, stream_qos
 
@@ -54,6 +58,11 @@ class ReplayNode(Node):
         self.schedule = list(heapq.merge(*per_topic))
         self.raws = {t: bag.raw(t)[1] for t in streams}
         self.t0_bag = self.schedule[0][0] if self.schedule else 0
+        # when each message is due (gaps shortened: a clock jump is not slept through)
+        due, self.gaps = replay_times([ns for ns, _, _ in self.schedule])
+        self.due = due.tolist()
+        if self.gaps.count:
+            self.get_logger().warning(f"{bag_path}: {self.gaps.warning()}")
         self.own_clock = CLOCK_TOPIC not in bag.topics
         if self.own_clock:
             from rosgraph_msgs.msg import Clock
@@ -79,9 +88,12 @@ class ReplayNode(Node):
             self.t0_wall = now
         horizon = self.t0_bag + int((now - self.t0_wall) * self.rate * 1e9)
         sched, n = self.schedule, len(self.schedule)
-        while self.i < n and sched[self.i][0] <= horizon:
+        due = self.due
+        while self.i < n and due[self.i] <= horizon:
             ns, topic, k = sched[self.i]
             if self.own_clock:
+                if ns - self.next_clock > self.gaps.threshold_ns > 0:
+                    self.next_clock = ns          # a gap: the clock jumps over it
                 while self.next_clock <= ns:
                     self.clock_pub.publish(clock_msg(self.next_clock * 1e-9))
                     self.next_clock += self.clock_period_ns
@@ -91,7 +103,7 @@ class ReplayNode(Node):
             self.published += 1
         if not self.quiet and now - self.last_report > 5.0:
             self.last_report = now
-            left = (sched[-1][0] - horizon) * 1e-9 / self.rate if n else 0.0
+            left = (due[-1] - horizon) * 1e-9 / self.rate if n else 0.0
             print(f"replay: {self.i}/{n} messages, about {max(left, 0):.0f} s left", file=sys.stderr,
                   flush=True)
         if self.i >= n:
