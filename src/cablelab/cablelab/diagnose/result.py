@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 #: keys of a ranking row that are part of the JSON, in order (contract keys first)
 ROW_KEYS = ("effect", "error_before", "error_after", "params", "significant", "stderr", "units",
             "p_value", "delta_bic", "n_eff", "gain", "channels", "evidence", "identifiability",
-            "explanation")
+            "ambiguous_with", "ambiguity", "explanation")
 
 
 @dataclass(frozen=True)
@@ -58,11 +58,15 @@ class Step:
     stderr: dict
     units: dict
     ranking: list
+    note: str | None = None
 
     def to_json(self) -> dict:
-        return {"effects": self.effects, "added": self.added, "error": self.error,
-                "params": self.params, "stderr": self.stderr, "units": self.units,
-                "ranking": [c.to_json() for c in self.ranking]}
+        out = {"effects": self.effects, "added": self.added, "error": self.error,
+               "params": self.params, "stderr": self.stderr, "units": self.units,
+               "ranking": [c.to_json() for c in self.ranking]}
+        if self.note:
+            out["note"] = self.note
+        return out
 
 
 @dataclass(frozen=True)
@@ -100,17 +104,36 @@ class Diagnosis:
             after = "-" if c.error_after is None else f"{100 * c.error_after:.2f} %"
             mark = "*" if c.significant else " "
             out.append(f" {mark}{i}. {c.effect:<26} -> {after:>9}  {c.explanation or ''}")
+        out.extend(ambiguity_lines(self.ranking))
         for s in self.greedy[1:]:
-            out.append(f"  + {s.added:<26} held-out NRMSE {100 * s.error:.2f} %")
+            out.append(f"  + {s.added:<26} held-out NRMSE {100 * s.error:.2f} %"
+                       + (f"  ({s.note})" if s.note else ""))
         if self.final is not None:
             out.append("final: " + ", ".join(f"{k} = {v:.6g}" for k, v in self.final.params.items()))
         return out
 
 
+def ambiguity_lines(ranking) -> list[str]:
+    """One line per group of ambiguous candidates (ranking rows or :class:`Candidate`): the data
+    cannot tell them apart, so none of them is the answer."""
+    out, seen = [], set()
+    for c in ranking:
+        row = c.to_json() if isinstance(c, Candidate) else c
+        others = row.get("ambiguous_with") or []
+        group = tuple(sorted({row["effect"], *others}))
+        if not others or group in seen:
+            continue
+        seen.add(group)
+        out.append(f"ambiguous: {' and '.join([row['effect'], *others])} explain the same residual "
+                   "within noise; this recording cannot tell them apart, so the ranking names no "
+                   "winner among them")
+    return out
+
+
 def step_from_dict(s: dict) -> Step:
     return Step(effects=list(s["effects"]), added=s["added"], error=s["error"], params=s["params"],
                 stderr=s["stderr"], units=s["units"],
-                ranking=[Candidate.from_row(r) for r in s["ranking"]])
+                ranking=[Candidate.from_row(r) for r in s["ranking"]], note=s.get("note"))
 
 
-__all__ = ["Candidate", "Diagnosis", "Step", "step_from_dict"]
+__all__ = ["Candidate", "Diagnosis", "Step", "ambiguity_lines", "step_from_dict"]

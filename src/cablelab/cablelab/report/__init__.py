@@ -111,6 +111,10 @@ def build_report(ds: Dataset, model: Model, candidates, out_dir, *, folds: int =
              "yes" if r["significant"] else "no", _num(r.get("p_value"), "{:.2g}"),
              html.escape(r["explanation"])] for r in steps[0]["ranking"]]
     parts.append(_table(rows, ["effect", "held-out NRMSE with it", "significant", "p", "explanation"]))
+    from ..diagnose.result import ambiguity_lines
+
+    parts.extend(f"<p class='warnings'>{html.escape(line)}</p>"
+                 for line in ambiguity_lines(steps[0]["ranking"]))
     parts.append("<h2>Parameters of the final model</h2>")
     rows = [[html.escape(r["name"]), _num(r["value"], "{:.6g}"), _num(r["stderr"], "{:.2g}"),
              html.escape(r["unit"]), "fixed" if r["fixed"] else ""] for r in fin.table()]
