@@ -263,6 +263,14 @@ def rank_candidates(model: Model, ds: Dataset, candidates, *, folds: int = FOLDS
                          "significant": False, "explanation": f"{c}: cannot be fitted ({exc})"})
             prog.step(c)
             continue
+        own_held = [k for k in full.held if k not in base_full.held]
+        if own_held and set(own_held) >= {p.name for p in get_effect(c).columns(ds)}:
+            rows.append({"effect": c, "error_before": err0, "error_after": err1, "params": {},
+                         "significant": False, "held": own_held,
+                         "explanation": f"{c}: not excited by this recording ({', '.join(own_held)} "
+                                        "cannot be determined from it)"})
+            prog.step(c)
+            continue
         sig = lr_significance(base_full, full, len(cands), alpha)
         gain, changed = practical_gain(ym0, yh0, ym1, yh1)
         significant = bool(sig["passes"] and gain >= min_gain and err1 < err0)
@@ -271,7 +279,7 @@ def rank_candidates(model: Model, ds: Dataset, candidates, *, folds: int = FOLDS
                "stderr": {k: full.stderr.get(k, 0.0) for k in own},
                "units": {k: full.units.get(k, "") for k in own},
                "significant": significant, "p_value": sig["p_value"], "delta_bic": sig["delta_bic"],
-               "n_eff": sig["n_eff"], "gain": gain,
+               "n_eff": sig["n_eff"], "gain": gain, **({"held": own_held} if own_held else {}),
                "channels": dict(zip(ds.channels, map(float, channel_nrmse(ym1, yh1))))}
         from .identifiability import confounding, describe
 

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 #: keys of a ranking row that are part of the JSON, in order (contract keys first)
 ROW_KEYS = ("effect", "error_before", "error_after", "params", "significant", "stderr", "units",
             "p_value", "delta_bic", "n_eff", "gain", "channels", "evidence", "identifiability",
-            "ambiguous_with", "ambiguity", "explanation")
+            "ambiguous_with", "ambiguity", "held", "explanation")
 
 
 @dataclass(frozen=True)
@@ -79,6 +79,8 @@ class Diagnosis:
     ranking: list
     folds: int
     greedy: list = field(default_factory=list)
+    held: dict = field(default_factory=dict)
+    held_warning: str | None = None
 
     @property
     def final(self) -> Step | None:
@@ -89,6 +91,9 @@ class Diagnosis:
         out = {"plant": self.plant,
                "baseline": {"effects": self.baseline_effects, "error": self.baseline_error},
                "ranking": [c.to_json() for c in self.ranking], "folds": self.folds}
+        if self.held:
+            out["held"] = dict(self.held)
+            out["held_warnings"] = [self.held_warning]
         if self.greedy:
             out["greedy"] = [s.to_json() for s in self.greedy]
             f = self.final

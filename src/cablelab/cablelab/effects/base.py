@@ -65,6 +65,10 @@ class Effect:
             (must set ``valid`` False where the result is undefined).
         derived: optional ``fn(effect, own, all_params, ds) -> {name: value}``: values reported
             beside the fitted parameters (e.g. the contract's F_s, v_s of a Stribeck effect).
+        described: optional ``fn(ds) -> {param name: value}``: the values the plant description
+            gives the effect's parameters (e.g. the levelling gains of a suspended platform's
+            parameter set); a parameter the data do not excite is held there (else at its
+            ``Param.nominal``, the effect's neutral value).
         requires: a capability the plant must declare (:attr:`cablelab.registry.Plant.
             capabilities`, e.g. ``"joint_actuators"``); ``None`` = no requirement.
     """
@@ -81,6 +85,7 @@ class Effect:
     transform: TransformFn | None = None
     requires: str | None = None
     derived: Callable | None = None
+    described: Callable | None = None
 
     def applies_to(self, plant: str, capabilities=frozenset()) -> bool:
         """Whether the effect applies to ``plant`` with these capabilities."""

@@ -18,7 +18,7 @@ import scipy.linalg
 
 from ..errors import CablelabError
 from ..model import Dataset, Model, Param
-from .linear import LinearFit, solve_linear
+from .linear import LinearFit, RankDeficient, solve_linear, unexcited_columns
 
 #: grid points per nonlinear parameter for the start of the outer search
 OUTER_GRID = 11
@@ -56,10 +56,22 @@ class Identification:
     extra: dict = field(default_factory=dict)
 
     def table(self) -> list[dict]:
-        """[{name, value, stderr, unit, fixed}] in model order."""
+        """[{name, value, stderr, unit, fixed}] in model order (``held`` added, True, for a
+        parameter the data did not excite, held at its description or neutral value)."""
+        held = self.extra.get("held") or {}
         return [{"name": k, "value": float(v), "stderr": float(self.stderr.get(k, 0.0)),
-                 "unit": self.units.get(k, ""), "fixed": k in self.fixed}
+                 "unit": self.units.get(k, ""), "fixed": k in self.fixed,
+                 **({"held": True} if k in held else {})}
                 for k, v in self.params.items()]
+
+    @property
+    def held(self) -> dict:
+        """name -> value of the parameters held because the data did not excite them."""
+        return dict(self.extra.get("held") or {})
+
+    def held_warning(self) -> str | None:
+        """One warning line naming the held parameters (None when nothing is held)."""
+        return held_warning(self.held, self.units)
 
     def effect_params(self, effect_id: str, ds: Dataset) -> dict:
         """The parameters belonging to one effect, by name."""
@@ -93,7 +105,7 @@ def _weighted_residual(fit: LinearFit, phi, lhs, valid) -> np.ndarray:
     return np.where(valid[:, None], r, 0.0).reshape(-1)
 
 
-def identify(model: Model, ds: Dataset, *, on_deficient: str = "raise",
+def identify(model: Model, ds: Dataset, *, on_deficient: str | None = None,
              outer_grid: int = OUTER_GRID, start: Mapping[str, float] | None = None,
              channel_scale=None) -> Identification:
     """Fit the model's free parameters to the dataset.
@@ -101,7 +113,10 @@ def identify(model: Model, ds: Dataset, *, on_deficient: str = "raise",
     Args:
         model: plant + effects + fixed parameters.
         ds: conditioned dataset of the same plant.
-        on_deficient: ``"raise"`` (default) or ``"base"`` (regroup to base parameters).
+        on_deficient: what to do with a rank-deficient regressor: ``"raise"``, ``"base"``
+            (regroup to base parameters) or ``"hold"`` (hold the parameters the data do not
+            excite at their description or neutral values, :func:`hold_unexcited`; they are
+            listed in ``extra["held"]`` and ``fixed``); default: the model's ``unexcited``.
         outer_grid: grid points per nonlinear parameter for the outer search start.
         start: start values of the nonlinear parameters (e.g. the full-record fit when fitting
             cross-validation folds); skips the grid.
@@ -112,13 +127,79 @@ def identify(model: Model, ds: Dataset, *, on_deficient: str = "raise",
     Raises:
         CablelabError: too few samples, rank-deficient regressor (names the directions).
     """
+    policy = on_deficient or model.unexcited
+    if policy == "hold":
+        return _identify_holding(model, ds, outer_grid=outer_grid, start=start,
+                                 channel_scale=channel_scale)
+    return _identify_once(model, ds, on_deficient=policy, outer_grid=outer_grid, start=start,
+                          channel_scale=channel_scale)
+
+
+def held_value(model: Model, ds: Dataset, name: str) -> float:
+    """The value a parameter the data do not excite is held at: the description's
+    (``Effect.described``), else the parameter's nominal (the effect's neutral value)."""
+    for e in model.effect_units():
+        for p in e.columns(ds):
+            if p.name == name:
+                if e.described is not None:
+                    val = e.described(ds).get(name)
+                    if val is not None:
+                        return float(val)
+                return float(p.nominal)
+    raise KeyError(name)
+
+
+def hold_unexcited(model: Model, ds: Dataset, nl: Mapping[str, float] | None = None) -> dict:
+    """``{name: value}`` of the free linear parameters to hold so the rest of the model has a
+    full-rank regressor on ``ds`` (:func:`~cablelab.fit.linear.unexcited_columns`, evaluated
+    with the nonlinear parameters at ``nl`` or nominal), each at :func:`held_value`."""
+    ds2 = model.apply_nonlinear(ds, dict(nl or {}))
+    phi, cols, y_known = model.regressor(ds2)
+    idx = unexcited_columns(phi, ds2.y - y_known, cols, valid=ds2.valid)
+    return {cols[i].name: held_value(model, ds, cols[i].name) for i in idx}
+
+
+def _identify_holding(model: Model, ds: Dataset, **kw) -> Identification:
+    held: dict[str, float] = {}
+    current = model
+    for _ in range(len(model.effects) * 64 + 1):
+        try:
+            r = _identify_once(current, ds, on_deficient="raise", **kw)
+        except RankDeficient:
+            more = hold_unexcited(current, ds, kw.get("start"))
+            if not more:
+                raise
+            held.update(more)
+            current = model.with_effects(model.effects, {**model.fixed, **held})
+            continue
+        r.model = model
+        r.extra["held"] = dict(held)
+        return r
+    raise RankDeficient(f"rank-deficient fit: holding the unexcited parameters "
+                        f"{', '.join(held)} did not leave a full-rank model")
+
+
+def held_warning(held: Mapping[str, float], units: Mapping[str, str] | None = None) -> str | None:
+    """One warning line naming the held parameters and their values, or None."""
+    if not held:
+        return None
+    units = units or {}
+    vals = ", ".join(f"{k} = {v:.6g}{(' ' + units[k]) if units.get(k) else ''}"
+                     for k, v in held.items())
+    return (f"not excited by this recording (rank-deficient fit), held at their description or "
+            f"neutral values: {vals}; record motion that excites them, or --strict to refuse")
+
+
+def _identify_once(model: Model, ds: Dataset, *, on_deficient: str = "raise",
+                   outer_grid: int = OUTER_GRID, start: Mapping[str, float] | None = None,
+                   channel_scale=None) -> Identification:
     if ds.plant != model.plant:
         raise CablelabError(f"dataset of plant {ds.plant} given to a {model.plant} model")
     if channel_scale is None:
         channel_scale = "rms"
         if ds.n_channels > 1:
-            first = identify(model, ds, on_deficient=on_deficient, outer_grid=outer_grid,
-                             start=start, channel_scale="rms")
+            first = _identify_once(model, ds, on_deficient=on_deficient, outer_grid=outer_grid,
+                                   start=start, channel_scale="rms")
             channel_scale = noise_weights(first.residual)
             start = {p.name: first.params[p.name] for p in model.nonlinear_params()} or start
     nl_params = model.nonlinear_params()

@@ -54,7 +54,7 @@ def build_report(ds: Dataset, model: Model, candidates, out_dir, *, folds: int =
     except OSError as exc:
         raise CablelabError(f"{out_dir}: cannot create report directory ({exc.strerror})") from None
     steps = greedy(model, ds, candidates, folds=folds, quiet=quiet)
-    final_model = Model(model.plant, tuple(steps[-1]["effects"]), model.fixed)
+    final_model = model.with_effects(steps[-1]["effects"])
     base = identify(model, ds)
     fin = identify(final_model, ds)
     y_meas = np.where(fin.valid[:, None], fin.residual + fin.y_hat, np.nan)
@@ -99,8 +99,7 @@ def build_report(ds: Dataset, model: Model, candidates, out_dir, *, folds: int =
     for i, st in enumerate(steps):
         if i == 0:
             continue  # the nominal residual is plotted below
-        ident_i = fin if i == len(steps) - 1 else identify(Model(model.plant, tuple(st["effects"]),
-                                                                 model.fixed), ds)
+        ident_i = fin if i == len(steps) - 1 else identify(model.with_effects(st["effects"]), ds)
         name = f"step_{i}_residual.png"
         plots.residual_time(fig(name), ds.t, ident_i.residual, [], ds.channels, ds.units,
                             f"step {i}: + {st['added']} (held-out NRMSE {100 * st['error']:.2f} %)")

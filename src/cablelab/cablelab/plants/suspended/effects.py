@@ -153,6 +153,15 @@ def _suspension(ds: Dataset) -> np.ndarray:
     return b
 
 
+def _described_gains(ds: Dataset, names) -> dict:
+    """The description's virtual-joint gains (its parameter set, 000 Table 5 / repo) by name."""
+    sec = getattr(ds.description, "suspended", None) if ds.description is not None else None
+    if sec is None:
+        return {}
+    p = sec.params()
+    return {n: float(getattr(p, n)) for n in names}
+
+
 _P = ("suspended",)
 SUSPENDED_EFFECTS = (
     register(Effect(
@@ -221,7 +230,8 @@ SUSPENDED_EFFECTS = (
         explanation="the platform is levelled by a finite-gain PD on J11/J12 (not held exactly "
                     "level): its tilt pushes back on the cable",
         signature="platform roll/pitch from the pose tracks the swing; swing period off by a few %",
-        reference="000 eq. 2, sec. 4 (J11/J12 virtual PD); spec 000 sec. 4.3, 7", regressor=_levelling)),
+        reference="000 eq. 2, sec. 4 (J11/J12 virtual PD); spec 000 sec. 4.3, 7", regressor=_levelling,
+        described=lambda ds: _described_gains(ds, ("kp11", "kp12", "kd11", "kd12")))),
     register(Effect(
         id="suspension_motion", plants=_P,
         params=(Param("ml_x", "kg m", 5.0, 0.0, np.inf, "static moment about S moved by a_S (swing_x)"),
