@@ -205,7 +205,7 @@ def identify(ds: Dataset, model: Model, *, folds: int = FOLDS, simulation: str |
     cv = cv_error(model, ds, folds)[0] if folds else None
     out = {
         "plant": ds.plant, "effects": list(model.effects), "samples": int(ident.valid.sum()),
-        "params": _effect_table(ident),
+        "params": None,
         "fit": {"nrmse": _mean_nrmse(mets), "cv_nrmse": cv, "folds": folds,
                 "channels": dict(zip(ds.channels, mets)), "rank": ident.linear.rank,
                 "parameters": len(ident.linear.names), "condition": ident.linear.cond,
@@ -213,6 +213,11 @@ def identify(ds: Dataset, model: Model, *, folds: int = FOLDS, simulation: str |
                 "active_bounds": ident.linear.active_bounds},
     }
     _held(out, ident)
+    # the parameters in the user's terms; the regression's own coefficients they replace
+    # (e.g. c_td, c_lo for beta_td, beta_lo) under "internal"
+    out["params"], internal = ident.reported(ds)
+    if internal:
+        out["internal"] = internal
     if simulation:
         plant = _plant_of(ds)
         if plant is None or plant.simulation_fit is None:

@@ -56,3 +56,23 @@ def test_with_the_weighed_mass_the_preload_stands_alone(loaded):
     assert first["effect"] == "spring_preload" and first["significant"]
     assert "ambiguous_with" not in first
     assert first["params"]["F0"] == pytest.approx(2.7, rel=0.10)
+
+
+def test_impacts_are_reported_as_the_papers_velocity_ratios(loaded):
+    """003 eq. 24 / Table 2 name beta_td, beta_lo: the ranking row and identify report those
+    (truth 0.57, 1.13), the momentum coefficients c_td, c_lo only under "internal"."""
+    plant, desc, ds = loaded
+    out = diagnose(ds, build_model(plant, desc, fixed={"m": leg_of(desc).mass}),
+                   ["impact_restitution"]).to_json()
+    row = out["ranking"][0]
+    assert set(row["params"]) == {"beta_td", "beta_lo"} and row["units"]["beta_td"] == "1"
+    assert row["params"]["beta_td"] == pytest.approx(TRUE.beta_td, rel=0.05)
+    assert row["params"]["beta_lo"] == pytest.approx(TRUE.beta_lo, rel=0.05)
+    assert set(row["internal"]) == {"c_td", "c_lo"}
+    assert "beta_td = " in row["explanation"] and "c_td" not in row["explanation"]
+    # with m fixed the ratio's error is the coefficient's over m (delta method, m exact)
+    from cablelab.fit import identify as fit
+
+    r = fit(build_model(plant, desc, ["impact_restitution"], fixed={"m": leg_of(desc).mass}), ds)
+    phys = r.physical("impact_restitution", ds)
+    assert phys["beta_td"]["stderr"] == pytest.approx(r.stderr["c_td"] / leg_of(desc).mass, rel=1e-4)

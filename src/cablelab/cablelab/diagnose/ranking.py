@@ -275,9 +275,15 @@ def rank_candidates(model: Model, ds: Dataset, candidates, *, folds: int = FOLDS
         gain, changed = practical_gain(ym0, yh0, ym1, yh1)
         significant = bool(sig["passes"] and gain >= min_gain and err1 < err0)
         own = full.effect_params(c, ds)
-        row = {"effect": c, "error_before": err0, "error_after": err1, "params": own,
-               "stderr": {k: full.stderr.get(k, 0.0) for k in own},
-               "units": {k: full.units.get(k, "") for k in own},
+        # reported in the user's terms (the paper's / spec's parameters, errors propagated);
+        # the regression's own coefficients stay under "internal"
+        phys = full.physical(c, ds)
+        inner = full.internal(c, ds)
+        row = {"effect": c, "error_before": err0, "error_after": err1,
+               "params": {k: v["value"] for k, v in phys.items()},
+               "stderr": {k: v["stderr"] for k, v in phys.items()},
+               "units": {k: v["unit"] for k, v in phys.items()},
+               **({"internal": {k: v["value"] for k, v in inner.items()}} if inner else {}),
                "significant": significant, "p_value": sig["p_value"], "delta_bic": sig["delta_bic"],
                "n_eff": sig["n_eff"], "gain": gain, **({"held": own_held} if own_held else {}),
                "channels": dict(zip(ds.channels, map(float, channel_nrmse(ym1, yh1))))}
@@ -288,7 +294,7 @@ def rank_candidates(model: Model, ds: Dataset, candidates, *, folds: int = FOLDS
             significant = row["significant"] = False
         row["evidence"] = _evidence(by_regime0, residual_by_regime(full.residual, y_ref, regimes,
                                                                   ds.channels))
-        row["explanation"] = explain(c, own, row["stderr"], row["units"], err0, err1, significant,
+        row["explanation"] = explain(c, row["params"], row["stderr"], row["units"], err0, err1, significant,
                                      (int(changed.sum()), len(changed)), gain)
         if significant and row["evidence"]:
             ev = row["evidence"]

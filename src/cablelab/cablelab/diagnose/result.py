@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 #: keys of a ranking row that are part of the JSON, in order (contract keys first)
 ROW_KEYS = ("effect", "error_before", "error_after", "params", "significant", "stderr", "units",
             "p_value", "delta_bic", "n_eff", "gain", "channels", "evidence", "identifiability",
-            "ambiguous_with", "ambiguity", "held", "explanation")
+            "ambiguous_with", "ambiguity", "held", "internal", "explanation")
 
 
 @dataclass(frozen=True)

@@ -73,6 +73,62 @@ class Identification:
         """One warning line naming the held parameters (None when nothing is held)."""
         return held_warning(self.held, self.units)
 
+    def physical(self, effect_id: str, ds: Dataset) -> dict:
+        """The effect's parameters in the user's terms: ``{name: {"value", "stderr", "unit"}}``
+        (:attr:`~cablelab.effects.base.Effect.physical`, else its own parameters), standard errors
+        propagated from the fit's covariance by the delta method (the mapping's Jacobian by
+        central differences over the free parameters)."""
+        from ..effects import get_effect
+
+        eff = get_effect(effect_id)
+        if eff.physical is None:
+            names = [p.name for p in eff.columns(ds)] + [p.name for p in eff.nonlinear]
+            return {k: {"value": float(self.params[k]), "stderr": float(self.stderr.get(k, 0.0)),
+                        "unit": self.units.get(k, "")} for k in names if k in self.params}
+        out = {}
+        for ph in eff.physical(ds):
+            try:
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    value, se = propagate(ph.value, self.params, *self.extra.get("cov", ((), None)),
+                                          stderr=self.stderr)
+            except KeyError:      # needs a parameter of an effect the model does not have
+                continue
+            except ZeroDivisionError:
+                value, se = float("nan"), float("nan")
+            out[ph.name] = {"value": value, "stderr": se, "unit": ph.unit}
+        return out
+
+    def reported(self, ds: Dataset) -> tuple[dict, dict]:
+        """``(params, internal)``: every parameter of the model in the user's terms (the
+        effects' :meth:`physical` parameters where they have them, with ``fixed``/``held``
+        flags for the others) and the internal coefficients those replace."""
+        from ..effects import get_effect
+
+        table = {r["name"]: {k: v for k, v in r.items() if k != "name"} for r in self.table()}
+        params, internal = {}, {}
+        for eid in self.model.effects:
+            inner = self.internal(eid, ds)
+            if not inner:
+                continue
+            for k in inner:
+                internal[k] = table.pop(k, inner[k])
+            for k, v in self.physical(eid, ds).items():
+                params[k] = {**v, "fixed": False}
+        # model order: the effects' own parameters first as they come, physical ones in place
+        return {**table, **params}, internal
+
+    def internal(self, effect_id: str, ds: Dataset) -> dict:
+        """The effect's fitted coefficients as the regression sees them, when they differ from
+        its physical parameters (:meth:`physical`); else empty."""
+        from ..effects import get_effect
+
+        eff = get_effect(effect_id)
+        if eff.physical is None:
+            return {}
+        names = [p.name for p in eff.columns(ds)] + [p.name for p in eff.nonlinear]
+        return {k: {"value": float(self.params[k]), "stderr": float(self.stderr.get(k, 0.0)),
+                    "unit": self.units.get(k, "")} for k in names if k in self.params}
+
     def effect_params(self, effect_id: str, ds: Dataset) -> dict:
         """The parameters belonging to one effect, by name."""
         from ..effects import get_effect
@@ -83,6 +139,32 @@ class Identification:
         if eff.derived is not None:
             own.update(eff.derived(eff, own, self.params, ds))
         return own
+
+
+def propagate(fn, params: Mapping[str, float], names=(), cov=None, *, stderr=None
+              ) -> tuple[float, float]:
+    """``(fn(params), its standard error)`` by the delta method: ``sqrt(J C J^T)`` with C the
+    covariance of the free parameters ``names`` and J the gradient of ``fn`` by central
+    differences (step 1e-4 standard errors). Parameters outside ``names`` (fixed) count as exact.
+    Without a covariance, the diagonal of ``stderr`` is used (correlations ignored)."""
+    p = {k: float(v) for k, v in params.items()}
+    value = float(fn(p))
+    names = list(names)
+    if cov is None or not names:
+        names = [k for k in p if stderr and stderr.get(k, 0.0) > 0]
+        cov = np.diag([float(stderr[k]) ** 2 for k in names]) if names else np.zeros((0, 0))
+    cov = np.asarray(cov, dtype=float)
+    sd = np.sqrt(np.clip(np.diag(cov), 0, None))
+    grad = np.zeros(len(names))
+    for i, k in enumerate(names):
+        if k not in p or sd[i] == 0:
+            continue
+        h = 1e-4 * sd[i]
+        hi, lo = dict(p), dict(p)
+        hi[k], lo[k] = p[k] + h, p[k] - h
+        grad[i] = (float(fn(hi)) - float(fn(lo))) / (2 * h)
+    var = float(grad @ cov @ grad) if names else 0.0
+    return value, float(np.sqrt(max(var, 0.0)))
 
 
 def _linear_system(model: Model, ds: Dataset):
@@ -267,6 +349,8 @@ def _identify_once(model: Model, ds: Dataset, *, on_deficient: str = "raise",
             params[c.name], stderr[c.name], units[c.name] = float(v), float(s), c.unit
     for p in nl_params:
         params[p.name], stderr[p.name], units[p.name] = nl_values[p.name], 0.0, p.unit
+    cov_names = [] if fit.base else [c.name for c in cols]
+    cov_all = np.zeros((0, 0)) if fit.base else np.asarray(fit.cov, dtype=float)
     if jac_nl is not None and not fit.base:
         w = fit.channel_scale
         a = np.where(valid[:, None, None], phi * w[None, :, None], 0.0).reshape(-1, phi.shape[2])
@@ -275,6 +359,8 @@ def _identify_once(model: Model, ds: Dataset, *, on_deficient: str = "raise",
         try:
             cov = fit.sigma2 * np.linalg.pinv(jtj)
             se = np.sqrt(np.clip(np.diag(cov), 0, None))
+            cov_names = [c.name for c in cols] + [p.name for p in nl_params]
+            cov_all = cov
             for name, s in zip([c.name for c in cols] + [p.name for p in nl_params], se):
                 stderr[name] = float(s)
         except np.linalg.LinAlgError:
@@ -299,7 +385,8 @@ def _identify_once(model: Model, ds: Dataset, *, on_deficient: str = "raise",
     return Identification(model, params, stderr, units, tuple(model.fixed), fit, y_hat, resid,
                           valid, tuple(ds.channels),
                           extra={"stderr_white": white, "lag1": r1, "stderr_inflation": inflation,
-                                 "sample_step": step})
+                                 "sample_step": step,
+                                 "cov": (tuple(cov_names), cov_all * inflation ** 2)})
 
 
 #: a channel residual below this fraction of the largest one is round-off (a channel the plant
