@@ -27,6 +27,7 @@ VERBS = {
     "info": "info",
     "repair": "repair",
     "batch": "batch",
+    "excite": "excite",
 }
 
 
