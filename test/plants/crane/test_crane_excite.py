@@ -82,3 +82,15 @@ def test_excite_needs_a_known_parameter(confounded, tmp_path, capsys):
     assert main(["excite", confounded, "--params", "nope", "-o", str(tmp_path / "r")]) == 2
     err = capsys.readouterr().err
     assert "nope" in err and "OF[luff]" in err
+
+
+def test_diagnose_prints_the_excite_command_for_a_confounded_pair(confounded, capsys):
+    assert main(["diagnose", confounded, "--candidates", "torque_sensor_offset", "--folds", "3",
+                 "--fix", "l_c=0.3"]) == 0
+    text = capsys.readouterr().out
+    line = next(x for x in text.splitlines() if x.startswith("to separate") and "m_c" in x)
+    assert f"cablelab excite {confounded} --params 'OF[luff],m_c' --duration 60 -o " in line
+    assert main(["diagnose", confounded, "--candidates", "torque_sensor_offset", "--folds", "3",
+                 "--fix", "l_c=0.3", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert any("'OF[luff],m_c'" in c for c in out["excite"])

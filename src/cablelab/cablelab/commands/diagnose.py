@@ -32,9 +32,12 @@ def run(args) -> int:
     cands = parse_effect_list(args.candidates) if args.candidates else plant.candidates(desc)
     out = diagnose(ds, model, cands, folds=args.folds, alpha=args.alpha, min_gain=args.min_gain,
                    greedy_mode=args.greedy, quiet=args.json)
+    from ..diagnose.result import excite_commands
+
     doc = with_warnings(args, out.to_json())
+    doc["excite"] = excite_commands(out.ranking, out.plant, args.bag, tuple(out.held))
     if args.json:
         print(dump_json(doc))
         return 0
-    print("\n".join(out.lines()))
+    print("\n".join(out.lines() + doc["excite"]))
     return 0

@@ -112,8 +112,11 @@ def build_report(ds: Dataset, model: Model, candidates, out_dir, *, folds: int =
     parts.append(_table(rows, ["effect", "held-out NRMSE with it", "significant", "p", "explanation"]))
     from ..diagnose.result import ambiguity_lines
 
+    from ..diagnose.result import excite_commands
+
     parts.extend(f"<p class='warnings'>{html.escape(line)}</p>"
-                 for line in ambiguity_lines(steps[0]["ranking"]))
+                 for line in ambiguity_lines(steps[0]["ranking"])
+                 + excite_commands(steps[0]["ranking"], model.plant, ds.source))
     parts.append("<h2>Parameters of the final model</h2>")
     rows = [[html.escape(r["name"]), _num(r["value"], "{:.6g}"), _num(r["stderr"], "{:.2g}"),
              html.escape(r["unit"]), "fixed" if r["fixed"] else ""] for r in fin.table()]
