@@ -124,10 +124,11 @@ def _effect_table(ident) -> dict:
 
 
 def _held(out: dict, ident) -> dict:
-    """``out`` with ``"held"`` (name -> value) and its warning line when the fit held parameters."""
+    """``out`` with ``"held"`` (name -> value) and its line in ``"warnings"`` when the fit held
+    parameters."""
     if ident.held:
         out["held"] = ident.held
-        out.setdefault("held_warnings", []).append(ident.held_warning())
+        out.setdefault("warnings", []).append(ident.held_warning())
     return out
 
 

@@ -124,7 +124,7 @@ def with_warnings(args, out: dict) -> dict:
     """``out`` with the input checks' ``"warnings"`` list (JSON); in text mode each warning is
     printed first as ``warning: ...``."""
     warnings = list(getattr(args, "warnings", []) or [])
-    warnings += [w for w in out.pop("held_warnings", ()) if w]   # parameters the data left open
+    warnings += [w for w in out.get("warnings", ()) if w and w not in warnings]   # the verb's own (held)
     out["warnings"] = warnings
     if not getattr(args, "json", False):
         for w in warnings:

@@ -93,7 +93,7 @@ class Diagnosis:
                "ranking": [c.to_json() for c in self.ranking], "folds": self.folds}
         if self.held:
             out["held"] = dict(self.held)
-            out["held_warnings"] = [self.held_warning]
+            out["warnings"] = [self.held_warning]
         if self.greedy:
             out["greedy"] = [s.to_json() for s in self.greedy]
             f = self.final
