@@ -201,3 +201,14 @@ def test_identify_holds_unexcited_parameters_at_their_nominal_and_fits_the_rest(
     assert "b = 7.5 N" in r.held_warning() and "--strict" in r.held_warning()
     ref = identify(Model(plant, ("toy_u_base",)), ds)
     assert r.params["a"] == pytest.approx(ref.params["a"], rel=1e-12)
+
+
+def test_a_model_whose_every_parameter_is_unexcited_is_held_whole():
+    from cablelab.fit.linear import unexcited_columns
+
+    phi = np.zeros((300, 1, 2))
+    y = np.random.default_rng(2).normal(size=300)
+    ps = [Param("a", "1", 1.5), Param("b", "1", -2.0)]
+    assert unexcited_columns(phi, y, ps) == [0, 1]
+    f = solve_linear(phi[:, :, :0], y, [])               # nothing left to fit: the residual is y
+    assert f.rss == pytest.approx(float(y @ y))

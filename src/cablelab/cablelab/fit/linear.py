@@ -135,7 +135,7 @@ def solve_linear(phi: np.ndarray, y: np.ndarray, params: Sequence[Param], *,
         w = np.ones(n_c)
     else:
         w = np.asarray(channel_scale, dtype=float).reshape(n_c)
-    a = (phi[mask] * w[None, :, None]).reshape(-1, p)
+    a = (phi[mask] * w[None, :, None]).reshape(int(mask.sum()) * n_c, p)
     b = (y[mask] * w[None, :]).reshape(-1)
     n = a.shape[0]
     if n <= p:
@@ -233,7 +233,7 @@ def unexcited_columns(phi: np.ndarray, y: np.ndarray, params: Sequence[Param], *
         w = 1.0 / np.where(rms > 0, rms, 1.0) if n_c > 1 else np.ones(1)
     else:
         w = np.ones(n_c) if channel_scale is None else np.asarray(channel_scale, float).reshape(n_c)
-    a = (phi[mask] * w[None, :, None]).reshape(-1, p)
+    a = (phi[mask] * w[None, :, None]).reshape(int(mask.sum()) * n_c, p)
     if p == 0 or a.shape[0] == 0:
         return []
     s = np.linalg.norm(a, axis=0)
