@@ -113,7 +113,7 @@ def test_unexcited_parameter_is_held_with_a_warning(tmp_path, capsys):
     assert any("M" in w and "not excited" in w and "--strict" in w for w in out["warnings"])
     assert main(["identify", bag, "--folds", "0"]) == 0
     text = capsys.readouterr().out
-    assert text.startswith("warning: not excited") and "held: not excited" in text
+    assert "\nwarning: not excited" in "\n" + text and "held: not excited" in text
 
 
 def test_csv_import_with_scale_factor(tmp_path, capsys):
