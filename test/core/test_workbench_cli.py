@@ -93,12 +93,27 @@ def test_too_few_samples_for_the_folds(tmp_path, capsys):
 def test_rank_deficient_fit_names_the_parameter(tmp_path, capsys):
     t = np.arange(2000) * 0.01
     bag = _write(tmp_path / "b", t, 0.1 * t, 3.0 + 0 * t)  # constant velocity: M not excited
-    err = _err(capsys, ["identify", bag])
+    err = _err(capsys, ["identify", bag, "--strict"])
     assert "rank-deficient" in err and "M" in err and "--fix" in err
     # fixing the unexcited parameter makes the fit well-posed
     assert main(["identify", bag, "--fix", "M=2", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["params"]["Fv"]["value"] == pytest.approx(30.0, rel=1e-6)
+
+
+def test_unexcited_parameter_is_held_with_a_warning(tmp_path, capsys):
+    t = np.arange(2000) * 0.01
+    bag = _write(tmp_path / "b", t, 0.1 * t, 3.0 + 0 * t)  # constant velocity: M not excited
+    assert main(["identify", bag, "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["held"] == {"M": 2.0}                       # the description's axis.inertia
+    assert out["params"]["M"]["held"] and out["params"]["M"]["fixed"]
+    # the rest is the same fit as with M given: effort 3 N at 0.1 m/s
+    assert out["params"]["Fv"]["value"] == pytest.approx(30.0, rel=1e-6)
+    assert any("M" in w and "not excited" in w and "--strict" in w for w in out["warnings"])
+    assert main(["identify", bag, "--folds", "0"]) == 0
+    text = capsys.readouterr().out
+    assert "\nwarning: not excited" in "\n" + text and "held: not excited" in text
 
 
 def test_csv_import_with_scale_factor(tmp_path, capsys):

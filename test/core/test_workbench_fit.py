@@ -149,3 +149,66 @@ def test_model_regressor_is_sum_of_effect_blocks_on_a_multi_actuator_map():
     fc = np.array([1.0, 2.0, 3.0])
     expect = np.einsum("nca,na->nc", amap, np.sign(v) * fc)
     assert np.allclose(eff.block(ds) @ fc, expect)
+
+
+def test_unexcited_columns_holds_zero_then_the_later_of_a_dependent_pair():
+    from cablelab.fit.linear import unexcited_columns
+
+    rng = np.random.default_rng(5)
+    x = rng.normal(size=(400, 3))
+    ps = [Param(n, "1") for n in "abcd"]
+    y = x @ np.array([1.0, 2.0, 3.0])
+    # full rank: nothing held
+    assert unexcited_columns(x, y, ps[:3]) == []
+    # a zero column is held
+    phi = np.column_stack([x[:, 0], np.zeros(400), x[:, 1], x[:, 2]])
+    assert unexcited_columns(phi, y, ps) == [1]
+    # two identical columns (up to scale): the later one is held, the rest has full rank
+    phi = np.column_stack([x[:, 0], x[:, 1], 3.0 * x[:, 1], x[:, 2]])
+    held = unexcited_columns(phi, y, ps)
+    assert held == [2]
+    keep = [i for i in range(4) if i not in held]
+    assert np.linalg.matrix_rank(phi[:, keep]) == len(keep)
+    # a combination of three columns: one of them is held
+    phi = np.column_stack([x, x[:, 0] - 0.5 * x[:, 2]])
+    held = unexcited_columns(phi, y, ps)
+    assert len(held) == 1 and held[0] in (0, 2, 3)
+
+
+def test_identify_holds_unexcited_parameters_at_their_nominal_and_fits_the_rest():
+    from cablelab.effects import register
+    from cablelab.effects.base import Effect
+    from cablelab.fit import identify
+    from cablelab.fit.linear import RankDeficient
+    from cablelab.model import Dataset, Model
+
+    plant = "toy_unexcited"
+    sig = lambda name: (lambda ds: ds.require_signal(name).reshape(ds.n, 1, 1))  # noqa: E731
+    register(Effect(id="toy_u_base", plants=(plant,), params=(Param("a", "N", 0.0),),
+                    explanation="t", signature="t", reference="test", regressor=sig("u")))
+    register(Effect(id="toy_u_idle", plants=(plant,), params=(Param("b", "N", 7.5),),
+                    explanation="t", signature="t", reference="test", regressor=sig("z")))
+    t = np.arange(0, 10, 0.01)
+    u = np.sin(t)
+    rng = np.random.default_rng(3)
+    ds = Dataset(plant=plant, t=t, y=(2.0 * u + 0.01 * rng.normal(size=t.size))[:, None],
+                 channels=("f",), signals={"u": u, "z": np.zeros_like(t)})
+    with pytest.raises(RankDeficient, match="b"):
+        identify(Model(plant, ("toy_u_base", "toy_u_idle")), ds)
+    r = identify(Model(plant, ("toy_u_base", "toy_u_idle"), unexcited="hold"), ds)
+    assert r.held == {"b": 7.5} and r.params["b"] == 7.5 and "b" in r.fixed
+    assert r.params["a"] == pytest.approx(2.0, abs=0.01)
+    assert "b = 7.5 N" in r.held_warning() and "--strict" in r.held_warning()
+    ref = identify(Model(plant, ("toy_u_base",)), ds)
+    assert r.params["a"] == pytest.approx(ref.params["a"], rel=1e-12)
+
+
+def test_a_model_whose_every_parameter_is_unexcited_is_held_whole():
+    from cablelab.fit.linear import unexcited_columns
+
+    phi = np.zeros((300, 1, 2))
+    y = np.random.default_rng(2).normal(size=300)
+    ps = [Param("a", "1", 1.5), Param("b", "1", -2.0)]
+    assert unexcited_columns(phi, y, ps) == [0, 1]
+    f = solve_linear(phi[:, :, :0], y, [])               # nothing left to fit: the residual is y
+    assert f.rss == pytest.approx(float(y @ y))

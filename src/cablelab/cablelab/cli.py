@@ -28,6 +28,7 @@ VERBS = {
     "repair": "repair",
     "batch": "batch",
     "layout": "layout",
+    "excite": "excite",
 }
 
 

@@ -29,14 +29,21 @@ class Model:
         effects: effect ids or :class:`Effect` objects, in order (the regressor columns follow
             this order); stored as ids, with the looked-up objects in ``units``.
         fixed: known parameter values by name, moved to the left-hand side of the fit.
+        unexcited: what a fit does with parameters the data cannot determine (a rank-deficient
+            regressor): ``"raise"`` refuses with the unidentifiable directions named; ``"hold"``
+            holds them at their description value (or the effect's neutral value) and says so
+            (:func:`cablelab.fit.identify`, ``Identification.extra["held"]``).
     """
 
     plant: str
     effects: tuple[str, ...]
     fixed: Mapping[str, float] = field(default_factory=dict)
     units: tuple[Effect, ...] = field(init=False, repr=False, compare=False)
+    unexcited: str = "raise"
 
     def __post_init__(self) -> None:
+        if self.unexcited not in ("raise", "hold"):
+            raise ValueError(f"unexcited={self.unexcited!r}: expected 'raise' or 'hold'")
         units: list[Effect] = []
         for e in self.effects:
             unit = e if isinstance(e, Effect) else get_effect(e, self.plant)  # validates id, plant
@@ -48,7 +55,12 @@ class Model:
 
     def with_effect(self, effect: "str | Effect") -> "Model":
         """The model with one more effect (an id or an :class:`Effect`)."""
-        return Model(self.plant, self.units + (effect,), self.fixed)
+        return Model(self.plant, self.units + (effect,), self.fixed, unexcited=self.unexcited)
+
+    def with_effects(self, effects, fixed: Mapping[str, float] | None = None) -> "Model":
+        """The same plant and policy with other effects (and known parameters)."""
+        return Model(self.plant, tuple(effects), dict(self.fixed if fixed is None else fixed),
+                     unexcited=self.unexcited)
 
     def effect_units(self) -> list[Effect]:
         """The model's :class:`Effect` objects, in order."""

@@ -117,16 +117,28 @@ def load_bag_description(bag_path, description_path=None, bag=None):
 
 
 def build_model(plant, desc, effects: Sequence[str] = (), baseline: Sequence[str] | None = None,
-                fixed: dict | None = None) -> Model:
-    """``baseline`` (default: the plant's nominal effects) + ``effects``, with known parameters."""
+                fixed: dict | None = None, *, strict: bool = False) -> Model:
+    """``baseline`` (default: the plant's nominal effects) + ``effects``, with known parameters.
+    A parameter the data do not excite is held at its description (or neutral) value with a
+    warning; ``strict`` refuses the rank-deficient fit instead (``--strict``)."""
     base = tuple(plant.baseline(desc)) if baseline is None else tuple(baseline)
     effs = base + tuple(e for e in effects if e not in base)
-    return Model(plant.name, effs, dict(fixed or {}))
+    return Model(plant.name, effs, dict(fixed or {}), unexcited="raise" if strict else "hold")
 
 
 def _effect_table(ident) -> dict:
     return {row["name"]: {"value": row["value"], "stderr": row["stderr"], "unit": row["unit"],
-                          "fixed": row["fixed"]} for row in ident.table()}
+                          "fixed": row["fixed"], **({"held": True} if row.get("held") else {})}
+            for row in ident.table()}
+
+
+def _held(out: dict, ident) -> dict:
+    """``out`` with ``"held"`` (name -> value) and its line in ``"warnings"`` when the fit held
+    parameters."""
+    if ident.held:
+        out["held"] = ident.held
+        out.setdefault("warnings", []).append(ident.held_warning())
+    return out
 
 
 def _fit_on_record(model: Model, ds: Dataset):
@@ -159,6 +171,7 @@ def compare_fit(ds: Dataset, model: Model, *, segments: int = 5):
     out["whiteness"] = {ch: _whiteness_summary(ident.residual[:, c], ds.inputs, _decimation(ds))
                         for c, ch in enumerate(ds.channels)}
     out["rank"], out["condition"] = ident.linear.rank, ident.linear.cond
+    _held(out, ident)
     plant = _plant_of(ds)
     if plant is not None and plant.simulate is not None:
         out["free_run"] = plant.simulate(ds, ident.params)
@@ -190,6 +203,13 @@ def _whiteness_summary(res, inputs, decimate: int = 1) -> dict:
                           "max_abs": float(np.max(np.abs(v["xcorr"])))} for k, v in w["cross"].items()}}
 
 
+def _mean_nrmse(mets) -> float | None:
+    """Mean NRMSE over the channels that have one (a channel without signal, e.g. a yaw the
+    plant sets aside as not excited, has none)."""
+    vals = [m["nrmse"] for m in mets if m.get("nrmse") is not None]
+    return float(np.mean(vals)) if vals else None
+
+
 @blas_single
 def identify(ds: Dataset, model: Model, *, folds: int = FOLDS, simulation: str | None = None,
              quiet: bool = True) -> dict:
@@ -201,13 +221,19 @@ def identify(ds: Dataset, model: Model, *, folds: int = FOLDS, simulation: str |
     cv = cv_error(model, ds, folds)[0] if folds else None
     out = {
         "plant": ds.plant, "effects": list(model.effects), "samples": int(ident.valid.sum()),
-        "params": _effect_table(ident),
-        "fit": {"nrmse": float(np.mean([m["nrmse"] for m in mets])), "cv_nrmse": cv, "folds": folds,
+        "params": None,
+        "fit": {"nrmse": _mean_nrmse(mets), "cv_nrmse": cv, "folds": folds,
                 "channels": dict(zip(ds.channels, mets)), "rank": ident.linear.rank,
                 "parameters": len(ident.linear.names), "condition": ident.linear.cond,
                 "unidentifiable": ident.linear.unidentifiable,
                 "active_bounds": ident.linear.active_bounds},
     }
+    _held(out, ident)
+    # the parameters in the user's terms; the regression's own coefficients they replace
+    # (e.g. c_td, c_lo for beta_td, beta_lo) under "internal"
+    out["params"], internal = ident.reported(ds)
+    if internal:
+        out["internal"] = internal
     if simulation:
         plant = _plant_of(ds)
         if plant is None or plant.simulation_fit is None:
@@ -236,8 +262,11 @@ def diagnose(ds: Dataset, model: Model, candidates: Sequence[str], *, folds: int
         steps = [step_from_dict(s) for s in greedy(model, ds, cands, folds=folds, alpha=alpha,
                                                     min_gain=min_gain, quiet=quiet)]
         first = steps[0]
+        base_fit = _identify(model, ds)
         return Diagnosis(plant=ds.plant, baseline_effects=first.effects, baseline_error=first.error,
-                         ranking=first.ranking, folds=folds, greedy=steps)
+                         ranking=first.ranking, folds=folds, greedy=steps, held=base_fit.held,
+                         held_warning=base_fit.held_warning())
     d = rank_candidates(model, ds, cands, folds=folds, alpha=alpha, min_gain=min_gain, quiet=quiet)
     return Diagnosis(plant=ds.plant, baseline_effects=list(model.effects), baseline_error=d.error,
-                     ranking=[Candidate.from_row(r) for r in d.ranking], folds=folds)
+                     ranking=[Candidate.from_row(r) for r in d.ranking], folds=folds,
+                     held=d.ident.held, held_warning=d.ident.held_warning())

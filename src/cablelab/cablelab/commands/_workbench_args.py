@@ -87,11 +87,19 @@ def add_common(p, *, effects_required: bool = False) -> None:
     p.add_argument("--fix", metavar="NAME=VALUE", action="append", default=[],
                    help="known parameter moved to the left-hand side (repeatable)")
     add_tensions(p)
+    add_strict(p)
     p.add_argument("--cutoff", type=number(gt=0, unit="Hz"), metavar="HZ", default=None,
                    help="zero-phase Butterworth cut-off for positions (default fs/10)")
     p.add_argument("--decimate", type=number(ge=1, integer=True), metavar="K", default=None,
                    help="keep every K-th sample after filtering")
     add_json(p)
+
+
+def add_strict(p) -> None:
+    """``--strict``: refuse a fit whose data do not determine every parameter."""
+    p.add_argument("--strict", action="store_true",
+                   help="refuse a rank-deficient fit (default: hold the parameters the recording "
+                        "does not excite at their description or neutral values, with a warning)")
 
 
 def add_folds(p) -> None:
@@ -202,7 +210,8 @@ def load_from_args(args, *, check_out: bool = False):
             from ..errors import CablelabError
 
             raise CablelabError(f"--fix {name}={value}: the value must be a finite number")
-    model = build_model(plant, desc, parse_effect_list(args.effects), baseline, fixed)
+    model = build_model(plant, desc, parse_effect_list(args.effects), baseline, fixed,
+                        strict=getattr(args, "strict", False))
     if not model.effects:
         from ..errors import CablelabError
 
@@ -240,6 +249,7 @@ def with_warnings(args, out: dict) -> dict:
     """``out`` with the input checks' ``"warnings"`` list (JSON); in text mode each warning is
     printed first as ``warning: ...``."""
     warnings = list(getattr(args, "warnings", []) or [])
+    warnings += [w for w in out.get("warnings", ()) if w and w not in warnings]   # the verb's own (held)
     out["warnings"] = warnings
     if not getattr(args, "json", False):
         for w in warnings:

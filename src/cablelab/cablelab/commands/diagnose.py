@@ -45,11 +45,14 @@ def run(args) -> int:
                         where=f"model {' + '.join(step.effects)}")
     if args.out:
         write_overlay_out(args, plant, ds, greedy_stages(ds, model, out.greedy))
+    from ..diagnose.result import excite_commands
+
     doc = with_warnings(args, out.to_json())
+    doc["excite"] = excite_commands(out.ranking, out.plant, args.bag, tuple(out.held))
     if args.json:
         print(dump_json(doc))
         return 0
-    print("\n".join(out.lines()))
+    print("\n".join(out.lines() + doc["excite"]))
     if args.out:
         print(f"model overlay (measured, prediction, residual per stage) written to {args.out}")
     return 0

@@ -35,7 +35,8 @@ def run(args) -> int:
     print(f"plant {out['plant']}, model {' + '.join(out['effects'])}: NRMSE {100 * f['nrmse']:.2f} % "
           f"({held}), rank {f['rank']}, condition {f['condition']:.3g}")
     for name, v in out["params"].items():
-        print(param_line(name, v, " (fixed)" if v["fixed"] else ""))
+        print(param_line(name, v, " (held: not excited)" if v.get("held") else
+                         " (fixed)" if v["fixed"] else ""))
     if "simulation" in out:
         sim = out["simulation"]
         print(f"simulation-based fit ({sim['objective']}): NMSE {sim['nmse']:.4g}, Pearson "

@@ -238,6 +238,20 @@ def rank_candidates(model: Model, ds: Dataset, candidates, *, folds: int = FOLDS
     y_ref = base_full.residual + base_full.y_hat
     by_regime0 = residual_by_regime(base_full.residual, y_ref, regimes, ds.channels)
     prog.step("baseline")
+    # what the ambiguity check compares (diagnose/ambiguity.py): the model's columns, weighted and
+    # on its valid rows, and each candidate's held-out prediction and projected columns
+    from .ambiguity import find_ambiguous, project_out
+
+    ds_base = model.apply_nonlinear(ds, base_full.params)
+    w_ch = base_full.linear.channel_scale if base_full.linear.channel_scale is not None \
+        else np.ones(ds.n_channels)
+    use = base_full.valid & np.isfinite(ds_base.y).all(axis=1)
+
+    def weighted(phi):
+        return (phi[use] * w_ch[None, :, None]).reshape(int(use.sum()) * phi.shape[1], phi.shape[2])
+
+    phi0 = weighted(model.regressor(ds_base)[0])
+    compared = {}
     rows = []
     for c in cands:
         m2 = model.with_effect(c)
@@ -249,15 +263,29 @@ def rank_candidates(model: Model, ds: Dataset, candidates, *, folds: int = FOLDS
                          "significant": False, "explanation": f"{c}: cannot be fitted ({exc})"})
             prog.step(c)
             continue
+        own_held = [k for k in full.held if k not in base_full.held]
+        if own_held and set(own_held) >= {p.name for p in get_effect(c).columns(ds)}:
+            rows.append({"effect": c, "error_before": err0, "error_after": err1, "params": {},
+                         "significant": False, "held": own_held,
+                         "explanation": f"{c}: not excited by this recording ({', '.join(own_held)} "
+                                        "cannot be determined from it)"})
+            prog.step(c)
+            continue
         sig = lr_significance(base_full, full, len(cands), alpha)
         gain, changed = practical_gain(ym0, yh0, ym1, yh1)
         significant = bool(sig["passes"] and gain >= min_gain and err1 < err0)
         own = full.effect_params(c, ds)
-        row = {"effect": c, "error_before": err0, "error_after": err1, "params": own,
-               "stderr": {k: full.stderr.get(k, 0.0) for k in own},
-               "units": {k: full.units.get(k, "") for k in own},
+        # reported in the user's terms (the paper's / spec's parameters, errors propagated);
+        # the regression's own coefficients stay under "internal"
+        phys = full.physical(c, ds)
+        inner = full.internal(c, ds)
+        row = {"effect": c, "error_before": err0, "error_after": err1,
+               "params": {k: v["value"] for k, v in phys.items()},
+               "stderr": {k: v["stderr"] for k, v in phys.items()},
+               "units": {k: v["unit"] for k, v in phys.items()},
+               **({"internal": {k: v["value"] for k, v in inner.items()}} if inner else {}),
                "significant": significant, "p_value": sig["p_value"], "delta_bic": sig["delta_bic"],
-               "n_eff": sig["n_eff"], "gain": gain,
+               "n_eff": sig["n_eff"], "gain": gain, **({"held": own_held} if own_held else {}),
                "channels": dict(zip(ds.channels, map(float, channel_nrmse(ym1, yh1))))}
         from .identifiability import confounding, describe
 
@@ -266,7 +294,7 @@ def rank_candidates(model: Model, ds: Dataset, candidates, *, folds: int = FOLDS
             significant = row["significant"] = False
         row["evidence"] = _evidence(by_regime0, residual_by_regime(full.residual, y_ref, regimes,
                                                                   ds.channels))
-        row["explanation"] = explain(c, own, row["stderr"], row["units"], err0, err1, significant,
+        row["explanation"] = explain(c, row["params"], row["stderr"], row["units"], err0, err1, significant,
                                      (int(changed.sum()), len(changed)), gain)
         if significant and row["evidence"]:
             ev = row["evidence"]
@@ -275,8 +303,24 @@ def rank_candidates(model: Model, ds: Dataset, candidates, *, folds: int = FOLDS
                                    f"{ev['channel']} RMS)")
         row["explanation"] += describe(row["identifiability"])
         rows.append(row)
+        phi_c, cols_c, _ = m2.regressor(m2.apply_nonlinear(ds, base_full.params))
+        own_idx = [i for i, p in enumerate(cols_c) if p.name in own]
+        compared[c] = {"error": err1, "y": ym1, "y_hat": yh1, "y_hat0": yh0,
+                       "columns": project_out(phi0, weighted(phi_c[:, :, own_idx]))}
         prog.step(c)
     rows.sort(key=lambda r: (r["error_after"] is None, r["error_after"] if r["error_after"] is not None else 0))
+    helps = [r["effect"] for r in rows if r["error_after"] is not None
+             and (r["significant"] or r.get("gain", 0.0) >= min_gain)]
+    rms = np.sqrt(np.nanmean(np.where(use[:, None], ds_base.y, np.nan) ** 2, axis=0))
+    pairs = find_ambiguous(err0, compared, helps, 1.0 / np.where(rms > 0, rms, 1.0))
+    from .ambiguity import describe as describe_ambiguity
+
+    for r in rows:
+        others = pairs.get(r["effect"])
+        if others:
+            r["ambiguous_with"] = [o["effect"] for o in rows if o["effect"] in others]
+            r["ambiguity"] = {o: others[o] for o in r["ambiguous_with"]}
+            r["explanation"] += describe_ambiguity(r["effect"], r["ambiguous_with"])
     return Diagnosis(model.plant, model, err0, rows, base_full)
 
 
@@ -292,17 +336,21 @@ def greedy(model: Model, ds: Dataset, candidates, *, folds: int = FOLDS, alpha: 
     """
     steps = []
     current = model
-    added = None
+    added = note = None
     for _ in range(max_steps + 1):
         d = rank_candidates(current, ds, candidates, folds=folds, alpha=alpha, min_gain=min_gain,
                             quiet=quiet)
         ident = d.ident
         steps.append({"effects": list(current.effects), "added": added, "error": d.error,
                       "params": dict(ident.params), "stderr": dict(ident.stderr),
-                      "units": dict(ident.units), "ranking": d.ranking})
+                      "units": dict(ident.units), "ranking": d.ranking,
+                      **({"note": note} if note else {})})
         best = d.best_significant()
         if best is None:
             break
         added = best["effect"]
+        rivals = list(best.get("ambiguous_with", ()))
+        note = (f"chose {added} over {', '.join(rivals)} (ambiguous: held-out errors equal within "
+                "noise, this recording cannot tell them apart)") if rivals else None
         current = current.with_effect(added)
     return steps

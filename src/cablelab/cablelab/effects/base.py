@@ -40,6 +40,23 @@ class Param:
         return dataclasses.replace(self, name=name)
 
 
+@dataclass(frozen=True)
+class Physical:
+    """A parameter as the description, the spec or the paper names it, computed from the fitted
+    ones (e.g. beta_td = 1 - c_td / m of 003 eq. 24 from the impact effect's momentum column).
+
+    Args:
+        name: the paper's / spec's symbol (``beta_td``, ``d_ry``); unit: SI unit text.
+        value: ``fn(params) -> float`` from every model parameter by name (fitted and fixed).
+        doc: one-line meaning, with where the name comes from.
+    """
+
+    name: str
+    unit: str
+    value: Callable[[Mapping[str, float]], float]
+    doc: str = ""
+
+
 RegressorFn = Callable[[Dataset], np.ndarray]
 TransformFn = Callable[[Dataset, Mapping[str, float]], Dataset]
 
@@ -65,6 +82,14 @@ class Effect:
             (must set ``valid`` False where the result is undefined).
         derived: optional ``fn(effect, own, all_params, ds) -> {name: value}``: values reported
             beside the fitted parameters (e.g. the contract's F_s, v_s of a Stribeck effect).
+        described: optional ``fn(ds) -> {param name: value}``: the values the plant description
+            gives the effect's parameters (e.g. the levelling gains of a suspended platform's
+            parameter set); a parameter the data do not excite is held there (else at its
+            ``Param.nominal``, the effect's neutral value).
+        physical: optional ``fn(ds) -> [Physical, ...]``: the parameters reported to the user
+            when the fitted ones are internal regression coefficients (a momentum in kg for a
+            velocity ratio, a torque for a pose offset); ``None``: the effect's own parameters
+            are the physical ones.
         requires: a capability the plant must declare (:attr:`cablelab.registry.Plant.
             capabilities`, e.g. ``"joint_actuators"``); ``None`` = no requirement.
     """
@@ -81,6 +106,8 @@ class Effect:
     transform: TransformFn | None = None
     requires: str | None = None
     derived: Callable | None = None
+    described: Callable | None = None
+    physical: Callable | None = None
 
     def applies_to(self, plant: str, capabilities=frozenset()) -> bool:
         """Whether the effect applies to ``plant`` with these capabilities."""

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import Effect, Param, RegressorFn
+from .base import Effect, Param, Physical, RegressorFn
 from . import register
 
 #: velocities below this magnitude (in the actuator's unit/s) count as "at rest" for sign(v):
@@ -110,6 +110,33 @@ def stribeck_contract_params(effect: Effect, own: dict, all_params: dict, ds) ->
     return out
 
 
+def stribeck_physical(effect_id: str):
+    """The contract's Stribeck parameters per actuator: F_s = F_c + dFs (the model's Coulomb
+    level, 0 without it) and v_s = vs_rel x p99(|v|) (CONTRACT sec. 4)."""
+    def fn(ds):
+        eff_cols = [c for c in _stribeck_columns(effect_id, ds)]
+        v = ds.require_actuators(effect_id)
+        p99 = np.percentile(np.abs(v), 99, axis=0)
+        out = []
+        for j, col in enumerate(eff_cols):
+            suffix = col.name[len("dFs"):]
+            pos = ds.act_units[j][1] if j < len(ds.act_units) and ds.act_units[j][1] else "?"
+            scale = float(p99[min(j, len(p99) - 1)])
+            out.append(Physical("F_s" + suffix, col.unit,
+                                lambda p, s=suffix, c=col.name: p.get("Fc" + s, 0.0) + p[c],
+                                "Stribeck breakaway friction F_s (CONTRACT sec. 4)"))
+            out.append(Physical("v_s" + suffix, f"{pos}/s", lambda p, k=scale: p["vs_rel"] * k,
+                                "Stribeck speed v_s (CONTRACT sec. 4)"))
+        return tuple(out)
+    return fn
+
+
+def _stribeck_columns(effect_id: str, ds):
+    from . import get_effect
+
+    return get_effect(effect_id).columns(ds)
+
+
 def stribeck_effect(effect_id: str, plants: tuple, reference: str,
                     requires: str | None = None) -> Effect:
     """A Stribeck friction effect (generic: joint effects; the CDPR registers its winch one)."""
@@ -130,6 +157,7 @@ def stribeck_effect(effect_id: str, plants: tuple, reference: str,
         regressor=stribeck_regressor(effect_id),
         per_actuator=True,
         derived=stribeck_contract_params,
+        physical=stribeck_physical(effect_id),
     )
 
 

@@ -18,7 +18,7 @@ import scipy.linalg
 
 from ..errors import CablelabError
 from ..model import Dataset, Model, Param
-from .linear import LinearFit, solve_linear
+from .linear import LinearFit, RankDeficient, solve_linear, unexcited_columns
 
 #: grid points per nonlinear parameter for the start of the outer search
 OUTER_GRID = 11
@@ -56,10 +56,78 @@ class Identification:
     extra: dict = field(default_factory=dict)
 
     def table(self) -> list[dict]:
-        """[{name, value, stderr, unit, fixed}] in model order."""
+        """[{name, value, stderr, unit, fixed}] in model order (``held`` added, True, for a
+        parameter the data did not excite, held at its description or neutral value)."""
+        held = self.extra.get("held") or {}
         return [{"name": k, "value": float(v), "stderr": float(self.stderr.get(k, 0.0)),
-                 "unit": self.units.get(k, ""), "fixed": k in self.fixed}
+                 "unit": self.units.get(k, ""), "fixed": k in self.fixed,
+                 **({"held": True} if k in held else {})}
                 for k, v in self.params.items()]
+
+    @property
+    def held(self) -> dict:
+        """name -> value of the parameters held because the data did not excite them."""
+        return dict(self.extra.get("held") or {})
+
+    def held_warning(self) -> str | None:
+        """One warning line naming the held parameters (None when nothing is held)."""
+        return held_warning(self.held, self.units)
+
+    def physical(self, effect_id: str, ds: Dataset) -> dict:
+        """The effect's parameters in the user's terms: ``{name: {"value", "stderr", "unit"}}``
+        (:attr:`~cablelab.effects.base.Effect.physical`, else its own parameters), standard errors
+        propagated from the fit's covariance by the delta method (the mapping's Jacobian by
+        central differences over the free parameters)."""
+        from ..effects import get_effect
+
+        eff = get_effect(effect_id)
+        if eff.physical is None:
+            names = [p.name for p in eff.columns(ds)] + [p.name for p in eff.nonlinear]
+            return {k: {"value": float(self.params[k]), "stderr": float(self.stderr.get(k, 0.0)),
+                        "unit": self.units.get(k, "")} for k in names if k in self.params}
+        out = {}
+        for ph in eff.physical(ds):
+            try:
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    value, se = propagate(ph.value, self.params, *self.extra.get("cov", ((), None)),
+                                          stderr=self.stderr)
+            except KeyError:      # needs a parameter of an effect the model does not have
+                continue
+            except ZeroDivisionError:
+                value, se = float("nan"), float("nan")
+            out[ph.name] = {"value": value, "stderr": se, "unit": ph.unit}
+        return out
+
+    def reported(self, ds: Dataset) -> tuple[dict, dict]:
+        """``(params, internal)``: every parameter of the model in the user's terms (the
+        effects' :meth:`physical` parameters where they have them, with ``fixed``/``held``
+        flags for the others) and the internal coefficients those replace."""
+        from ..effects import get_effect
+
+        table = {r["name"]: {k: v for k, v in r.items() if k != "name"} for r in self.table()}
+        params, internal = {}, {}
+        for eid in self.model.effects:
+            inner = self.internal(eid, ds)
+            if not inner:
+                continue
+            for k in inner:
+                internal[k] = table.pop(k, inner[k])
+            for k, v in self.physical(eid, ds).items():
+                params[k] = {**v, "fixed": False}
+        # model order: the effects' own parameters first as they come, physical ones in place
+        return {**table, **params}, internal
+
+    def internal(self, effect_id: str, ds: Dataset) -> dict:
+        """The effect's fitted coefficients as the regression sees them, when they differ from
+        its physical parameters (:meth:`physical`); else empty."""
+        from ..effects import get_effect
+
+        eff = get_effect(effect_id)
+        if eff.physical is None:
+            return {}
+        names = [p.name for p in eff.columns(ds)] + [p.name for p in eff.nonlinear]
+        return {k: {"value": float(self.params[k]), "stderr": float(self.stderr.get(k, 0.0)),
+                    "unit": self.units.get(k, "")} for k in names if k in self.params}
 
     def effect_params(self, effect_id: str, ds: Dataset) -> dict:
         """The parameters belonging to one effect, by name."""
@@ -71,6 +139,32 @@ class Identification:
         if eff.derived is not None:
             own.update(eff.derived(eff, own, self.params, ds))
         return own
+
+
+def propagate(fn, params: Mapping[str, float], names=(), cov=None, *, stderr=None
+              ) -> tuple[float, float]:
+    """``(fn(params), its standard error)`` by the delta method: ``sqrt(J C J^T)`` with C the
+    covariance of the free parameters ``names`` and J the gradient of ``fn`` by central
+    differences (step 1e-4 standard errors). Parameters outside ``names`` (fixed) count as exact.
+    Without a covariance, the diagonal of ``stderr`` is used (correlations ignored)."""
+    p = {k: float(v) for k, v in params.items()}
+    value = float(fn(p))
+    names = list(names)
+    if cov is None or not names:
+        names = [k for k in p if stderr and stderr.get(k, 0.0) > 0]
+        cov = np.diag([float(stderr[k]) ** 2 for k in names]) if names else np.zeros((0, 0))
+    cov = np.asarray(cov, dtype=float)
+    sd = np.sqrt(np.clip(np.diag(cov), 0, None))
+    grad = np.zeros(len(names))
+    for i, k in enumerate(names):
+        if k not in p or sd[i] == 0:
+            continue
+        h = 1e-4 * sd[i]
+        hi, lo = dict(p), dict(p)
+        hi[k], lo[k] = p[k] + h, p[k] - h
+        grad[i] = (float(fn(hi)) - float(fn(lo))) / (2 * h)
+    var = float(grad @ cov @ grad) if names else 0.0
+    return value, float(np.sqrt(max(var, 0.0)))
 
 
 def _linear_system(model: Model, ds: Dataset):
@@ -93,7 +187,7 @@ def _weighted_residual(fit: LinearFit, phi, lhs, valid) -> np.ndarray:
     return np.where(valid[:, None], r, 0.0).reshape(-1)
 
 
-def identify(model: Model, ds: Dataset, *, on_deficient: str = "raise",
+def identify(model: Model, ds: Dataset, *, on_deficient: str | None = None,
              outer_grid: int = OUTER_GRID, start: Mapping[str, float] | None = None,
              channel_scale=None) -> Identification:
     """Fit the model's free parameters to the dataset.
@@ -101,7 +195,10 @@ def identify(model: Model, ds: Dataset, *, on_deficient: str = "raise",
     Args:
         model: plant + effects + fixed parameters.
         ds: conditioned dataset of the same plant.
-        on_deficient: ``"raise"`` (default) or ``"base"`` (regroup to base parameters).
+        on_deficient: what to do with a rank-deficient regressor: ``"raise"``, ``"base"``
+            (regroup to base parameters) or ``"hold"`` (hold the parameters the data do not
+            excite at their description or neutral values, :func:`hold_unexcited`; they are
+            listed in ``extra["held"]`` and ``fixed``); default: the model's ``unexcited``.
         outer_grid: grid points per nonlinear parameter for the outer search start.
         start: start values of the nonlinear parameters (e.g. the full-record fit when fitting
             cross-validation folds); skips the grid.
@@ -112,13 +209,79 @@ def identify(model: Model, ds: Dataset, *, on_deficient: str = "raise",
     Raises:
         CablelabError: too few samples, rank-deficient regressor (names the directions).
     """
+    policy = on_deficient or model.unexcited
+    if policy == "hold":
+        return _identify_holding(model, ds, outer_grid=outer_grid, start=start,
+                                 channel_scale=channel_scale)
+    return _identify_once(model, ds, on_deficient=policy, outer_grid=outer_grid, start=start,
+                          channel_scale=channel_scale)
+
+
+def held_value(model: Model, ds: Dataset, name: str) -> float:
+    """The value a parameter the data do not excite is held at: the description's
+    (``Effect.described``), else the parameter's nominal (the effect's neutral value)."""
+    for e in model.effect_units():
+        for p in e.columns(ds):
+            if p.name == name:
+                if e.described is not None:
+                    val = e.described(ds).get(name)
+                    if val is not None:
+                        return float(val)
+                return float(p.nominal)
+    raise KeyError(name)
+
+
+def hold_unexcited(model: Model, ds: Dataset, nl: Mapping[str, float] | None = None) -> dict:
+    """``{name: value}`` of the free linear parameters to hold so the rest of the model has a
+    full-rank regressor on ``ds`` (:func:`~cablelab.fit.linear.unexcited_columns`, evaluated
+    with the nonlinear parameters at ``nl`` or nominal), each at :func:`held_value`."""
+    ds2 = model.apply_nonlinear(ds, dict(nl or {}))
+    phi, cols, y_known = model.regressor(ds2)
+    idx = unexcited_columns(phi, ds2.y - y_known, cols, valid=ds2.valid)
+    return {cols[i].name: held_value(model, ds, cols[i].name) for i in idx}
+
+
+def _identify_holding(model: Model, ds: Dataset, **kw) -> Identification:
+    held: dict[str, float] = {}
+    current = model
+    for _ in range(len(model.effects) * 64 + 1):
+        try:
+            r = _identify_once(current, ds, on_deficient="raise", **kw)
+        except RankDeficient:
+            more = hold_unexcited(current, ds, kw.get("start"))
+            if not more:
+                raise
+            held.update(more)
+            current = model.with_effects(model.effects, {**model.fixed, **held})
+            continue
+        r.model = model
+        r.extra["held"] = dict(held)
+        return r
+    raise RankDeficient(f"rank-deficient fit: holding the unexcited parameters "
+                        f"{', '.join(held)} did not leave a full-rank model")
+
+
+def held_warning(held: Mapping[str, float], units: Mapping[str, str] | None = None) -> str | None:
+    """One warning line naming the held parameters and their values, or None."""
+    if not held:
+        return None
+    units = units or {}
+    vals = ", ".join(f"{k} = {v:.6g}{(' ' + units[k]) if units.get(k) else ''}"
+                     for k, v in held.items())
+    return (f"not excited by this recording (rank-deficient fit), held at their description or "
+            f"neutral values: {vals}; record motion that excites them, or --strict to refuse")
+
+
+def _identify_once(model: Model, ds: Dataset, *, on_deficient: str = "raise",
+                   outer_grid: int = OUTER_GRID, start: Mapping[str, float] | None = None,
+                   channel_scale=None) -> Identification:
     if ds.plant != model.plant:
         raise CablelabError(f"dataset of plant {ds.plant} given to a {model.plant} model")
     if channel_scale is None:
         channel_scale = "rms"
         if ds.n_channels > 1:
-            first = identify(model, ds, on_deficient=on_deficient, outer_grid=outer_grid,
-                             start=start, channel_scale="rms")
+            first = _identify_once(model, ds, on_deficient=on_deficient, outer_grid=outer_grid,
+                                   start=start, channel_scale="rms")
             channel_scale = noise_weights(first.residual)
             start = {p.name: first.params[p.name] for p in model.nonlinear_params()} or start
     nl_params = model.nonlinear_params()
@@ -186,6 +349,8 @@ def identify(model: Model, ds: Dataset, *, on_deficient: str = "raise",
             params[c.name], stderr[c.name], units[c.name] = float(v), float(s), c.unit
     for p in nl_params:
         params[p.name], stderr[p.name], units[p.name] = nl_values[p.name], 0.0, p.unit
+    cov_names = [] if fit.base else [c.name for c in cols]
+    cov_all = np.zeros((0, 0)) if fit.base else np.asarray(fit.cov, dtype=float)
     if jac_nl is not None and not fit.base:
         w = fit.channel_scale
         a = np.where(valid[:, None, None], phi * w[None, :, None], 0.0).reshape(-1, phi.shape[2])
@@ -194,6 +359,8 @@ def identify(model: Model, ds: Dataset, *, on_deficient: str = "raise",
         try:
             cov = fit.sigma2 * np.linalg.pinv(jtj)
             se = np.sqrt(np.clip(np.diag(cov), 0, None))
+            cov_names = [c.name for c in cols] + [p.name for p in nl_params]
+            cov_all = cov
             for name, s in zip([c.name for c in cols] + [p.name for p in nl_params], se):
                 stderr[name] = float(s)
         except np.linalg.LinAlgError:
@@ -218,7 +385,8 @@ def identify(model: Model, ds: Dataset, *, on_deficient: str = "raise",
     return Identification(model, params, stderr, units, tuple(model.fixed), fit, y_hat, resid,
                           valid, tuple(ds.channels),
                           extra={"stderr_white": white, "lag1": r1, "stderr_inflation": inflation,
-                                 "sample_step": step})
+                                 "sample_step": step,
+                                 "cov": (tuple(cov_names), cov_all * inflation ** 2)})
 
 
 #: a channel residual below this fraction of the largest one is round-off (a channel the plant

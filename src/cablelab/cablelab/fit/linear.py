@@ -29,6 +29,10 @@ RANK_TOL = 1e-8
 ZERO_COLUMN = 1e-7
 
 
+class RankDeficient(CablelabError):
+    """A rank-deficient regressor (the one-line message names the unidentifiable directions)."""
+
+
 @dataclass
 class LinearFit:
     """Result of :func:`solve_linear`.
@@ -132,7 +136,7 @@ def solve_linear(phi: np.ndarray, y: np.ndarray, params: Sequence[Param], *,
     else:
         w = np.asarray(channel_scale, dtype=float).reshape(n_c)
     # (no free parameter, e.g. every one fixed: no columns, the residual is y itself)
-    a = (phi[mask] * w[None, :, None]).reshape(-1, p) if p else np.zeros((int(mask.sum()) * n_c, 0))
+    a = (phi[mask] * w[None, :, None]).reshape(int(mask.sum()) * n_c, p)
     b = (y[mask] * w[None, :]).reshape(-1)
     n = a.shape[0]
     if n <= p:
@@ -156,7 +160,7 @@ def solve_linear(phi: np.ndarray, y: np.ndarray, params: Sequence[Param], *,
     if rank < p:
         dirs = [_combo(names, vt[i] / s_safe) for i in range(rank, p)]
         if on_deficient == "raise":
-            raise CablelabError(
+            raise RankDeficient(
                 f"rank-deficient fit (rank {rank} of {p}, condition {cond:.3g}): "
                 f"{'; '.join(dirs)} cannot be identified from this data; fix a parameter "
                 "(--fix NAME=VALUE), drop an effect (--effects), or record motion that excites it")
@@ -203,3 +207,47 @@ def _solve_base(a, b, s, names, units, rank, cond, dirs, w) -> LinearFit:
     return LinearFit(tuple(base_names), tuple(units[k] for k in ind), theta,
                      np.sqrt(np.clip(np.diag(cov), 0, None)), cov, rank, cond, a.shape[0], rss,
                      sigma2, unidentifiable=dirs, base=base_names, channel_scale=w)
+
+
+def unexcited_columns(phi: np.ndarray, y: np.ndarray, params: Sequence[Param], *,
+                      valid: np.ndarray | None = None, channel_scale="rms",
+                      rank_tol: float = RANK_TOL) -> list[int]:
+    """Indices of the columns to hold so that the rest of ``phi`` has full rank: the columns the
+    data do not excite at all first (norm below :data:`ZERO_COLUMN` x the largest, as
+    :func:`solve_linear`), then, while the column-scaled regressor is rank-deficient, the column
+    that carries most of its null space (sum of squared null-vector components); between equal
+    shares the later column (the effect added last, not the model's own) is held.
+
+    Args: as :func:`solve_linear` (``y`` only sets the channel weights).
+    """
+    phi = np.asarray(phi, dtype=float)
+    y = np.asarray(y, dtype=float)
+    if phi.ndim == 2:
+        phi = phi[:, None, :]
+    if y.ndim == 1:
+        y = y[:, None]
+    n_s, n_c, p = phi.shape
+    mask = np.ones(n_s, dtype=bool) if valid is None else np.asarray(valid, dtype=bool).copy()
+    mask &= np.isfinite(y).all(axis=1) & np.isfinite(phi).all(axis=(1, 2))
+    if isinstance(channel_scale, str):
+        rms = np.sqrt(np.mean(y[mask] ** 2, axis=0)) if mask.any() else np.ones(n_c)
+        w = 1.0 / np.where(rms > 0, rms, 1.0) if n_c > 1 else np.ones(1)
+    else:
+        w = np.ones(n_c) if channel_scale is None else np.asarray(channel_scale, float).reshape(n_c)
+    a = (phi[mask] * w[None, :, None]).reshape(int(mask.sum()) * n_c, p)
+    if p == 0 or a.shape[0] == 0:
+        return []
+    s = np.linalg.norm(a, axis=0)
+    held = [i for i in range(p) if not s[i] > ZERO_COLUMN * s.max()]
+    keep = [i for i in range(p) if i not in held]
+    while keep:
+        a_s = a[:, keep] / s[keep]
+        _, sv, vt = np.linalg.svd(a_s, full_matrices=False)
+        rank = int(np.sum(sv > sv[0] * rank_tol))
+        if rank == len(keep):
+            break
+        share = np.sum(vt[rank:] ** 2, axis=0)
+        # ties (identical columns) go to the later column: the tolerance keeps round-off out
+        top = np.flatnonzero(share >= share.max() * (1 - 1e-6))[-1]
+        held.append(keep.pop(int(top)))
+    return sorted(held)

@@ -46,7 +46,7 @@ def build_report(ds: Dataset, model: Model, candidates, out_dir, *, folds: int =
     except OSError as exc:
         raise CablelabError(f"{out_dir}: cannot create report directory ({exc.strerror})") from None
     steps = greedy(model, ds, candidates, folds=folds, alpha=alpha, min_gain=min_gain, quiet=quiet)
-    final_model = Model(model.plant, tuple(steps[-1]["effects"]), model.fixed)
+    final_model = model.with_effects(steps[-1]["effects"])
     base = identify(model, ds)
     fin = identify(final_model, ds)
     y_meas = np.where(fin.valid[:, None], fin.residual + fin.y_hat, np.nan)
@@ -73,8 +73,7 @@ def build_report(ds: Dataset, model: Model, candidates, out_dir, *, folds: int =
                         "residual of the nominal model; worst segments shaded", valid=base.valid)
     step_figs = []
     for i, st in enumerate(steps[1:], 1):
-        ident_i = fin if i == len(steps) - 1 else identify(Model(model.plant, tuple(st["effects"]),
-                                                                 model.fixed), ds)
+        ident_i = fin if i == len(steps) - 1 else identify(model.with_effects(st["effects"]), ds)
         name = f"step_{i}_residual.png"
         plots.residual_time(fig(name), ds.t, ident_i.residual, [], ds.channels, ds.units,
                             f"step {i}: + {st['added']} (held-out NRMSE {100 * st['error']:.2f} %)",
@@ -101,6 +100,11 @@ def build_report(ds: Dataset, model: Model, candidates, out_dir, *, folds: int =
     # the answer first: what is missing (waterfall, ranking), then the fitted model, then evidence
     parts.append(answer_section(steps))
     parts.append(ranking_section(steps, alpha=alpha, min_gain=min_gain))
+    from ..diagnose.result import ambiguity_lines, excite_commands
+
+    parts.extend(f"<p class='warnings'>{html.escape(line)}</p>"
+                 for line in ambiguity_lines(steps[0]["ranking"])
+                 + excite_commands(steps[0]["ranking"], model.plant, ds.source))
     parts.append("<h2>Parameters of the final model</h2>")
     table = fin.table()
     any_fixed = any(r["fixed"] for r in table)     # a column for --fix only when it was used

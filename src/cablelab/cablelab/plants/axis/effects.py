@@ -20,6 +20,15 @@ def _gravity(ds: Dataset) -> np.ndarray:
     return (ds.gravity * np.sin(ds.require_signal("q"))).reshape(ds.n, 1, 1)
 
 
+def _described(field: str, name: str):
+    """``ds -> {name: value}`` of the description's ``axis.<field>`` (empty when not given)."""
+    def fn(ds: Dataset) -> dict:
+        sec = getattr(ds.description, "axis", None) if ds.description is not None else None
+        val = getattr(sec, field, None) if sec is not None else None
+        return {} if val is None else {name: float(val)}
+    return fn
+
+
 AXIS_INERTIA = register(Effect(
     id="axis_inertia",
     plants=("axis",),
@@ -28,6 +37,7 @@ AXIS_INERTIA = register(Effect(
     signature="residual follows the acceleration",
     reference="EMPS reference model (IDIM); 002 eq. 4.2 inertial parameters",
     regressor=_inertia,
+    described=_described("inertia", "M"),
 ))
 
 AXIS_GRAVITY = register(Effect(
@@ -38,4 +48,5 @@ AXIS_GRAVITY = register(Effect(
     signature="residual follows sin(q), the joint angle from hanging down",
     reference="CONTRACT sec. 3 axis.gravity_moment; 002 eq. A.10 (gravity terms)",
     regressor=_gravity,
+    described=_described("gravity_moment", "mc"),
 ))

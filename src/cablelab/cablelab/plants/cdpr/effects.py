@@ -36,6 +36,7 @@ import numpy as np
 from ...model import Dataset, Effect, Param
 from ...rotations import cross
 from ...effects import register
+from ...effects.base import Physical
 from ...effects.friction import coulomb_regressor, stribeck_effect, viscous_regressor
 
 #: search range of the sheave radius r_p, m
@@ -105,6 +106,10 @@ CDPR_GRAVITY = register(Effect(
     signature="the whole static wrench",
     reference="001 eq. 11-13",
     regressor=_gravity,
+    physical=lambda ds: (
+        Physical("m", "kg", lambda p: p["m"], "total moving mass (001 eq. 11)"),
+        Physical("x_G", "m", lambda p: p["mx"] / p["m"], "centre of mass x, platform frame (001 eq. 13)"),
+        Physical("y_G", "m", lambda p: p["my"] / p["m"], "centre of mass y, platform frame (001 eq. 13)")),
 ))
 
 PLATFORM_INERTIA = register(Effect(

@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...effects import register
+from ...effects.base import Physical
 from ...model import Dataset, Effect, Param
 
 
@@ -57,7 +58,14 @@ register(Effect(
     explanation="abrupt velocity change at touch-down and lift-off, zdot+ = beta zdot- "
                 "(beta = 1 - c / m)",
     signature="velocity residual jumps at contact-switch edges; apex height and time errors",
-    reference="003 eq. 24, Table 2", regressor=_cols("impulse_td", "impulse_lo")))
+    reference="003 eq. 24, Table 2", regressor=_cols("impulse_td", "impulse_lo"),
+    # the columns are momentum changes m (1 - beta) zdot-: the paper's velocity ratios are
+    # beta = 1 - c / m with m the leg's mass (leg_inertia, fitted or weighed)
+    physical=lambda ds: (
+        Physical("beta_td", "1", lambda p: 1.0 - p["c_td"] / p["m"],
+                 "touch-down velocity ratio zdot+ / zdot- (003 eq. 24, Table 2: 0.57)"),
+        Physical("beta_lo", "1", lambda p: 1.0 - p["c_lo"] / p["m"],
+                 "lift-off velocity ratio zdot+ / zdot- (003 eq. 24, Table 2: 1.13)"))))
 
 register(Effect(
     id="spring_preload", plants=LEG,
@@ -90,7 +98,12 @@ register(Effect(
     signature="stance frequency against the weighed mass (003: 1.62 kg); residual in phase with the "
               "stance acceleration; explains beta_lo > 1 (E9)",
     reference="003 sec. 3.3-3.4 (m 1.55 estimated vs 1.62 kg weighed, beta_lo > 1)",
-    regressor=_neg("acc_stance")))
+    regressor=_neg("acc_stance"),
+    physical=lambda ds: (
+        Physical("m_s", "kg", lambda p: p["m"] - p["dm_f"],
+                 "stance inertia (spec 003 sec. 7: m_s)"),
+        Physical("m_f", "kg", lambda p: p["m"],
+                 "flight inertia and weight, the leg's mass (spec 003 sec. 7: m_f)"))))
 
 
 def _contact_delay(ds: Dataset, values) -> Dataset:

@@ -44,6 +44,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...effects import register
+from ...effects.base import Physical
 from ...model import Dataset, Effect, Param
 
 __all__ = ["SUSPENDED_EFFECTS", "BASELINE", "CANDIDATES"]
@@ -153,6 +154,35 @@ def _suspension(ds: Dataset) -> np.ndarray:
     return b
 
 
+def _described_gains(ds: Dataset, names) -> dict:
+    """The description's virtual-joint gains (its parameter set, 000 Table 5 / repo) by name."""
+    sec = getattr(ds.description, "suspended", None) if ds.description is not None else None
+    if sec is None:
+        return {}
+    p = sec.params()
+    return {n: float(getattr(p, n)) for n in names}
+
+
+#: air density for c_d A = 2 c / rho (ISA sea level, 15 degC), kg/m^3
+AIR_DENSITY = 1.225
+
+
+def _offset_physical(ds: Dataset):
+    """Pose offsets in metres and radians (spec 000 sec. 7: +-0.05 m, +-0.1 rad): a measured
+    position offset (dx, dy) at distance L shifts the swing angles by ``q8 = atan2(d_y, -d_z)``:
+    +dy / L, ``q9 = asin(-d_x / L)``: -dx / L; the fitted torque is the restoring moment's slope
+    (``cable_link_inertia``'s ``mgl`` x g, its column being -g sin q) x angle."""
+    L = float(ds.signals.get("L", 1.0))
+    g = float(ds.signals.get("g", 9.81))
+    return (Physical("d_rx", "m", lambda p: -L * p["off_y"] / (g * p["mgl_y"]),
+                     "offset of the measured rest position along x (spec 000 sec. 7)"),
+            Physical("d_ry", "m", lambda p: L * p["off_x"] / (g * p["mgl_x"]),
+                     "offset of the measured rest position along y (spec 000 sec. 7)"),
+            Physical("d_yaw", "rad", lambda p: p["off_yaw"] / p["k_yaw"],
+                     "offset of the measured rest yaw (spec 000 sec. 7; needs the yaw return "
+                     "stiffness virtual_yaw_stiffness in the model)"))
+
+
 _P = ("suspended",)
 SUSPENDED_EFFECTS = (
     register(Effect(
@@ -189,7 +219,12 @@ SUSPENDED_EFFECTS = (
         params=(Param("c_x", "kg/m", 0.0, 0.0, np.inf, "quadratic drag rho c_d A / 2, x swing"),
                 Param("c_y", "kg/m", 0.0, 0.0, np.inf, "quadratic drag, y swing")),
         explanation="quadratic air drag on the platform",
-        signature="amplitude-dependent decay rate", reference="spec 000 sec. 7", regressor=_drag)),
+        signature="amplitude-dependent decay rate", reference="spec 000 sec. 7", regressor=_drag,
+        physical=lambda ds: (
+            Physical("cdA_x", "m^2", lambda p: 2.0 * p["c_x"] / AIR_DENSITY,
+                     "drag area c_d A of the x swing (spec 000 sec. 7: 0-0.5 m^2)"),
+            Physical("cdA_y", "m^2", lambda p: 2.0 * p["c_y"] / AIR_DENSITY,
+                     "drag area c_d A of the y swing (spec 000 sec. 7)")))),
     register(Effect(
         id="arm_coupling", plants=_P,
         params=(Param("arm_x", "kg m^2", 0.0, -np.inf, np.inf, "arm joint-2 reaction on swing_x"),
@@ -206,12 +241,13 @@ SUSPENDED_EFFECTS = (
                   "the swing frequency", reference="spec 000 sec. 7 (CRANEbot rope)", regressor=_elastic)),
     register(Effect(
         id="pose_sensor_offset", plants=_P,
-        params=(Param("off_x", "N m", 0.0, -np.inf, np.inf, "mgl_x x rest-angle offset of swing_x"),
-                Param("off_y", "N m", 0.0, -np.inf, np.inf, "mgl_y x rest-angle offset of swing_y"),
-                Param("off_yaw", "N m", 0.0, -np.inf, np.inf, "k_yaw x yaw offset")),
+        params=(Param("off_x", "N m", 0.0, -np.inf, np.inf, "g mgl_x x rest-angle offset of swing_x (reported as d_ry, m)"),
+                Param("off_y", "N m", 0.0, -np.inf, np.inf, "g mgl_y x rest-angle offset of swing_y (reported as d_rx, m)"),
+                Param("off_yaw", "N m", 0.0, -np.inf, np.inf, "k_yaw x yaw offset (reported as d_yaw, rad)")),
         explanation="the measured rest pose is offset: the restoring moment acts about a shifted "
                     "angle (constant torque = static moment x offset)",
-        signature="constant residual in r or yaw", reference="spec 000 sec. 7", regressor=_offset)),
+        signature="constant residual in r or yaw", reference="spec 000 sec. 7", regressor=_offset,
+        physical=_offset_physical)),
     register(Effect(
         id="platform_levelling", plants=_P,
         params=(Param("kp11", "N m/rad", 300.0, 0.0, np.inf, "levelling stiffness J11 (about x)"),
@@ -221,7 +257,8 @@ SUSPENDED_EFFECTS = (
         explanation="the platform is levelled by a finite-gain PD on J11/J12 (not held exactly "
                     "level): its tilt pushes back on the cable",
         signature="platform roll/pitch from the pose tracks the swing; swing period off by a few %",
-        reference="000 eq. 2, sec. 4 (J11/J12 virtual PD); spec 000 sec. 4.3, 7", regressor=_levelling)),
+        reference="000 eq. 2, sec. 4 (J11/J12 virtual PD); spec 000 sec. 4.3, 7", regressor=_levelling,
+        described=lambda ds: _described_gains(ds, ("kp11", "kp12", "kd11", "kd12")))),
     register(Effect(
         id="suspension_motion", plants=_P,
         params=(Param("ml_x", "kg m", 5.0, 0.0, np.inf, "static moment about S moved by a_S (swing_x)"),

@@ -49,6 +49,8 @@ PARAMETERS = (
     Param("excitation_seed", 0, "seed of the built-in multi-sine excitation", ge=0),
     Param("reference_timeout", 0.5, "a reference older than this is stale: the crane is held",
           "s wall", gt=0.0),
+    Param("reference_bag", "", "a reference bag written by `cablelab excite`: played from the first "
+          "joint state on and published on /crane/reference (overrides reference_source)"),
 )
 
 
@@ -62,6 +64,12 @@ class CraneController(PlantNode):
         self.params = None
         self.source = v.reference_source
         self.seed = v.excitation_seed
+        self.play = None
+        if v.reference_bag:
+            from ....excite import read_reference
+
+            self.play = read_reference(v.reference_bag, "/crane/reference", JOINTS)
+            self.source = "bag"
         self.ref = None
         self.swing = None
         self.fallbacks = 0
@@ -72,7 +80,7 @@ class CraneController(PlantNode):
         self.inputs.add("swing_estimate", timeout=0.5, length=2, required=False)
         self.pub_cmd = self.create_publisher(Float64MultiArray, "/crane/effort_commands", publisher_qos())
         self.pub_ref = self.create_publisher(JointTrajectory, "/crane/reference", publisher_qos()) \
-            if self.source == "excitation" else None
+            if self.source in ("excitation", "bag") else None
         self.create_subscription(JointState, "/crane/joint_states", self.on_state, stream_qos())
         self.create_subscription(JointState, "/crane/swing_estimate", self.on_swing, stream_qos())
         if self.source == "topic":
@@ -124,10 +132,11 @@ class CraneController(PlantNode):
         if qd is None or qd.size != 3 or not np.isfinite(qd).all():
             qd = np.zeros(3)
         swing = self.swing[None] if self.swing is not None and self.inputs.fresh("swing_estimate", now) else None
-        if self.source == "excitation":
+        if self.source in ("excitation", "bag"):
             if self.t0 is None:
                 self.t0 = t
-            r = reference_trajectory(np.array([t - self.t0]), q0=tuple(self._q0(q)), seed=self.seed)
+            r = self.play(np.array([t - self.t0])) if self.play is not None else \
+                reference_trajectory(np.array([t - self.t0]), q0=tuple(self._q0(q)), seed=self.seed)
             ref = tuple(x[0] for x in r)
             self.pub_ref.publish(convert.joint_trajectory_msg(t, JOINTS, *ref))
         elif self.ref is not None and self.inputs.fresh("reference", now):

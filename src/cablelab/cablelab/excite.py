@@ -1,0 +1,325 @@
+"""Experiment design: a reference trajectory that makes named parameters identifiable.
+
+A diagnosis that finds two parameters confounded (or one not excited) can only say "record
+motion that excites them independently". This module designs that motion, the way robot
+identification toolboxes do (Swevers et al., "Optimal robot excitation and identification",
+IEEE T-RA 1997): every joint follows a finite Fourier series
+
+    q_j(t) = c_j + w(t) s_j sum_k [a_jk / (k w_f) sin(k w_f t) - b_jk / (k w_f) cos(k w_f t)]
+
+(base frequency w_f = 2 pi f_0, H harmonics; w(t) a smoothstep fade-in and fade-out so the
+machine starts and ends at rest at c), and the coefficients minimise the condition number of
+the named parameters' information (:func:`condition`: unit-norm columns of the regressor of the
+model that holds them, the plant's nominal model plus the effects they belong to, with the other
+parameters eliminated), computed with the plant's own effects on the dataset the
+plant builds from the designed motion (:class:`Exciter`). The machine's limits hold by
+construction: each joint's deviation is scaled by the largest ``s_j`` that keeps it inside its
+range (with a margin), its speed and its acceleration limits.
+
+A plant offers experiment design by registering an :class:`Exciter` (:func:`register_exciter`):
+its limits from the description and a ``motion_dataset(t, q, qd, qdd, description)``.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from typing import Callable, Sequence
+
+import numpy as np
+
+from .errors import CablelabError
+
+#: fade-in / fade-out of the designed motion, s
+FADE_S = 2.0
+#: share of each joint's half range the motion may use around the range's centre
+RANGE_MARGIN = 0.9
+
+
+@dataclass(frozen=True)
+class Limits:
+    """The machine's limits per joint (SI): position range, speed, acceleration."""
+
+    joints: tuple
+    lower: np.ndarray
+    upper: np.ndarray
+    speed: np.ndarray
+    accel: np.ndarray
+
+    def check(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, tol: float = 1e-9) -> list[str]:
+        """Violations (one line each) of a motion (N, n) against the limits; empty if none."""
+        out = []
+        for j, name in enumerate(self.joints):
+            if q[:, j].min() < self.lower[j] - tol or q[:, j].max() > self.upper[j] + tol:
+                out.append(f"{name}: position {q[:, j].min():.4g}..{q[:, j].max():.4g} outside "
+                           f"[{self.lower[j]:.4g}, {self.upper[j]:.4g}]")
+            if np.abs(qd[:, j]).max() > self.speed[j] * (1 + 1e-6) + tol:
+                out.append(f"{name}: speed {np.abs(qd[:, j]).max():.4g} above {self.speed[j]:.4g}")
+            if np.abs(qdd[:, j]).max() > self.accel[j] * (1 + 1e-6) + tol:
+                out.append(f"{name}: acceleration {np.abs(qdd[:, j]).max():.4g} above {self.accel[j]:.4g}")
+        return out
+
+
+@dataclass(frozen=True)
+class Exciter:
+    """What a plant offers for experiment design.
+
+    Args:
+        limits: ``fn(description) -> Limits``.
+        motion_dataset: ``fn(t, q, qd, qdd, description) -> Dataset``: the dataset the plant's
+            effects see for a motion that follows the reference exactly (outputs zero).
+        reference_topic: the plant's ``reference`` topic (trajectory_msgs/JointTrajectory).
+        base_hz: lowest frequency of the Fourier series; harmonics: number of harmonics.
+        rate_hz: sample rate of the written reference.
+    """
+
+    limits: Callable
+    motion_dataset: Callable
+    reference_topic: str
+    base_hz: float = 0.05
+    harmonics: int = 5
+    rate_hz: float = 100.0
+
+
+_EXCITERS: dict[str, Exciter] = {}
+
+
+def register_exciter(plant: str, exciter: Exciter) -> Exciter:
+    _EXCITERS[plant] = exciter
+    return exciter
+
+
+def get_exciter(plant: str) -> Exciter:
+    from .registry import get_plant
+
+    get_plant(plant)  # importing the plant registers its exciter
+    ex = _EXCITERS.get(plant)
+    if ex is None:
+        have = ", ".join(sorted(_EXCITERS)) or "none"
+        raise CablelabError(f"plant {plant} offers no experiment design yet (plants with one: {have})")
+    return ex
+
+
+def _window(t: np.ndarray, duration: float):
+    """Smoothstep fade-in over the first and fade-out over the last FADE_S seconds, with its first
+    and second derivatives."""
+    fade = min(FADE_S, duration / 4)
+
+    def ramp(x):
+        s = np.clip(x / fade, 0, 1)
+        inside = (x > 0) & (x < fade)
+        w = s ** 3 * (10 - 15 * s + 6 * s * s)
+        wd = np.where(inside, 30 * s * s * (1 - s) ** 2 / fade, 0.0)
+        wdd = np.where(inside, 60 * s * (1 - s) * (1 - 2 * s) / fade ** 2, 0.0)
+        return w, wd, wdd
+
+    a, ad, add = ramp(t)
+    b, bd, bdd = ramp(duration - t)
+    return a * b, ad * b - a * bd, add * b - 2 * ad * bd + a * bdd
+
+
+def fourier_motion(coef: np.ndarray, t: np.ndarray, base_hz: float, duration: float):
+    """Unit-scale deviation ``(x, xd, xdd)`` (N, n_joints) of the windowed Fourier series with
+    coefficients ``coef`` (n_joints, 2, H): a (sine) and b (cosine) velocity amplitudes."""
+    n_j, _, h = coef.shape
+    k = np.arange(1, h + 1)
+    om = 2 * np.pi * base_hz * k                                  # (H,)
+    arg = t[:, None] * om[None, :]                                # (N, H)
+    s, c = np.sin(arg), np.cos(arg)
+    a, b = coef[:, 0, :], coef[:, 1, :]                           # (n_j, H)
+    x = s @ (a / om).T - c @ (b / om).T
+    xd = c @ a.T + s @ b.T
+    xdd = -(s * om) @ a.T + (c * om) @ b.T
+    x = x - x[:1]                                                  # start at the centre
+    w, wd, wdd = _window(t, duration)
+    w, wd, wdd = w[:, None], wd[:, None], wdd[:, None]
+    return w * x, wd * x + w * xd, wdd * x + 2 * wd * xd + w * xdd
+
+
+def scaled_motion(coef, t, limits: Limits, base_hz: float, duration: float):
+    """``(q, qd, qdd)``: the Fourier deviation scaled per joint to the largest amplitude the
+    limits allow, around the centre of each joint's range (limits hold by construction)."""
+    x, xd, xdd = fourier_motion(coef, t, base_hz, duration)
+    centre = 0.5 * (limits.lower + limits.upper)
+    half = 0.5 * (limits.upper - limits.lower) * RANGE_MARGIN
+    with np.errstate(divide="ignore"):
+        s = np.min(np.stack([half / np.max(np.abs(x), axis=0),
+                             limits.speed / np.max(np.abs(xd), axis=0),
+                             limits.accel / np.max(np.abs(xdd), axis=0)]), axis=0)
+    s = np.where(np.isfinite(s), s, 0.0)
+    return centre + s * x, s * xd, s * xdd
+
+
+def _weighted_columns(model, ds):
+    """The model's regressor on ``ds`` as one matrix (valid rows, channels weighted by their
+    regressor RMS so torques and forces weigh alike) and its parameter names."""
+    phi, cols, _ = model.regressor(ds)
+    ok = ds.valid & np.isfinite(phi).all(axis=(1, 2))
+    a = phi[ok]
+    rms = np.sqrt(np.mean(a ** 2, axis=(0, 2)))
+    a = (a / np.where(rms > 0, rms, 1.0)[None, :, None]).reshape(-1, phi.shape[2])
+    return a, [c.name for c in cols]
+
+
+def condition(model, ds, params: Sequence[str] | None = None) -> float:
+    """Condition number of the named parameters' information (``params``; None: all of the
+    model's): with unit-norm columns and the model's other parameters eliminated (Schur
+    complement of the information matrix), ``1 / lambda_min``. 1 when the named columns are
+    orthogonal to each other and to the rest; large when a combination of them is (nearly) a
+    combination of the other columns (confounded); inf when one is not excited. For one named
+    parameter it is its variance inflation factor; for a pair with correlation rho and nothing
+    else, (1 + |rho|) / (1 - rho^2)."""
+    a, names = _weighted_columns(model, ds)
+    if a.shape[1] == 0:
+        return 1.0
+    norms = np.linalg.norm(a, axis=0)
+    if np.any(norms <= 1e-12 * max(norms.max(), 1e-300)):
+        return float("inf")
+    a = a / norms
+    sel = [names.index(p) for p in params] if params else list(range(len(names)))
+    rest = [i for i in range(len(names)) if i not in sel]
+    a_s = a[:, sel]
+    if rest:
+        q, r = np.linalg.qr(a[:, rest])
+        keep = np.abs(np.diag(r)) > 1e-10 * max(np.abs(np.diag(r)).max(), 1e-300)
+        q = q[:, keep]
+        a_s = a_s - q @ (q.T @ a_s)
+    lam = np.linalg.eigvalsh(a_s.T @ a_s)
+    return float(1.0 / lam[0]) if lam[0] > 1e-15 else float("inf")
+
+
+def model_for(plant, desc, params: Sequence[str], ds) -> tuple:
+    """The plant's nominal model plus the effects that own ``params`` (names as the fit reports
+    them, ``OF[slew]``), and the parameters' effects.
+
+    Raises:
+        CablelabError: a name that no applicable effect has (the message lists what exists).
+    """
+    from .effects import effects_for, get_effect
+    from .model import Model
+
+    base = list(plant.baseline(desc))
+    owners = []
+    known = {}
+    for eid in base + [e for e in effects_for(plant.name) if e not in base]:
+        eff = get_effect(eid, plant.name)
+        for p in list(eff.columns(ds)) + list(eff.nonlinear):
+            known.setdefault(p.name, eid)
+    for name in params:
+        if name not in known:
+            raise CablelabError(f"--params {name!r}: no parameter of that name for plant {plant.name} "
+                                f"(parameters: {', '.join(sorted(known))})")
+        if known[name] not in base and known[name] not in owners:
+            owners.append(known[name])
+    return Model(plant.name, tuple(base + owners)), tuple(known[n] for n in params)
+
+
+@dataclass
+class Design:
+    """Result of :func:`design`: the reference (t, q, qd, qdd), its limits, the condition numbers
+    before (in the given dataset, or None) and after, the model and the seconds spent."""
+
+    t: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    qdd: np.ndarray
+    limits: Limits
+    params: tuple
+    condition_before: float | None
+    condition_after: float
+    model: object
+    seconds: float
+
+    def to_json(self) -> dict:
+        return {"params": list(self.params), "condition_before": self.condition_before,
+                "condition_after": self.condition_after, "duration": float(self.t[-1] - self.t[0]),
+                "model": list(self.model.effects), "joints": list(self.limits.joints),
+                "seconds": self.seconds}
+
+
+def design(plant_name: str, desc, params: Sequence[str], *, duration: float = 60.0,
+           before_ds=None, seed: int = 0, starts: int = 1, max_iter: int = 30) -> Design:
+    """Design an excitation of ``duration`` s for the named parameters (module doc).
+
+    Args:
+        plant_name, desc: the plant and its description (limits, geometry).
+        params: parameter names as the fit reports them.
+        before_ds: the dataset of the recording that confounds them (condition_before), or None.
+        seed, starts: random starts of the local optimiser (the best is kept).
+    """
+    import scipy.optimize
+
+    from .registry import get_plant
+
+    if not (np.isfinite(duration) and duration >= 4 * FADE_S):
+        raise CablelabError(f"--duration {duration!r}: expected at least {4 * FADE_S:g} s")
+    if not params:
+        raise CablelabError("--params: name at least one parameter (e.g. --params 'OF[slew],m')")
+    t0 = time.monotonic()
+    plant = get_plant(plant_name)
+    ex = get_exciter(plant_name)
+    lim = ex.limits(desc)
+    n_j, h = len(lim.joints), ex.harmonics
+    # design grid: 10 samples per period of the highest harmonic
+    fs = 10.0 * ex.base_hz * h
+    t = np.arange(0.0, duration, 1.0 / fs)
+    probe = ex.motion_dataset(t, *scaled_motion(np.ones((n_j, 2, h)), t, lim, ex.base_hz, duration), desc)
+    model, _ = model_for(plant, desc, params, probe)
+
+    def cost(x):
+        q, qd, qdd = scaled_motion(x.reshape(n_j, 2, h), t, lim, ex.base_hz, duration)
+        c = condition(model, ex.motion_dataset(t, q, qd, qdd, desc), params)
+        return float(np.log(c)) if np.isfinite(c) else 1e3
+
+    rng = np.random.default_rng(seed)
+    best = None
+    for _ in range(max(1, starts)):
+        x0 = rng.normal(size=n_j * 2 * h) / np.tile(np.arange(1, h + 1), n_j * 2)
+        res = scipy.optimize.minimize(cost, x0, method="L-BFGS-B", options={"maxiter": max_iter})
+        if best is None or res.fun < best.fun:
+            best = res
+    coef = best.x.reshape(n_j, 2, h)
+    t_out = np.arange(0.0, duration + 0.5 / ex.rate_hz, 1.0 / ex.rate_hz)
+    q, qd, qdd = scaled_motion(coef, t_out, lim, ex.base_hz, duration)
+    after = condition(model, ex.motion_dataset(t_out, q, qd, qdd, desc), params)
+    before = condition(model, before_ds, params) if before_ds is not None else None
+    return Design(t_out, q, qd, qdd, lim, tuple(params), before, after, model,
+                  time.monotonic() - t0)
+
+
+def write_reference(path, d: Design, exciter: Exciter, description_yaml: str | None = None,
+                    *, overwrite: bool = False) -> None:
+    """Write the designed reference as a bag of the plant's reference topic
+    (trajectory_msgs/JointTrajectory: positions, velocities, accelerations), with the
+    description when given."""
+    from .bags import BagWriter
+
+    with BagWriter(path, overwrite=overwrite) as w:
+        if description_yaml:
+            w.write_description(description_yaml)
+        w.write_joint_trajectory(exciter.reference_topic, d.t, list(d.limits.joints), d.q, d.qd, d.qdd)
+
+
+def read_reference(path, topic: str, joints: Sequence[str]):
+    """``fn(t) -> (q, qd, qdd)`` (N, n) interpolating a reference bag written by
+    :func:`write_reference` (held at its last point after the end): what a controller plays."""
+    from .bags import open_bag
+
+    bag = open_bag(path)
+    if not bag.has(topic):
+        raise CablelabError(f"{path}: no {topic} in the reference bag (topics: "
+                            f"{', '.join(sorted(bag.topics)) or 'none'})")
+    tr = bag.joint_trajectory(topic, list(joints))
+    tt = tr.t - tr.t[0]
+    cols = [np.asarray(a, float) if a is not None else np.zeros_like(tr.positions)
+            for a in (tr.positions, tr.velocities, tr.accelerations)]
+
+    def fn(t):
+        t = np.atleast_1d(np.asarray(t, float))
+        return tuple(np.stack([np.interp(t, tt, c[:, j]) for j in range(c.shape[1])], axis=1)
+                     for c in cols)
+
+    return fn
+
+
+__all__ = ["Design", "Exciter", "Limits", "condition", "design", "fourier_motion", "get_exciter",
+           "model_for", "read_reference", "register_exciter", "scaled_motion", "write_reference"]
