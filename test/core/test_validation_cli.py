@@ -117,6 +117,8 @@ RULES = {
     ("replay", "--start-delay"): lambda x: FINITE(x) and 0 <= x <= 3600,
     ("record", "--duration"): lambda x: FINITE(x) and x >= 0,
     ("record", "--flush-period"): lambda x: FINITE(x) and 0 < x <= 3600,
+    ("excite", "--duration"): lambda x: FINITE(x) and 5 <= x <= 3600,
+    ("excite", "--seed"): lambda x: FINITE(x) and x == int(x) and 0 <= x <= 2 ** 32 - 1,
 }
 
 

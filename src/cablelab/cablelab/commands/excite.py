@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 
 from ._workbench_args import add_overwrite, add_recover, add_tensions, dump_json
+from .numeric import number
 
 HELP = "design a reference trajectory (within the machine's limits) that separates named parameters"
 DESCRIPTION = (
@@ -25,9 +26,9 @@ def add_arguments(p) -> None:
     add_tensions(p)
     p.add_argument("--params", metavar="A,B", required=True,
                    help="parameters to separate, as the fit names them (e.g. 'OF[hoist],m')")
-    p.add_argument("--duration", type=float, default=60.0, metavar="S",
+    p.add_argument("--duration", type=number(ge=5, le=3600, unit="s"), default=60.0, metavar="S",
                    help="length of the designed reference, s (default 60)")
-    p.add_argument("--seed", type=int, default=0, help="seed of the optimiser's random start")
+    p.add_argument("--seed", type=number(ge=0, le=2**32 - 1, integer=True), default=0, help="seed of the optimiser's random start")
     p.add_argument("-o", "--out", required=True, metavar="REF", help="reference bag to write")
     add_overwrite(p)
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
