@@ -20,7 +20,7 @@ from cablelab.bags import open_bag
 from cablelab.bags.reader import recorder_lost
 
 HOG = [sys.executable, "-c", "while True: pass"]
-RATE, DURATION = 1000.0, 3.0
+RATE, DURATION, STOPPED = 1000.0, 5.0, 3000
 
 
 def _hogs(launcher, n: int = 2) -> None:
@@ -46,22 +46,32 @@ def _stamps(bag, topic: str) -> np.ndarray:
 
 
 def test_recorder_gets_every_sample_of_a_1khz_simulator_beside_cpu_hogs(launcher, tmp_path):
+    """Two busy-looping processes beside a 1 kHz simulator (real time: nothing slows it down
+    for the recorder) and the recorder; the recorder is moreover stopped (SIGSTOP) while the
+    simulator publishes 3000 states, a descheduling made certain: the writers' history (10 s
+    of a 1 kHz stream) holds what it has not received, and it catches up. Every step is in the
+    bag. (With the 2 s history publishers had before, this lost about a thousand states.)"""
     bag_dir = tmp_path / "run"
     _hogs(launcher, 2)
-    launcher.start("recorder", [sys.executable, "-m", "cablelab.cli", "record", "--plant", "suspended",
-                                "-o", bag_dir, "--quiet"])
+    rec = launcher.start("recorder", [sys.executable, "-m", "cablelab.cli", "record", "--plant", "suspended",
+                                      "-o", bag_dir, "--quiet", "--flush-period", "0.2"])
     streams = ["/suspended/joint_states", "/suspended/platform_pose", "/suspended/imu",
                "/suspended/ground_truth/swing", "/suspended/ground_truth/virtual_joints"]
     launcher.wait_for_subscribers(streams, timeout=180, node_name="cablelab_recorder")
-    # real time at 1 kHz (no lock-step: nothing slows the simulator down for the recorder); time
-    # starts once the recorder matched and acknowledged (start gate)
+    # time starts once the recorder matched and acknowledged (start gate)
     sim = launcher.node("sim", "cable_sim_node", "suspended",
                         {"rate": RATE, "duration": DURATION, "wait_for_subscribers": 1,
                          "start_swing_x": 0.05})
-    assert sim.wait(300) == 0, sim.log()[-2000:]
+    launcher.wait_for_recorded(bag_dir, {"/suspended/joint_states": 300}, timeout=180, poll=0.1)
+    rec.signal(signal.SIGSTOP)
+    try:   # (a best-effort probe in this process sees at most what was published)
+        launcher.wait_for_topics({"/suspended/joint_states": STOPPED}, timeout=600)
+    finally:
+        rec.signal(signal.SIGCONT)
+    assert sim.wait(600) == 0, sim.log()[-2000:]
     n = int(round(DURATION * RATE))
-    launcher.wait_for_recorded(bag_dir, {t: n for t in streams}, timeout=180)
-    assert launcher.stop("recorder", grace=60) == 0, launcher.procs["recorder"].log()
+    launcher.wait_for_recorded(bag_dir, {t: n for t in streams}, timeout=300)
+    assert launcher.stop("recorder", grace=60) == 0, rec.log()
 
     bag = open_bag(bag_dir)
     k_all = np.arange(1, n + 1)

@@ -41,10 +41,12 @@ from ..bags.reader import LOST_KEY  # metadata.yaml custom_data key prefix: samp
 
 class RecorderNode(Node):
     """Args: output bag path, topics (name -> type or None to discover), overwrite, duration
-    (s, 0 = until stopped), flush_period (s)."""
+    (s, 0 = until stopped), flush_period (s), fast (spin with FastExecutor; False: rclpy's
+    executor, for comparison in bench/bench_recorder.py)."""
 
     def __init__(self, output, topics: dict[str, str | None], *, overwrite: bool = False,
-                 duration: float = 0.0, flush_period: float = 1.0, quiet: bool = False):
+                 duration: float = 0.0, flush_period: float = 1.0, quiet: bool = False,
+                 fast: bool = True):
         super().__init__("cablelab_recorder")
         writer = output if isinstance(output, BagWriter) else BagWriter(output, overwrite=overwrite)
         self.writer = writer.open()
@@ -60,7 +62,9 @@ class RecorderNode(Node):
         self.lost_gaps: dict[str, int] = {}      # topic -> samples missing between sequence numbers
         self.single_writer: set[str] = set()     # topics with exactly one publisher (gaps mean loss)
         self._lost_handles: dict[str, tuple] = {}  # topic -> (event handle, total before it)
+        self._last_seq: dict[str, int] = {}      # topic -> last publication sequence number
         self.quiet = quiet
+        self.fast = bool(fast)
         self.duration = float(duration)
         self.t_start = time.monotonic()
         self.done = False
@@ -84,7 +88,7 @@ class RecorderNode(Node):
         executor overhead (the recorder must keep up with 1 kHz topics on a busy machine)."""
         from .fastspin import executor_for
 
-        return executor_for(self, True)
+        return executor_for(self, self.fast)
 
     def _subscribe(self, topic: str, msgtype: str, reliable: bool = True,
                    transient: bool | None = None) -> None:
@@ -100,7 +104,8 @@ class RecorderNode(Node):
         gaps = self.lost_gaps
         gaps.setdefault(topic, 0)
         single = self.single_writer
-        last_seq = [None]
+        last_seq = self._last_seq
+        last_seq.pop(topic, None)
         now_ns = time.time_ns
 
         def callback(data: bytes, info: dict) -> None:
@@ -114,10 +119,10 @@ class RecorderNode(Node):
             counts[topic] += 1
             seq = info.get("publication_sequence_number")
             if seq is not None:
-                prev = last_seq[0]
+                prev = last_seq.get(topic)
                 if prev is not None and seq > prev + 1 and topic in single:
                     gaps[topic] += seq - prev - 1
-                last_seq[0] = seq
+                last_seq[topic] = seq
 
         self._retire_lost_handle(topic)
         sub = self.create_subscription(cls, topic, callback, recorder_qos(transient, reliable), raw=True)
@@ -160,10 +165,10 @@ class RecorderNode(Node):
                 self._subscribe(topic, found[0])
             if topic in self.subs and found:
                 self._adapt_qos(topic, found[0])
-                if self.count_publishers(topic) == 1:
-                    self.single_writer.add(topic)
-                else:
-                    self.single_writer.discard(topic)
+                single = self.count_publishers(topic) == 1
+                if single != (topic in self.single_writer):
+                    self._last_seq.pop(topic, None)     # (sequence numbers are per writer)
+                    (self.single_writer.add if single else self.single_writer.discard)(topic)
         self._poll_lost()
 
     # ------------------------------------------------------------------ lost samples
