@@ -20,7 +20,7 @@ from cablelab.bags import open_bag
 from cablelab.bags.reader import recorder_lost
 
 HOG = [sys.executable, "-c", "while True: pass"]
-RATE, DURATION, STOPPED = 1000.0, 5.0, 3000
+RATE, DURATION, STOPPED, STOP_WALL = 1000.0, 5.0, 3000, 8.0
 
 
 def _hogs(launcher, n: int = 2) -> None:
@@ -45,12 +45,39 @@ def _stamps(bag, topic: str) -> np.ndarray:
     return np.asarray(bag.joint_state(topic).t)
 
 
+def _wait_sim_time(launcher, t: float, timeout: float) -> None:
+    """Wait until the simulator's /diagnostics says its sim time reached ``t`` s, at most
+    ``timeout`` s."""
+    from diagnostic_msgs.msg import DiagnosticArray
+
+    from cablelab.ros.qos import stream_qos
+
+    probe = launcher.probe()
+    now = [0.0]
+
+    def on_diag(msg):
+        for st in msg.status:
+            for kv in st.values:
+                if st.name == "cable_sim_node" and kv.key == "sim time s":
+                    now[0] = max(now[0], float(kv.value))
+    sub = probe.node.create_subscription(DiagnosticArray, "/diagnostics", on_diag, stream_qos(100))
+    try:
+        deadline = time.monotonic() + timeout
+        while now[0] < t and time.monotonic() < deadline:
+            probe.executor.spin_once(timeout_sec=0.1)
+    finally:
+        probe.node.destroy_subscription(sub)
+
+
 def test_recorder_gets_every_sample_of_a_1khz_simulator_beside_cpu_hogs(launcher, tmp_path):
     """Two busy-looping processes beside a 1 kHz simulator (real time: nothing slows it down
     for the recorder) and the recorder; the recorder is moreover stopped (SIGSTOP) while the
-    simulator publishes 3000 states, a descheduling made certain: the writers' history (10 s
-    of a 1 kHz stream) holds what it has not received, and it catches up. Every step is in the
-    bag. (With the 2 s history publishers had before, this lost about a thousand states.)"""
+    simulator publishes 3000 states (at most 8 s wall: a process silent for longer than the DDS
+    participant lease, 20 s, is taken for dead and unmatched), a descheduling made certain: the
+    writers' history (10 s of a 1 kHz stream) holds what it has not received, and it catches
+    up; the simulator, done
+    with its duration, exits only once the recorder acknowledged everything (its history ends
+    with it). Every step is in the bag."""
     bag_dir = tmp_path / "run"
     _hogs(launcher, 2)
     rec = launcher.start("recorder", [sys.executable, "-m", "cablelab.cli", "record", "--plant", "suspended",
@@ -64,8 +91,9 @@ def test_recorder_gets_every_sample_of_a_1khz_simulator_beside_cpu_hogs(launcher
                          "start_swing_x": 0.05})
     launcher.wait_for_recorded(bag_dir, {"/suspended/joint_states": 300}, timeout=180, poll=0.1)
     rec.signal(signal.SIGSTOP)
-    try:   # (a best-effort probe in this process sees at most what was published)
-        launcher.wait_for_topics({"/suspended/joint_states": STOPPED}, timeout=600)
+    try:
+        _wait_sim_time(launcher, STOPPED / RATE + open_bag(bag_dir, recover=True).joint_state(
+            "/suspended/joint_states").t.max(), timeout=STOP_WALL)
     finally:
         rec.signal(signal.SIGCONT)
     assert sim.wait(600) == 0, sim.log()[-2000:]
@@ -161,3 +189,30 @@ def test_recorder_counts_lost_samples_on_diagnostics_metadata_and_info(launcher,
     text = subprocess.run([sys.executable, "-m", "cablelab.cli", "info", str(bag_dir)],
                           capture_output=True, text=True, timeout=120).stdout
     assert f"lost {missing} samples of /burst" in text
+
+
+def test_info_reads_the_lost_counts_from_the_bag_metadata(tmp_path, capsys):
+    """metadata.yaml custom_data `cablelab.lost.<topic>` round trip (BagWriter -> rosbags ->
+    recorder_lost / info); a bag without them reports nothing; a non-number is skipped."""
+    from cablelab.bags import BagWriter, bag_info
+    from cablelab.cli import main
+
+    def bag(name, custom):
+        with BagWriter(tmp_path / name) as w:
+            w.write_joint_states("/a/joint_states", [0.0, 0.001], ["j"], position=[[0.0], [1.0]])
+            for k, v in custom.items():
+                w.set_custom_data(k, v)
+        return tmp_path / name
+
+    lossy = bag("lossy", {"cablelab.lost./a/joint_states": "12", "cablelab.lost./clock": "0",
+                          "cablelab.lost./b": "many", "other.key": "3"})
+    assert recorder_lost(lossy) == {"/a/joint_states": 12, "/clock": 0}
+    assert recorder_lost(lossy / "lossy.mcap") == {"/a/joint_states": 12, "/clock": 0}
+    assert bag_info(lossy)["lost"] == {"/a/joint_states": 12, "/clock": 0}
+    assert main(["info", str(lossy)]) == 0
+    assert "warning:  the recorder lost 12 samples of /a/joint_states" in capsys.readouterr().out
+    clean = bag("clean", {"cablelab.lost./a/joint_states": "0"})
+    assert main(["info", str(clean)]) == 0
+    assert "lost:     0 samples (recorder checked 1 topics)" in capsys.readouterr().out
+    plain = bag("plain", {})
+    assert recorder_lost(plain) is None and "lost" not in bag_info(plain)
