@@ -34,9 +34,8 @@ from rclpy.node import Node
 from ..bags import BagWriter
 from ..errors import CablelabError
 from .convert import message_class
-from .qos import recorder_qos
-
 from ..bags.reader import LOST_KEY  # metadata.yaml custom_data key prefix: samples lost per topic
+from .qos import recorder_qos
 
 
 class RecorderNode(Node):
@@ -124,7 +123,6 @@ class RecorderNode(Node):
                     gaps[topic] += seq - prev - 1
                 last_seq[topic] = seq
 
-        self._retire_lost_handle(topic)
         sub = self.create_subscription(cls, topic, callback, recorder_qos(transient, reliable), raw=True)
         self.subs[topic] = sub
         self.sub_qos[topic] = (reliable, transient)
@@ -147,6 +145,7 @@ class RecorderNode(Node):
             self.get_logger().warning(f"{topic}: a publisher offers "
                                       f"{'best-effort' if not reliable else 'volatile'} QoS; "
                                       "recording it with that QoS")
+            self._retire_lost_handle(topic)
             self.destroy_subscription(self.subs.pop(topic))
             self._subscribe(topic, msgtype, reliable, transient)
 
@@ -173,10 +172,13 @@ class RecorderNode(Node):
 
     # ------------------------------------------------------------------ lost samples
     def _retire_lost_handle(self, topic: str) -> None:
-        """Keep the message-lost total of a subscription about to be replaced."""
+        """Keep the message-lost total of a subscription about to be destroyed, and release its
+        status handle (it holds the subscription)."""
         if topic in self._lost_handles:
             self._poll_lost()
-            self._lost_handles.pop(topic)
+            handle, _ = self._lost_handles.pop(topic)
+            if handle is not None:
+                handle.destroy_when_not_in_use()
 
     def _poll_lost(self) -> None:
         """Read the DDS message-lost status of every subscription (non-blocking)."""
@@ -260,6 +262,8 @@ class RecorderNode(Node):
         if not self.closed:
             self.closed = True
             lost = self.lost()
+            for topic in list(self._lost_handles):
+                self._retire_lost_handle(topic)
             for topic in sorted(set(self.registered) | set(lost)):
                 self.writer.set_custom_data(LOST_KEY + topic, str(lost.get(topic, 0)))
             self.writer.close()
