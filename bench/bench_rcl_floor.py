@@ -156,10 +156,11 @@ def run_floor(exe: Path, mjb: Path, state: Path, seconds: float, listener: bool,
             "listener": listener, "pinned": pin, "rt_priority": False}
 
 
-def run_timer(exe: Path, seconds: float, pin: bool, rt: int) -> dict:
-    """The bare timer: the same 1 ms absolute deadlines with nothing to do (no ROS, no physics),
-    on CPU 0 with --pin; ``rt`` > 0 runs it under SCHED_FIFO (chrt, needs the privilege)."""
-    argv = [str(exe), "timer", str(seconds + 1.0), "1000"]
+def run_timer(exe: Path, seconds: float, pin: bool, rt: int, rate: float = 1000.0) -> dict:
+    """The bare timer: the same absolute deadlines (1 ms at ``rate`` 1000 Hz) with nothing to do
+    (no ROS, no physics), on CPU 0 with --pin; ``rt`` > 0 runs it under SCHED_FIFO (chrt, needs
+    the privilege)."""
+    argv = [str(exe), "timer", str(seconds + 1.0), f"{rate:g}"]
     if rt > 0:
         argv = ["chrt", "-f", str(rt), *argv]
     if pin:
@@ -168,7 +169,7 @@ def run_timer(exe: Path, seconds: float, pin: bool, rt: int) -> dict:
     if r.returncode:
         raise SystemExit(f"bench_rcl_floor: the bare timer failed: {r.stderr.strip()[-500:]}")
     t = json.loads(r.stdout.strip().splitlines()[-1])
-    return {"rate_hz": 1000, "seconds": t["steps"] / 1000.0, "realtime_factor": None,
+    return {"rate_hz": rate, "seconds": t["steps"] / rate, "realtime_factor": None,
             "missed_cycles": t["missed_cycles"], "late": t["late"], "stale": 0, "dropped": t["dropped"],
             "p99_ms": {"wake-up": t["wakeup_p99_ms"]}, "wakeup_max_ms": t["wakeup_max_ms"],
             "pinned": pin, "rt_priority": rt > 0}

@@ -1,5 +1,6 @@
-"""Real time on an ordinary machine (issue 14): offline CDPR simulation vs bare mj_step, and the
-1 kHz closed loop of three node processes over DDS without real-time privileges.
+"""Real time on an ordinary machine: offline CDPR simulation vs bare mj_step, the machine's floor,
+the 1 kHz control loop in one process and the 1 kHz loop of three node processes over DDS,
+without real-time privileges, in one run.
 
 1. Offline: ``simulate`` (MuJoCo 2 ms physics, PDFF + live estimator at 100 Hz) of the 60 s test
    trajectory with 615 kg, and a bare loop of ``mujoco.mj_step`` on the simulator's own MjModel
@@ -7,20 +8,42 @@
    start pose so the cables carry the platform as in the run), the same simulated time, in this
    one run. Each is the best wall time of ``--repeat`` alternating tries (the machine may be
    shared). Target: ``realtime_factor`` >= 1/3 of ``bare_mj_step_realtime_factor``.
-2. Closed loop: ``cable_sim_node --plant cdpr`` in real-time mode at 1000 Hz, ``payload_estimator``
-   and ``pd_feedforward`` as three processes over DDS (own ROS_DOMAIN_ID from
-   ``cablelab.ros.launch``), normal scheduling (``rt_priority`` 0), ``--seconds`` s of steady state
-   (the measuring code is ``bench_cdpr.run_closed_loop``). Targets: ``realtime_factor`` >= 0.99,
-   ``missed_cycles`` 0 (steps braked for want of a command, run a period or more late, or
-   applying a command that answers an older state, each step counted once, plus steps dropped
-   when too far behind), every in-node p99
-   < 1 ms (the worst 1 s window of each node).
+2. Three-process loop (JSON key ``three_process``): ``cable_sim_node --plant cdpr`` in
+   real-time mode at 1000 Hz, ``payload_estimator`` and ``pd_feedforward`` as three processes
+   over DDS (own ROS_DOMAIN_ID from ``cablelab.ros.launch``), normal scheduling (``rt_priority``
+   0), ``--seconds`` s of steady state (the measuring code is ``bench_cdpr.run_closed_loop``).
+   Targets: ``realtime_factor`` >= 0.99, ``missed_cycles`` <= 3x the C rcl pair's (steps braked
+   for want of a command, run a period or more late, or applying a command that answers an
+   older state, each step counted once, plus steps dropped when too far behind), every in-node
+   p99 < 1 ms (the worst 1 s window of each node).
+3. The floor, in the same run (``bench_rcl_floor.py``'s code, ``bench/rcl_floor/floor.c`` built
+   with ``$CC``, default ``cc``; reported as unavailable, not failed, without a C compiler): the
+   bare timer (a C process sleeping to absolute 1 ms deadlines, nothing else) and the C rcl
+   simulator/controller pair, ``--seconds`` each.
+4. The control loop (``control_loop --plant cdpr``: the simulated CDPR and the PDFF law in one
+   process on absolute deadlines, docs/nodes.md) at 1 kHz with ``payload_estimator`` as a
+   second process, ``--seconds`` after a 1 s warm-up. Its cycles are counted as the bare
+   timer's (a wake-up a period or more late, plus periods skipped more than 20 behind);
+   ``p99_ms`` is the loop body's (read -> law -> write) p99 in the worst 1 s window. Targets:
+   ``missed_cycles`` <= 2x the bare timer's, ``p99_ms`` < 0.5.
+5. A rate sweep: the bare timer and the control loop at 100, 250, 500 Hz (``--sweep-seconds``
+   each; the 1000 Hz row is parts 3-4), printed beside the floor.
 
 ``--json`` prints one JSON object::
 
     {"offline_sim": {"plant": "cdpr", "realtime_factor", "bare_mj_step_realtime_factor"},
-     "closed_loop": {"rate_hz": 1000, "seconds", "realtime_factor", "missed_cycles",
-                     "p99_ms": {"sim", "estimator", "controller"}, "rt_priority": false}}
+     "floor": {"bare_timer_missed", "c_rcl_pair_missed", "seconds", "available"},
+     "control_loop": {"rate_hz": 1000, "seconds", "missed_cycles", "late", "dropped", "p99_ms",
+                      "realtime_factor", "cpu_per_cycle_ms", "placement"},
+     "three_process": {"rate_hz": 1000, "seconds", "realtime_factor", "missed_cycles",
+                       "p99_ms": {"sim", "estimator", "controller"}, "rt_priority": false, ...},
+     "rate_sweep": [{"rate_hz", "bare_timer_missed", "control_loop_missed", "p99_ms",
+                     "realtime_factor", "seconds"}, ...]}
+
+``--executor events`` runs the three node processes with rclpy's C++ ``EventsExecutor``
+instead of ``FastExecutor`` (node parameter ``events_executor``; the JSON's ``placement`` says
+so): the comparison of the two executors is two runs of ``--skip-offline --skip-floor
+--skip-control-loop --skip-sweep``, one with each.
 
 Run it on a quiet machine: ``./run python bench/bench_realtime.py --seconds 60 --json`` (the
 10-minute soak: ``--seconds 600``). ``--py-spy PATH`` samples the three node processes with
@@ -164,6 +187,79 @@ def closed_loop(seconds: float, log, env: dict | None = None, py_spy: str | None
     return r
 
 
+#: ``--pin`` for the control loop: the loop on the CPU of the three-process controller, the
+#: estimator (off the deadline path) on the other in the SCHED_IDLE class
+LOOP_PINNED = {"loop": {"cpu_affinity": [1]}, "estimator": {"cpu_affinity": [0], "sched_idle": True}}
+
+SWEEP_RATES = (100.0, 250.0, 500.0)
+
+
+def build_floor(log):
+    """(floor executable, MJB, state file) of ``bench/rcl_floor/floor.c``, or the one-line reason
+    why not (no C compiler, no shared libpython)."""
+    from bench_rcl_floor import build, model_files
+
+    tmp = Path(tempfile.mkdtemp(prefix="bench-rt-floor-"))
+    try:
+        exe = build(tmp)
+    except SystemExit as exc:
+        log(f"floor unavailable: {exc}")
+        return None, str(exc)
+    mjb, state = model_files(tmp)
+    return (exe, mjb, state), None
+
+
+def floor(built, seconds: float, log, pin: bool = False) -> dict:
+    """The bare timer and the C rcl pair at 1 kHz, ``seconds`` each (bench_rcl_floor)."""
+    from bench_rcl_floor import run_floor, run_timer
+
+    exe, mjb, state = built
+    log(f"floor: bare timer, {seconds:g} s ...")
+    timer = run_timer(exe, seconds, pin, 0)
+    log(f"floor: rcl loop in C, {seconds:g} s ...")
+    pair = run_floor(exe, mjb, state, seconds, False, pin, log)
+    return {"available": True, "seconds": seconds, "bare_timer_missed": timer["missed_cycles"],
+            "c_rcl_pair_missed": pair["missed_cycles"], "bare_timer": timer, "c_rcl_pair": pair}
+
+
+def control_loop(seconds: float, log, rate: float = 1000.0, pin: bool = False, extra: dict | None = None) -> dict:
+    """``control_loop --plant cdpr`` at ``rate`` Hz with ``payload_estimator`` (batch mode, 100 Hz)
+    as a second process, ``seconds`` after the loop's 1 s warm-up; the figures are the loop's own
+    summary line (:meth:`cablelab.ros.control_loop.ControlLoopNode.summary`)."""
+    from cablelab.ros.launch import Launcher
+
+    placement = {k: dict(v) for k, v in (LOOP_PINNED if pin else IDLE_ESTIMATOR).items()}
+    for k, v in (extra or {}).items():
+        placement.setdefault(k, {}).update(v)
+    tmp = Path(tempfile.mkdtemp(prefix="bench-rt-loop-"))
+    with Launcher(log_dir=tmp / "logs") as launch:
+        log(f"control loop {rate:g} Hz, {seconds:g} s: ROS_DOMAIN_ID {launch.domain_id}, logs in {launch.log_dir}")
+        launch.node("estimator", "payload_estimator", "cdpr", {"poll_period": 0.01} | placement.get("estimator", {}))
+        launch.wait_for_topics({"/diagnostics": 1}, timeout=60)       # the estimator is up
+        params = {"rate": rate, "duration": seconds + 1.0, "warmup": 1.0, "payload_mass": 249.0,
+                  "extras_every": max(1, int(round(rate / 100.0)))} | placement.get("loop", {})
+        argv = [sys.executable, "-m", "pd_feedforward.control_loop", "--plant", "cdpr", "--ros-args"]
+        for k, v in params.items():
+            argv += ["-p", f"{k}:={v}"]
+        proc = launch.start("loop", argv)
+        code = proc.wait(20 * seconds + 120)
+        launch.stop_all()
+        lines = [ln for ln in proc.log().splitlines() if ln.startswith('{"node": "control_loop"')]
+    if code != 0 or not lines:
+        raise SystemExit(f"bench_realtime: the control loop failed (exit {code}); log {proc.log_path}:\n"
+                         + proc.log()[-1500:])
+    r = json.loads(lines[-1])
+    return {"rate_hz": rate, "seconds": r["cycles"] / rate, "missed_cycles": r["missed_cycles"],
+            "late": r["late"], "dropped": r["dropped"], "cycles": r["cycles"], "p99_ms": r["p99_ms"],
+            "p99_all_ms": r["p99_all_ms"], "median_ms": r["median_ms"],
+            "realtime_factor": r["realtime_factor"], "cpu_per_cycle_ms": r.get("cpu_per_cycle_ms"),
+            "placement": placement or None}
+
+
+def _fmt(x, digits: int = 4) -> str:
+    return "-" if x is None else f"{x:.{digits}f}"
+
+
 def main(argv=None) -> int:
     bench = Bench("realtime", __doc__)
     bench.parser.add_argument("--seconds", type=float, default=60.0, help="closed-loop steady state, s (60)")
@@ -184,23 +280,67 @@ def main(argv=None) -> int:
                                    "DEFAULT); default: what cablelab.ros.launch sets")
     bench.parser.add_argument("--py-spy", default=None, metavar="PATH",
                               help="py-spy executable: sample each node and print where its time goes")
+    bench.parser.add_argument("--executor", choices=("fast", "events"), default="fast",
+                              help="executor of the three node processes: cablelab's FastExecutor (fast) or "
+                                   "rclpy's C++ EventsExecutor (events)")
+    bench.parser.add_argument("--skip-floor", action="store_true", help="no bare timer / C rcl pair")
+    bench.parser.add_argument("--skip-control-loop", action="store_true", help="no control_loop process")
+    bench.parser.add_argument("--skip-three-process", action="store_true", help="no three-process loop")
+    bench.parser.add_argument("--skip-sweep", action="store_true", help="no rate sweep")
+    bench.parser.add_argument("--loop-params", default=None, metavar="JSON",
+                              help='extra parameters of the control-loop runs\' processes, e.g. '
+                                   '\'{"loop": {"publish_thread": true}}\' (keys loop, estimator)')
+    bench.parser.add_argument("--sweep-seconds", type=float, default=20.0,
+                              help="s per rate of the sweep's 100, 250, 500 Hz runs (20)")
     args = bench.parse(argv)
     out = {}
     if not args.skip_offline:
         bench.log("offline simulation vs bare mj_step ...")
         out["offline_sim"] = offline_sim(repeat=args.repeat)
-    if not args.skip_loop:
+    built = None
+    loop_extra = json.loads(args.loop_params) if args.loop_params else None
+    if not args.skip_loop and not (args.skip_floor and args.skip_sweep):
+        built, why = build_floor(bench.log)
+        if built is None:
+            out["floor"] = {"available": False, "reason": why, "bare_timer_missed": None, "c_rcl_pair_missed": None}
+    if not args.skip_loop and not args.skip_floor and built is not None:
+        out["floor"] = floor(built, args.seconds, bench.log, args.pin)
+    if not args.skip_loop and not args.skip_control_loop:
+        out["control_loop"] = control_loop(args.seconds, bench.log, 1000.0, args.pin, loop_extra)
+    if not args.skip_loop and not args.skip_sweep:
+        from bench_rcl_floor import run_timer
+
+        sweep = []
+        for rate in SWEEP_RATES:
+            row = {"rate_hz": rate, "seconds": args.sweep_seconds, "bare_timer_missed": None}
+            if built is not None:
+                bench.log(f"sweep: bare timer {rate:g} Hz, {args.sweep_seconds:g} s ...")
+                row["bare_timer_missed"] = run_timer(built[0], args.sweep_seconds, args.pin, 0, rate)["missed_cycles"]
+            c = control_loop(args.sweep_seconds, bench.log, rate, args.pin, loop_extra)
+            row.update(control_loop_missed=c["missed_cycles"], p99_ms=c["p99_ms"], realtime_factor=c["realtime_factor"])
+            sweep.append(row)
+        f, c = out.get("floor", {}), out.get("control_loop")
+        if c is not None:
+            sweep.append({"rate_hz": 1000.0, "seconds": args.seconds, "bare_timer_missed": f.get("bare_timer_missed"),
+                          "control_loop_missed": c["missed_cycles"], "p99_ms": c["p99_ms"],
+                          "realtime_factor": c["realtime_factor"]})
+        out["rate_sweep"] = sweep
+    if not args.skip_loop and not args.skip_three_process:
         env = {}
         if args.publication_mode:
             env["RMW_FASTRTPS_PUBLICATION_MODE"] = args.publication_mode.upper()
         if args.transports:
             env["FASTDDS_BUILTIN_TRANSPORTS"] = args.transports
-        r = closed_loop(args.seconds, bench.log, env, args.py_spy, args.pin,
-                        json.loads(args.node_params) if args.node_params else None, args.idle_estimator)
-        out["closed_loop"] = {"rate_hz": r["rate_hz"], "seconds": r["seconds"],
+        extra = json.loads(args.node_params) if args.node_params else {}
+        if args.executor == "events":
+            for node in ("sim", "estimator", "controller"):
+                extra.setdefault(node, {})["events_executor"] = True
+        r = closed_loop(args.seconds, bench.log, env, args.py_spy, args.pin, extra or None, args.idle_estimator)
+        out["three_process"] = {"rate_hz": r["rate_hz"], "seconds": r["seconds"],
                               "realtime_factor": r["realtime_factor"], "missed_cycles": r["missed_cycles"],
                               "p99_ms": r["p99_ms"], "rt_priority": r["rt_priority"],
-                              "command_age_steps": r["command_age"], "placement": r["placement"]}
+                              "command_age_steps": r["command_age"], "placement": r["placement"],
+                              "cpu_ms": r["cpu_ms"]}
     if args.json:
         print(json.dumps(out))
         return 0
@@ -213,19 +353,46 @@ def main(argv=None) -> int:
                       value=o["bare_mj_step_realtime_factor"], unit="x real time", target=""),
                  dict(case="ratio bare / simulate", value=o["bare_mj_step_realtime_factor"] / o["realtime_factor"],
                       unit="", target="<= 3")]
-    if "closed_loop" in out:
-        c = out["closed_loop"]
+    if "floor" in out:
+        f = out["floor"]
+        if not f["available"]:
+            rows.append(dict(case="floor (bare timer, C rcl pair)", value="unavailable: " + f["reason"].splitlines()[0],
+                             unit="", target=""))
+        else:
+            rows += [dict(case=f"floor: bare timer 1 kHz, {f['seconds']:.0f} s (missed = late + dropped)",
+                          value=f"{f['bare_timer_missed']} (wake-up p99 {f['bare_timer']['p99_ms']['wake-up']:.3f} ms)",
+                          unit=f"of {int(round(f['bare_timer']['seconds'] * 1000))}", target=""),
+                     dict(case="floor: C rcl simulator/controller pair 1 kHz", value=f["c_rcl_pair_missed"],
+                          unit=f"of {int(round(f['c_rcl_pair']['seconds'] * 1000))}", target="")]
+    if "control_loop" in out:
+        c = out["control_loop"]
+        bare = out.get("floor", {}).get("bare_timer_missed")
+        rows += [dict(case=f"control loop 1 kHz (control_loop + estimator), {c['seconds']:.0f} s: missed cycles "
+                           f"(late {c['late']} + dropped {c['dropped']})",
+                      value=c["missed_cycles"], unit=f"of {c['cycles'] + c['dropped']}",
+                      target=f"<= {2 * bare} (2x bare timer)" if bare is not None else "<= 2x bare timer"),
+                 dict(case="control loop body p99 (read -> law -> write, worst 1 s window) / median",
+                      value=f"{c['p99_ms']:.3f} / {c['median_ms']:.3f}", unit="ms", target="< 0.5"),
+                 dict(case="control loop realtime factor / CPU per cycle (all threads)",
+                      value=f"{_fmt(c['realtime_factor'])} / {_fmt(c['cpu_per_cycle_ms'], 3)}",
+                      unit="x / ms", target="")]
+    if "three_process" in out:
+        c = out["three_process"]
         where = ("sim + estimator (SCHED_IDLE) on CPU 0, controller on CPU 1" if args.pin else
                  "estimator SCHED_IDLE, no CPU placement" if args.idle_estimator else "no CPU placement")
         if args.node_params:
             where += f", node parameters {args.node_params}"
         prio = "SCHED_FIFO (node parameter rt_priority)" if c["rt_priority"] else "no RT priority"
+        pair = out.get("floor", {}).get("c_rcl_pair_missed")
+        if args.executor == "events":
+            prio += ", rclpy EventsExecutor"
         rows += [dict(case=f"closed loop 1 kHz, 3 processes, {prio}, {where}, {c['seconds']:.0f} s steady state",
                       value=c["realtime_factor"], unit="x real time", target=">= 0.99"),
                  dict(case="missed cycles (steps braked, late or with a stale command, + dropped)",
                       value=f"{c['missed_cycles']} (braked {r['braked']}, late {r['late']}, "
                             f"dropped {r['dropped']}, stale {r['stale']})",
-                      unit=f"of {r['steps']}", target="0")]
+                      unit=f"of {r['steps']}", target=f"<= {3 * pair} (3x C rcl pair)" if pair is not None
+                      else "<= 3x C rcl pair")]
         rows.append(dict(case="applied command answers the state 1 / 2 / >= 3 periods back",
                          value=" / ".join(str(a) for a in r["command_age"]), unit="steps", target=""))
         rows += [dict(case=f"in-node p99, {k} (worst 1 s window)", value=v, unit="ms", target="< 1")
@@ -234,6 +401,12 @@ def main(argv=None) -> int:
                          value=" / ".join(f"{v:.3f}" for v in r["cpu_ms"].values()), unit="ms", target=""))
         rows.append(dict(case="load average before / after", value=" / ".join(r["load"]), unit="", target=""))
     print(table(rows))
+    if out.get("rate_sweep"):
+        print()
+        print(table([dict(rate_hz=f"{r['rate_hz']:g}", seconds=f"{r['seconds']:g}",
+                          bare_timer_missed="-" if r["bare_timer_missed"] is None else r["bare_timer_missed"],
+                          control_loop_missed=r["control_loop_missed"], loop_body_p99_ms=f"{r['p99_ms']:.3f}",
+                          realtime_factor=_fmt(r["realtime_factor"])) for r in out["rate_sweep"]]))
     return 0
 
 

@@ -30,7 +30,8 @@ def test_colcon_build_installs_runnable_executables(tmp_path):
     site = [str(p) for p in (tmp_path / "install").glob("*/lib/python3*/site-packages")]
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(site)}
     for pkg, exe in (("cable_sim_node", "cable_sim_node"), ("payload_estimator", "payload_estimator"),
-                     ("pd_feedforward", "pd_feedforward"), ("cablelab", "cablelab")):
+                     ("pd_feedforward", "pd_feedforward"), ("pd_feedforward", "control_loop"),
+                     ("cablelab", "cablelab")):
         path = tmp_path / "install" / pkg / "lib" / pkg / exe
         assert path.exists(), f"{path} not installed"
         res = subprocess.run([str(path), "--help"], capture_output=True, text=True, env=env, timeout=120)

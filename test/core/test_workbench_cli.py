@@ -50,6 +50,20 @@ def test_report_writes_html_with_all_figures(synth_bag, tmp_path, capsys):
     assert "joint_coulomb_friction" in html and "std. error" in html
 
 
+def test_report_text_output_states_the_answer(synth_bag, tmp_path, capsys):
+    """Without --json the terminal says what is missing (the slide's hidden Coulomb friction) and
+    where the page is; the page's answer sentence names the same effect."""
+    out = tmp_path / "rep"
+    assert main(["report", synth_bag, "-o", str(out)]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].startswith("missing: joint_coulomb_friction (held-out NRMSE "), lines
+    before, after = (float(x) for x in lines[0].split("NRMSE ")[1].rstrip("%)").split("% ->"))
+    assert after < before
+    assert lines[-1].startswith("wrote ") and str(out / "index.html") in lines[-1]
+    html = (out / "index.html").read_text()
+    assert "misses <b>joint_coulomb_friction</b>" in html
+
+
 def test_bag_without_the_plant_topic(tmp_path, capsys):
     bag = _write(tmp_path / "b", np.arange(100) * 0.01, np.zeros(100), np.zeros(100),
                  topic="/other/joint_states")

@@ -25,11 +25,16 @@ class BagCheck:
 
     Attributes:
         reports: topic -> :class:`~cablelab.timebase.TimebaseReport`.
-        warnings: one line each (time base, NaN samples, negative tensions, recovered bag).
+        warnings: one line each (time base, NaN samples, negative tensions, recovered bag,
+            measured velocities that contradict their positions).
+        derived_velocity: topic -> joint names whose measured velocity contradicts the
+            derivative of their position (:func:`velocity_checks`): the plants' datasets derive
+            those velocities from the positions instead (``options["derived_velocity"]``).
     """
 
     reports: dict = field(default_factory=dict)
     warnings: list = field(default_factory=list)
+    derived_velocity: dict = field(default_factory=dict)
 
     @property
     def gaps(self) -> list:
@@ -87,9 +92,37 @@ def check_bag(bag, plant, desc, options: dict | None = None, limits: Limits = Li
         raise_if_impossible(rep, str(bag.path))
         out.reports[topic] = rep
         out.warnings.extend(rep.warnings())
+        if msgtype == JOINT_STATE:
+            bad, lines = velocity_checks(series, topic)
+            if bad:
+                out.derived_velocity[topic] = bad
+                out.warnings.extend(lines)
     if plant.check_bag is not None:     # the plant's own checks: names vs description, values
         out.warnings.extend(plant.check_bag(bag, desc, options, series_by_topic))
     return out
+
+
+def velocity_checks(series, topic: str) -> tuple[list[str], list[str]]:
+    """Measured velocities that contradict the derivative of their positions (sign flipped,
+    other units, unrelated): ``(joint names, warning lines)``. The verbs then use the velocity
+    derived from the position for those joints (:func:`cablelab.velocity.velocity_agreement`)."""
+    from .velocity import velocity_agreement, velocity_contradiction
+
+    vel, pos = getattr(series, "velocity", None), getattr(series, "position", None)
+    if vel is None or pos is None or vel.size == 0 or not np.isfinite(vel).any():
+        return [], []
+    bad, lines = [], []
+    for j, name in enumerate(series.names[:min(vel.shape[1], pos.shape[1])]):
+        ag = velocity_agreement(series.t, pos[:, j], vel[:, j])
+        what = velocity_contradiction(ag)
+        if what:
+            bad.append(name)
+            lines.append(f"{topic}: {name}: the measured velocity contradicts the derivative of the "
+                         f"position ({what}; scale {ag['scale']:.3g}, correlation "
+                         f"{ag['correlation']:.2f} on {ag['samples']} moving samples); NOT USED, the "
+                         f"velocity derived from the position is used instead (fix the velocity's "
+                         f"sign or units in the recording, or leave it empty)")
+    return bad, lines
 
 
 def check_names(bag, topic: str, names, want, *, exact: bool = False, plant: str = "",
@@ -104,16 +137,32 @@ def check_names(bag, topic: str, names, want, *, exact: bool = False, plant: str
     """
     have = list(names)
     if exact:
-        if set(have) != set(want):
+        if set(have) != set(want) or len(have) != len(set(have)):
+            missing = [n for n in want if n not in have]
+            extra = [n for n in dict.fromkeys(have) if n not in want]
+            dup = [n for n in dict.fromkeys(have) if have.count(n) > 1]
+            if len(set(have)) != len(want):
+                what = (f"{len(set(have))} {noun} ({_span(have)}) but the plant description has "
+                        f"{len(want)} {described or noun}")
+            else:   # same count, other names: say which
+                what = (f"{len(have)} {noun}, as many as the plant description, but named "
+                        f"{_span(have)}, not {_span(want)}")
+            parts = ([f"missing {_list(missing)}"] if missing else []) + \
+                ([f"unexpected {_list(extra)}"] if extra else []) + \
+                ([f"repeated {_list(dup)}"] if dup else [])
             raise CablelabError(
-                f"{bag.path}: {topic} has {len(have)} {noun} ({_span(have)}) but the plant "
-                f"description has {len(want)} {described or noun}; give the description of this "
-                f"robot (--description)")
+                f"{bag.path}: {topic} has {what} ({'; '.join(parts)}); give the description of "
+                f"this robot (--description) or name the {noun} {_span(want)}")
         return
     missing = [n for n in want if n not in have]
     if missing:
         raise CablelabError(f"{bag.path}: {topic} has {noun} {', '.join(have) or 'none'}; the {plant} "
                             f"description needs {', '.join(want)} (missing {', '.join(missing)})")
+
+
+def _list(names, most: int = 4) -> str:
+    names = list(names)
+    return ", ".join(names[:most]) + (f" and {len(names) - most} more" if len(names) > most else "")
 
 
 def _span(names) -> str:
@@ -129,7 +178,13 @@ def negative_tension_warnings(tensions, names, topic: str) -> list[str]:
         neg = T < 0
     count = neg.sum(axis=0)
     out = []
-    for j in np.flatnonzero(count):
+    bad = np.flatnonzero(count)
+    if bad.size > 3:    # one line for many cables (a sign convention, not a sensor)
+        names_bad = [names[j] if j < len(names) else f"column {j + 1}" for j in bad]
+        return [f"{topic}: {bad.size} cables ({_list(names_bad)}) have negative tension in "
+                f"{int(neg.any(axis=1).sum())} of {T.shape[0]} samples (min {np.nanmin(T):.4g} N): "
+                f"cables cannot push, check the sensor sign and offset"]
+    for j in bad:
         name = names[j] if j < len(names) else f"column {j + 1}"
         out.append(f"{topic}: {name} has {int(count[j])} of {T.shape[0]} samples with negative tension "
                    f"(min {np.nanmin(T[:, j]):.4g} N): cables cannot push, check the sensor sign and offset")

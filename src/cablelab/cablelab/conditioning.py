@@ -101,14 +101,26 @@ def uniform_grid(t: np.ndarray, *signals: np.ndarray, rate_hz: float | None = No
     return tu, out
 
 
-def derivatives(x: np.ndarray, fs: float, cutoff_hz: float | None, order: int = 4):
-    """Filtered signal and its first two time derivatives (central differences).
+def derivatives(x: np.ndarray, fs: float, cutoff_hz: float | None, order: int = 4,
+                method: str = "central"):
+    """Filtered signal and its first two time derivatives.
 
+    Args:
+        method: ``"central"`` (central differences: exact enough while the motion stays far
+            below the sample rate; their gain sin(w T) / (w T) is 0.86 for the velocity and 0.74
+            for the acceleration of a 1.5 Hz motion sampled at 10 Hz) or ``"spline"`` (the
+            derivatives of the quintic spline through the filtered samples: unbiased up to a
+            few samples per period, used for slow recordings, see :func:`motion_cutoff`).
     Returns:
         ``(x_f, xd, xdd)`` each shaped like ``x`` (units x, x/s, x/s^2).
     """
     xf = lowpass(x, fs, cutoff_hz, order) if cutoff_hz else np.asarray(x, dtype=float)
     dt = 1.0 / fs
+    if method == "spline" and xf.shape[0] > 6:
+        from scipy.interpolate import make_interp_spline
+
+        sp = make_interp_spline(np.arange(xf.shape[0]) * dt, xf, k=5, axis=0)
+        return xf, sp.derivative(1)(np.arange(xf.shape[0]) * dt), sp.derivative(2)(np.arange(xf.shape[0]) * dt)
     xd = np.gradient(xf, dt, axis=0)
     xdd = np.gradient(xd, dt, axis=0)
     return xf, xd, xdd
@@ -116,6 +128,45 @@ def derivatives(x: np.ndarray, fs: float, cutoff_hz: float | None, order: int = 
 
 def default_cutoff(fs: float, opts: Conditioning) -> float:
     return float(opts.cutoff_hz) if opts.cutoff_hz else fs / 10.0
+
+
+#: the automatic cut-off may rise up to this fraction of the sample rate (below Nyquist, fs / 2)
+MAX_CUTOFF_FRACTION = 0.4
+
+
+def motion_cutoff(q: np.ndarray, fs: float, default_hz: float, order: int = 4,
+                  source: str = "data") -> tuple[float, list[str]]:
+    """The default cut-off, raised when it would filter the motion itself out (slow recordings).
+
+    The motion's excitation bandwidth (:func:`cablelab.velocity.excitation_bandwidth`) is
+    measured through the default filter; when it fills that filter (above
+    ``default_hz / CUTOFF_OVER_EXCITATION``), it is measured again through a filter at
+    :data:`MAX_CUTOFF_FRACTION` x fs, and the cut-off becomes
+    ``CUTOFF_OVER_EXCITATION x`` that bandwidth (at most ``MAX_CUTOFF_FRACTION x fs``). At the
+    EMPS rate (1 kHz, motion below 10 Hz) nothing changes; at 10 Hz a 1.5 Hz motion gets 3 Hz
+    instead of 1 Hz.
+
+    Returns:
+        ``(cut-off Hz, warning lines)``: a warning when even the highest cut-off is below
+        ``CUTOFF_OVER_EXCITATION x`` the motion's band (the recording is too slow for its motion:
+        accelerations are not resolved).
+    """
+    from .velocity import CUTOFF_OVER_EXCITATION, excitation_bandwidth
+
+    f_exc = excitation_bandwidth(q, fs, default_hz, order)
+    if not f_exc * CUTOFF_OVER_EXCITATION > default_hz:
+        return default_hz, []
+    top = MAX_CUTOFF_FRACTION * fs
+    f_exc = max(f_exc, excitation_bandwidth(q, fs, top, order))
+    cut = min(max(default_hz, CUTOFF_OVER_EXCITATION * f_exc), top)
+    warnings = []
+    if CUTOFF_OVER_EXCITATION * f_exc > top:
+        warnings.append(
+            f"{source}: the motion reaches {f_exc:.3g} Hz, too close to the Nyquist frequency "
+            f"({fs / 2:.3g} Hz) of this {fs:.3g} Hz recording: velocities and accelerations are not "
+            f"resolved (filtered at {cut:.3g} Hz) and the fitted parameters are biased; record at "
+            f"{2.5 * CUTOFF_OVER_EXCITATION * f_exc:.3g} Hz or more")
+    return cut, warnings
 
 
 def condition_motion(t: np.ndarray, q: np.ndarray, effort: np.ndarray,
@@ -159,6 +210,13 @@ def condition_motion(t: np.ndarray, q: np.ndarray, effort: np.ndarray,
             raise CablelabError(f"{source}: {name} has no finite samples in some column")
     fs = 1.0 / float(np.median(np.diff(t)))
     cutoff = default_cutoff(fs, opts)
+    warnings: list[str] = []
+    method = "central"
+    if opts.cutoff_hz is None:  # a slow recording: fs / 10 must not filter the motion out
+        default = cutoff
+        cutoff, w = motion_cutoff(q, fs, cutoff, opts.order, source)
+        warnings += w
+        method = "spline" if cutoff > default else method   # central differences are biased there
     parallel = None
     if opts.cutoff_hz is None:  # quantized encoder: lower the cut-off until qdd is not noise
         from .velocity import (CUTOFF_OVER_EXCITATION, PARALLEL_OVER_EXCITATION,
@@ -176,7 +234,7 @@ def condition_motion(t: np.ndarray, q: np.ndarray, effort: np.ndarray,
     rev = np.broadcast_to(np.asarray(revolute, dtype=bool), q.shape[1:] if q.ndim > 1 else ())
     if opts.unwrap and np.any(rev):
         q = np.where(rev, unwrap_angle(q), q)
-    qf, qd_pos, qdd_pos = derivatives(q, fs, cutoff, opts.order)
+    qf, qd_pos, qdd_pos = derivatives(q, fs, cutoff, opts.order, method)
     if qd is not None and np.all(np.isfinite(qd)):
         qd_f = lowpass(qd, fs, cutoff, opts.order)
         # acceleration from the encoder (its noise is known, the velocity sensor's is not)
@@ -196,4 +254,5 @@ def condition_motion(t: np.ndarray, q: np.ndarray, effort: np.ndarray,
     return {"t": t[sl], "q": qf[sl], "qd": qd_out[sl], "qdd": qdd[sl], "effort": effort[sl],
             "fs": fs / max(1, int(opts.decimate)), "cutoff_hz": parallel or cutoff,
             "derivative_cutoff_hz": cutoff, "parallel_hz": parallel,
-            "qd_smooth": qd_smooth[sl], "qdd_smooth": qdd_smooth[sl], "resampled": resampled}
+            "qd_smooth": qd_smooth[sl], "qdd_smooth": qdd_smooth[sl], "resampled": resampled,
+            "warnings": warnings}

@@ -30,7 +30,8 @@ def log(msg: str) -> None:
 @dataclass
 class PartResult:
     """What a plant's demo part shows: table rows ``[quantity, cablelab, paper]``, bags, the
-    report index, the plant page, the first effect the diagnosis found, analysis seconds."""
+    ``cablelab report`` index (``""`` when the part writes none), the plant page, the first effect
+    the diagnosis found, analysis seconds."""
 
     rows: list = field(default_factory=list)
     bags: list = field(default_factory=list)
@@ -82,20 +83,42 @@ def demo_parts() -> list[DemoPart]:
     return sorted(parts, key=lambda p: (p.order, p.plant))
 
 
+#: the links of a plant's line in the index: label -> (PartResult field, what the target is)
+INDEX_LINKS = {"demo page": ("page", "html"), "diagnosis report": ("report", "html")}
+
+
+def part_links(part: PartResult, out=None) -> list[tuple[str, str]]:
+    """``[(label, path)]`` of a part's index line: its page, its ``cablelab report`` when it has
+    one of its own (an existing HTML page other than its demo page), then each existing bag
+    (a directory, named by its path relative to ``out`` when given). A link is only ever made to
+    a file of the kind its label names."""
+    links, seen = [], set()
+    for label, (key, kind) in INDEX_LINKS.items():
+        path = str(getattr(part, key) or "")
+        if path.endswith(f".{kind}") and os.path.isfile(path) and os.path.abspath(path) not in seen:
+            seen.add(os.path.abspath(path))
+            links.append((label, path))
+    for b in part.bags:
+        if os.path.isdir(b):
+            name = os.path.relpath(b, out) if out is not None else os.path.basename(os.path.normpath(str(b)))
+            links.append((f"bag {name}", str(b)))
+    return links
+
+
 def index_page(out: Path, parts: dict) -> str:
-    """``out/index.html``: one table per plant (cablelab vs paper) linking each plant's pages."""
+    """``out/index.html``: one table per plant (cablelab vs paper) linking each plant's pages
+    (:func:`part_links`: every link says what it opens)."""
     import html
 
     body = ["<h1>cablelab demo</h1><p>Each plant ran as separate processes over DDS (simulator, "
             "estimator, controller, recorder); the analysis is <code>cablelab estimate / diagnose / "
             "report</code> on the recorded bags.</p>"]
     for title, part in parts.items():
-        rel = {k: os.path.relpath(getattr(part, k), out) for k in ("report", "page")}
+        links = " | ".join(f"<a href='{html.escape(os.path.relpath(path, out))}'>{html.escape(label)}</a>"
+                           for label, path in part_links(part, out))
         rows = "".join("<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in r) + "</tr>"
                        for r in part.rows)
-        body.append(f"<h2>{html.escape(title)}</h2><p><a href='{rel['page']}'>demo page</a> | "
-                    f"<a href='{rel['report']}'>diagnosis report</a> | bags: "
-                    f"{html.escape(', '.join(os.path.relpath(b, out) for b in part.bags))}</p>"
+        body.append(f"<h2>{html.escape(title)}</h2><p>{links}</p>"
                     f"<table border=1 cellpadding=4><tr><th>quantity</th><th>cablelab</th>"
                     f"<th>paper</th></tr>{rows}</table>")
     path = out / "index.html"
@@ -166,8 +189,9 @@ def main(argv: list[str] | None = None) -> int:
     print()
     for title, (_, res) in results.items():
         print(f"{title.split(' (')[0]}: bags {', '.join(str(b) for b in res.bags)}")
-        print(f"    report {os.path.abspath(res.report)}")
-        print(f"    page   {os.path.abspath(res.page)}")
+        for label, path in part_links(res):
+            if not label.startswith("bag "):
+                print(f"    {label + ':':<17} {os.path.abspath(path)}")
     if index:
         print(f"index:  {os.path.abspath(index)}")
     print(f"({time.monotonic() - t_start:.0f} s)")

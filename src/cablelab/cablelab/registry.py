@@ -60,6 +60,9 @@ class Plant:
         check_bag: optional ``fn(bag, desc, options, series) -> list of warnings`` run before
             every fit (:func:`cablelab.bagcheck.check_bag`; ``series``: topic -> decoded series):
             names against the description (one-line errors), physically impossible values.
+        options: the plant-specific command-line options it reads, by ``argparse`` dest
+            (``("tensions", "pose")`` for the CDPR); a verb refuses such an option given for a
+            bag of another plant (one line naming the option and the plants it belongs to).
         package: the Python package of the plant (filled in by :func:`get_plant`).
         remeasure: optional ``fn(ds, shifted) -> Dataset`` used by ``time_delay``
             (:mod:`cablelab.effects.delay`) when the output channels are raw measurements mapped
@@ -88,6 +91,7 @@ class Plant:
     check_bag: Callable | None = None
     package: str = ""
     remeasure: Callable | None = None
+    options: tuple[str, ...] = ()
 
 
 def register_plant(plant: Plant) -> Plant:

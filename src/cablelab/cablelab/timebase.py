@@ -18,7 +18,11 @@ Definitions (``dt`` = successive header-stamp differences in log order, ``T`` = 
   *recording gap*; a run of NaN/inf samples spanning more than ``gap_factor * T`` is a *NaN run*
   gap (short runs are bridged by the conditioning's interpolation);
 * irregular rate: ``rate_factor * T < dt <= gap_factor * T`` or ``dt < T / rate_factor``;
-* milliseconds: header span ~1000x the log span, or ``T >= 0.5`` s with integer stamps -> error.
+* milliseconds: header span ~1000x the log span; or integer stamps with ``T >= 0.5`` s when
+  nothing says they are seconds (log times that advance with the stamps while not being copies
+  of them, or epoch stamps of a plausible date, 1973-2286) -> error; stamps beyond 1e11 (year
+  5138 in s, 1973 in ms) with integer steps are ms. ``Limits(time_unit="s")`` (the verbs'
+  ``--time-unit s``) trusts the stamps as seconds and skips this check.
 """
 from __future__ import annotations
 
@@ -37,11 +41,14 @@ class Limits:
         gap_factor: a step longer than ``gap_factor * T`` is a gap (default 5).
         rate_factor: a step outside ``[T / rate_factor, rate_factor * T]`` is irregular (default 2).
         min_rate_hz: a median rate below this looks like stamps in ms or a broken clock (default 2 Hz).
+        time_unit: ``"auto"`` (detect stamps in milliseconds) or ``"s"`` (the stamps are seconds,
+            whatever they look like: a 1 Hz recording with integer stamps).
     """
 
     gap_factor: float = 5.0
     rate_factor: float = 2.0
     min_rate_hz: float = 2.0
+    time_unit: str = "auto"
 
 
 @dataclass(frozen=True)
@@ -159,6 +166,7 @@ def check_stamps(t, t_log=None, *, topic: str = "data", values=None,
     big = dt > limits.gap_factor * T
     rep.irregular = int((((dt > limits.rate_factor * T) & ~big) | ((dt > 0) & (dt < T / limits.rate_factor))).sum())
     dl = None
+    seconds_by_log = False
     if t_log is not None:
         tl = np.asarray(t_log, dtype=float).reshape(-1)
         if tl.size == t.size:
@@ -166,8 +174,15 @@ def check_stamps(t, t_log=None, *, topic: str = "data", values=None,
             span_h, span_l = ts[-1] - ts[0], float(np.nanmax(tl[idx]) - np.nanmin(tl[idx]))
             if span_l > 0 and 300.0 < span_h / span_l < 3000.0:
                 rep.milliseconds = True
-    if T >= 1.0 / limits.min_rate_hz and np.allclose(ts, np.round(ts)):
-        rep.milliseconds = True
+            # a recorder's own clock that advances like the stamps (and is not a copy of them)
+            independent = not np.allclose(tl[idx], ts, rtol=0.0, atol=1e-6)
+            seconds_by_log = bool(independent and span_l > 0 and 0.5 < span_h / span_l < 2.0)
+    if T >= 1.0 / limits.min_rate_hz and np.allclose(ts, np.round(ts)) and not seconds_by_log:
+        epoch_seconds = 1e8 <= float(np.min(ts)) and float(np.max(ts)) < 1e10
+        if not epoch_seconds:
+            rep.milliseconds = True
+    if limits.time_unit == "s":
+        rep.milliseconds = False
     gi = np.flatnonzero(big)
     kinds = np.full(gi.size, "recording gap", dtype=object)
     if dl is not None and gi.size:
@@ -203,7 +218,8 @@ def raise_if_impossible(rep: TimebaseReport, source: str = "") -> None:
         raise CablelabError(
             f"{where}{rep.topic}: header stamps look like milliseconds (median period {rep.period:.3g} "
             f"'s' with integer stamps, or 1000x the log time span); write stamps in seconds "
-            f"(import: --map time=0.001*COLUMN)")
+            f"(import: --map time=0.001*COLUMN), or if they are seconds (e.g. a 1 Hz recording) "
+            f"say so with --time-unit s")
     if rep.backward:
         raise CablelabError(
             f"{where}{rep.topic}: header stamps go back in time {rep.backward} time(s) (first after "

@@ -178,3 +178,68 @@ def excitation_bandwidth(q: np.ndarray, fs: float, cutoff_hz: float, order: int 
     if c[-1] <= 0:
         return 0.0
     return float(f[np.searchsorted(c, EXCITATION_POWER * c[-1])])
+
+
+# ------------------------------------------------------------------- measured vs derived velocity
+
+#: a measured velocity is trusted when, on the moving samples, it agrees with the derivative of
+#: the position within this factor of scale (rad/s vs deg/s is 57, vs rpm 9.5, m/s vs mm/s 1000)
+VELOCITY_SCALE_TOLERANCE = 1.5
+#: ... and correlates with it at least this much (a sign flip gives -1, an unrelated signal ~0)
+VELOCITY_MIN_CORRELATION = 0.7
+
+
+def velocity_agreement(t, q, qd) -> dict | None:
+    """How a measured velocity agrees with the derivative of its position, on the moving samples.
+
+    Both are low-passed alike (zero-phase, at fs / 10 but never below the encoder's speed
+    resolution band); the derivative is a central difference over the stamps. Moving samples:
+    derived speed above a quarter of its 99th percentile and above the speed resolution of the
+    encoder (:func:`speed_resolution`: a quantized position's derivative is noise below it).
+
+    Args:
+        t: (N,) s; q: (N,) position; qd: (N,) measured velocity (unit of q / s).
+    Returns:
+        ``{"scale", "correlation", "samples"}`` (scale: median of measured / derived on the moving
+        samples, signed), or None when the record is too short or does not move.
+    """
+    from .filters import lowpass
+
+    t, q, qd = (np.asarray(a, dtype=float).reshape(-1) for a in (t, q, qd))
+    ok = np.isfinite(t) & np.isfinite(q) & np.isfinite(qd)
+    t, q, qd = t[ok], q[ok], qd[ok]
+    if t.size < 50:
+        return None
+    keep = np.concatenate([[True], np.diff(t) > 0])
+    t, q, qd = t[keep], q[keep], qd[keep]
+    if t.size < 50 or not np.all(np.diff(t) > 0):
+        return None
+    fs = 1.0 / float(np.median(np.diff(t)))
+    cut = fs / 10.0
+    vd = np.gradient(lowpass(q, fs, cut), t)
+    vm = lowpass(qd, fs, cut)
+    speed = np.abs(vd)
+    p99 = float(np.percentile(speed, 99))
+    floor = max(0.25 * p99, speed_resolution(position_quantum(q), cut))
+    moving = speed > floor
+    if p99 <= 0 or moving.sum() < 20:
+        return None
+    a, b = vm[moving], vd[moving]
+    sa, sb = np.std(a), np.std(b)
+    corr = float(np.corrcoef(a, b)[0, 1]) if sa > 0 and sb > 0 else 0.0
+    return {"scale": float(np.median(a / b)), "correlation": corr, "samples": int(moving.sum())}
+
+
+def velocity_contradiction(agreement: dict | None) -> str:
+    """What is wrong with a measured velocity given :func:`velocity_agreement` (``""``: nothing)."""
+    if agreement is None:
+        return ""
+    s, r = agreement["scale"], agreement["correlation"]
+    units = not 1.0 / VELOCITY_SCALE_TOLERANCE <= abs(s) <= VELOCITY_SCALE_TOLERANCE
+    if s < 0 or r <= -VELOCITY_MIN_CORRELATION:
+        return "sign flipped" + (f", and {abs(s):.3g}x its size, units?" if units else "")
+    if r < VELOCITY_MIN_CORRELATION:
+        return "not correlated with the derivative of position"
+    if units:
+        return f"{s:.3g}x the derivative of the position, units?"
+    return ""

@@ -35,7 +35,7 @@ def load(bag_path, description_path=None, options: dict | None = None):
 
 
 def load_checked(bag_path, description_path=None, options: dict | None = None, *,
-                 recover: bool = False):
+                 recover: bool = False, before_dataset=None, limits=None):
     """:func:`load` with the input checks of :mod:`cablelab.bagcheck`: time base of every topic
     the plant reads (gaps, clock jumps, stamps out of order, NaN samples), description vs bag
     (joint and cable names), negative cable tensions. Samples inside a gap (widened by the
@@ -46,6 +46,10 @@ def load_checked(bag_path, description_path=None, options: dict | None = None, *
 
     Args:
         recover: read an unfinished bag (recorder killed) up to its last complete chunk.
+        before_dataset: optional ``fn(plant)`` called once the plant is known, before any data
+            is read (e.g. refusing options of another plant).
+        limits: :class:`~cablelab.timebase.Limits` of the time-base checks (default: the
+            defaults; ``Limits(time_unit="s")`` trusts integer stamps as seconds).
     Returns:
         ``(plant, description, dataset, check)``, ``check`` a :class:`~cablelab.bagcheck.BagCheck`
         (``check.warnings``: lines for the text output and the JSON ``"warnings"`` list).
@@ -60,14 +64,19 @@ def load_checked(bag_path, description_path=None, options: dict | None = None, *
     bag = open_bag(bag_path, recover=recover)
     desc = load_bag_description(bag_path, description_path, bag)
     plant = get_plant(desc.plant)
+    if before_dataset is not None:
+        before_dataset(plant)
     for topic, msgtype in plant.topics:
         if not bag.has(topic):
             have = ", ".join(sorted(bag.topics)) or "none"
             raise CablelabError(f"{bag_path}: topic {topic} needed by plant {plant.name} is not in the "
                                 f"bag (topics: {have})")
         bag.require(topic, msgtype)
-    check = check_bag(bag, plant, desc, options)
-    ds = plant.dataset(bag, desc, dict(options or {}))
+    from .timebase import Limits
+
+    check = check_bag(bag, plant, desc, options, limits or Limits())
+    ds = plant.dataset(bag, desc, {**(options or {}), "derived_velocity": check.derived_velocity})
+    check.warnings.extend(ds.signals.get("load_warnings") or ())   # e.g. too slow for its motion
     # drives that stop: every plant with friction-bearing actuators (joint or winch drives)
     # leaves its zero-speed zone out of the fits (cablelab.velocity; a plant may have applied it
     # itself with its encoder's floor). Swing modes or a hopping body are not drives: untouched.

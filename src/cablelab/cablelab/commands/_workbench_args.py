@@ -11,6 +11,21 @@ def add_bag(p) -> None:
     p.add_argument("--description", metavar="FILE",
                    help="plant description YAML (default: /plant_description in the bag)")
     add_recover(p)
+    add_time_unit(p)
+
+
+def add_time_unit(p) -> None:
+    """``--time-unit {auto,s}``: stamps that look like milliseconds are refused unless told."""
+    p.add_argument("--time-unit", choices=("auto", "s"), default="auto",
+                   help="unit of the stamps: auto (refuse stamps that look like milliseconds: integer "
+                        "stamps 1 apart) or s (they are seconds, e.g. a 1 Hz recording)")
+
+
+def limits_from_args(args):
+    """:class:`~cablelab.timebase.Limits` of the time-base checks from ``--time-unit``."""
+    from ..timebase import Limits
+
+    return Limits(time_unit=getattr(args, "time_unit", "auto") or "auto")
 
 
 def add_recover(p) -> None:
@@ -26,9 +41,35 @@ def add_overwrite(p) -> None:
 
 
 def add_tensions(p) -> None:
-    p.add_argument("--tensions", choices=("dynamometer", "motor", "both"), default="dynamometer",
-                   help="CDPR: cable tensions from the dynamometers, from the motor torques, or both "
-                        "(dynamometer wrench + per-winch torque balance against the motor torques)")
+    p.add_argument("--tensions", choices=("dynamometer", "motor", "both"), default=None,
+                   help="CDPR only: cable tensions from the dynamometers (default), from the motor "
+                        "torques, or both (dynamometer wrench + per-winch torque balance against "
+                        "the motor torques)")
+
+
+#: options that only some plants read: dest -> option as typed (see Plant.options)
+PLANT_OPTIONS = {"tensions": "--tensions", "pose": "--pose"}
+
+
+def check_plant_options(args, plant) -> None:
+    """A plant-specific option given for a bag of another plant is an error (it would be
+    silently ignored): one line naming the option and the plants it belongs to."""
+    from ..errors import CablelabError
+    from ..registry import available_plants, get_plant
+
+    for dest, flag in PLANT_OPTIONS.items():
+        if getattr(args, dest, None) is None or dest in plant.options:
+            continue
+        owners = []
+        for name in available_plants():
+            try:
+                if dest in get_plant(name).options:
+                    owners.append(name)
+            except CablelabError:
+                continue
+        raise CablelabError(f"{flag} {getattr(args, dest)}: an option of plant "
+                            f"{' / '.join(owners) or 'none'} only, and {args.bag} holds plant "
+                            f"{plant.name} (leave {flag} out)")
 
 
 def add_json(p) -> None:
@@ -38,7 +79,7 @@ def add_json(p) -> None:
 def add_common(p, *, effects_required: bool = False) -> None:
     add_bag(p)
     p.add_argument("--effects", metavar="A,B", default="", required=effects_required,
-                   help="effects added to the plant's nominal model (ids of CONTRACT section 4)")
+                   help="effects added to the plant's nominal model (ids: docs/interface.md section 3)")
     p.add_argument("--baseline", metavar="A,B", default=None,
                    help="replace the plant's nominal effects ('none' = empty model)")
     p.add_argument("--fix", metavar="NAME=VALUE", action="append", default=[],
@@ -91,7 +132,9 @@ def load_from_args(args):
 
     options = {"conditioning": conditioning_from_args(args), "tensions": args.tensions}
     plant, desc, ds, check = load_checked(args.bag, args.description, options,
-                                          recover=getattr(args, "recover", False))
+                                          recover=getattr(args, "recover", False),
+                                          before_dataset=lambda p: check_plant_options(args, p),
+                                          limits=limits_from_args(args))
     args.warnings = list(check.warnings)
     baseline = None
     if args.baseline is not None:
@@ -109,6 +152,15 @@ def load_from_args(args):
         raise CablelabError(f"--baseline {args.baseline}: the model has no effects left to fit; add some "
                             f"with --effects A,B (e.g. --effects {','.join(plant.baseline(desc))})")
     return plant, desc, ds, model
+
+
+def flag_impossible(args, effects, params: dict, units: dict | None = None, where: str = "") -> None:
+    """Add a ``PHYSICALLY IMPOSSIBLE`` warning to ``args.warnings`` for every identified mass or
+    inertia of the ``effects`` (ids) in ``params`` that is not > 0 (:mod:`cablelab.plausibility`)."""
+    from ..plausibility import impossible_parameters, positive_parameters
+
+    lines = impossible_parameters(params, positive_parameters(effects), units, where)
+    args.warnings = list(getattr(args, "warnings", []) or []) + lines
 
 
 def with_warnings(args, out: dict) -> dict:

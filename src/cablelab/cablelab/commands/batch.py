@@ -11,7 +11,7 @@ def add_arguments(p) -> None:
     p.add_argument("root", help="directory tree (or fsspec URL, e.g. s3://bucket/fleet) of rosbag2 bags")
     p.add_argument("-o", "--out", required=True, metavar="OUT", help="output directory (re-use it to resume)")
     p.add_argument("--effects", metavar="A,B", default="",
-                   help="effects added to each plant's nominal model (ids of CONTRACT section 4)")
+                   help="effects added to each plant's nominal model (ids: docs/interface.md section 3)")
     p.add_argument("--greedy", action="store_true",
                    help="add significant effects one at a time; parameters from the final model")
     add_folds(p)

@@ -1,7 +1,8 @@
 """``cablelab compare BAG [--effects a,b] --json``: measured vs model per channel."""
 from __future__ import annotations
 
-from ._workbench_args import add_common, with_warnings, dump_json, load_from_args, param_line
+from ._workbench_args import (add_common, dump_json, flag_impossible, load_from_args, param_line,
+                              with_warnings)
 
 HELP = "compare the model (nominal effects + --effects, fitted) with the measurement per channel"
 
@@ -15,7 +16,9 @@ def run(args) -> int:
     from ..workbench import compare
 
     _, _, ds, model = load_from_args(args)
-    out = with_warnings(args, compare(ds, model, segments=args.segments))
+    res = compare(ds, model, segments=args.segments)
+    flag_impossible(args, model.effects, res["params"])
+    out = with_warnings(args, res)
     if args.json:
         print(dump_json(out))
         return 0

@@ -1,7 +1,8 @@
 """``cablelab diagnose BAG [--effects a,b] [--greedy] --json``: which effect is missing."""
 from __future__ import annotations
 
-from ._workbench_args import add_common, add_folds, check_alpha, dump_json, load_from_args, with_warnings
+from ._workbench_args import (add_common, add_folds, check_alpha, dump_json, flag_impossible,
+                              load_from_args, with_warnings)
 
 HELP = "rank the missing physical effects by held-out error (blocked k-fold), --greedy adds them"
 
@@ -32,6 +33,12 @@ def run(args) -> int:
     cands = parse_effect_list(args.candidates) if args.candidates else plant.candidates(desc)
     out = diagnose(ds, model, cands, folds=args.folds, alpha=args.alpha, min_gain=args.min_gain,
                    greedy_mode=args.greedy, quiet=args.json)
+    for c in out.ranking:
+        flag_impossible(args, (c.effect,), c.params, c.extra.get("units"),
+                        where=f"candidate {c.effect}")
+    for step in out.greedy:
+        flag_impossible(args, step.effects, step.params, step.units,
+                        where=f"model {' + '.join(step.effects)}")
     doc = with_warnings(args, out.to_json())
     if args.json:
         print(dump_json(doc))

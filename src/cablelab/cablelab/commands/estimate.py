@@ -10,7 +10,8 @@ from __future__ import annotations
 import inspect
 
 from ..errors import CablelabError
-from ._workbench_args import add_bag, add_json, add_overwrite, add_tensions, dump_json, with_warnings
+from ._workbench_args import (add_bag, add_json, add_overwrite, add_tensions, check_plant_options,
+                              dump_json, limits_from_args, with_warnings)
 
 HELP = "estimate the payload (CDPR mass and CoM) or the swing (crane) per sample from a bag"
 
@@ -21,8 +22,8 @@ def add_arguments(p) -> None:
     p.add_argument("--effects", metavar="A,B", default="",
                    help="effects added to the plant's nominal model (e.g. pulley_geometry, "
                         "platform_inertia, winch_coulomb_friction)")
-    p.add_argument("--pose", choices=("desired", "measured"), default="desired",
-                   help="CDPR: pose for the wrench matrix (001 uses the desired pose)")
+    p.add_argument("--pose", choices=("desired", "measured"), default=None,
+                   help="CDPR only: pose for the wrench matrix (default desired, as 001)")
     p.add_argument("--out", metavar="BAG2", help="also write the per-sample estimates as a bag")
     add_overwrite(p)
     add_json(p)
@@ -58,15 +59,17 @@ def run(args) -> int:
     bag = open_bag(args.bag, recover=args.recover)
     desc = load_bag_description(args.bag, args.description, bag)
     plant = get_plant(desc.plant)
-    args.check = check_bag(bag, plant, desc, {"tensions": args.tensions})
+    check_plant_options(args, plant)
+    args.check = check_bag(bag, plant, desc, {"tensions": args.tensions, "pose": args.pose},
+                           limits_from_args(args))
     args.warnings = args.check.warnings
     fn = plant.estimate
     if fn is None:
         able = [p for p in available_plants() if get_plant(p).estimate is not None]
         raise CablelabError(f"plant {desc.plant}: no estimator (cablelab estimate supports "
                             f"{', '.join(able)})")
-    kwargs = {"tensions": args.tensions, "effects": parse_effect_list(args.effects),
-              "pose": args.pose, "out": None}
+    kwargs = {"tensions": args.tensions or "dynamometer", "effects": parse_effect_list(args.effects),
+              "pose": args.pose or "desired", "out": None, "derived_velocity": args.check.derived_velocity}
     accepted = inspect.signature(fn).parameters
     if not any(p.kind == p.VAR_KEYWORD for p in accepted.values()):
         kwargs = {k: v for k, v in kwargs.items() if k in accepted}
@@ -77,7 +80,12 @@ def run(args) -> int:
             kwargs["out"] = str(tmp)
         res = fn(bag, desc, **kwargs)
     res = _without_gaps(res, getattr(args, "check", None))
-    out = with_warnings(args, res.summary() if hasattr(res, "summary") else dict(res))
+    summary = res.summary() if hasattr(res, "summary") else dict(res)
+    if isinstance(summary.get("mass"), dict):     # a mass estimate that is not > 0 is no result
+        from ..plausibility import impossible_mass
+
+        args.warnings = list(args.warnings) + impossible_mass(summary["mass"].get("mean"))
+    out = with_warnings(args, summary)
     if args.json:
         print(dump_json(out))
         return 0

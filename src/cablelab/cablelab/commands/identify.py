@@ -1,7 +1,8 @@
 """``cablelab identify BAG --effects a,b --json``: parameters with uncertainty and fit."""
 from __future__ import annotations
 
-from ._workbench_args import add_common, with_warnings, add_folds, dump_json, load_from_args, param_line
+from ._workbench_args import (add_common, add_folds, dump_json, flag_impossible, load_from_args,
+                              param_line, with_warnings)
 
 HELP = "identify the parameters of the nominal model + --effects, with standard errors"
 
@@ -19,6 +20,11 @@ def run(args) -> int:
 
     _, _, ds, model = load_from_args(args)
     out = identify(ds, model, folds=args.folds, simulation=args.simulation, quiet=args.json)
+    flag_impossible(args, model.effects, out["params"])
+    if "simulation" in out:
+        units = {k: v.get("unit", "") for k, v in out["params"].items()}
+        flag_impossible(args, model.effects, {k: v["value"] for k, v in out["simulation"]["params"].items()},
+                        units, where="simulation-based fit")
     with_warnings(args, out)
     if args.json:
         print(dump_json(out))

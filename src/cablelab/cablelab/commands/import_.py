@@ -32,6 +32,9 @@ def add_arguments(p) -> None:
     p.add_argument("-o", "--out", required=True, metavar="BAG", help="bag directory to write")
     p.add_argument("--overwrite", action="store_true", help="replace an existing output")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    from ._workbench_args import add_time_unit
+
+    add_time_unit(p)
 
 
 def read_table(path: str) -> dict[str, np.ndarray]:
@@ -122,11 +125,27 @@ def evaluate(field: str, factors, table: dict[str, np.ndarray], source: str) -> 
                 x = float(x[0])
             else:
                 series += 1
+        _check_factor(field, op, name, x, source)
         value = value * x if op == "*" else value / x
     if series != 1:
         raise CablelabError(f"{source}: --map {field}: expected exactly one column in the expression, "
                             f"found {series}")
     return np.asarray(value, dtype=float)
+
+
+def _check_factor(field: str, op: str, name: str, x, source: str) -> None:
+    """A scale factor must be finite and non-zero, a divisor column must hold no zero: the
+    imported values would be inf, NaN or all 0."""
+    if np.ndim(x) == 0:
+        if not np.isfinite(x) or x == 0:
+            role = "divisor" if op == "/" else "scale factor"
+            raise CablelabError(f"--map {field}: {role} {name!r} = {float(x):g}; expected a finite, "
+                                f"non-zero number")
+    elif op == "/" and np.any(np.asarray(x) == 0):
+        k = int(np.flatnonzero(np.asarray(x) == 0)[0])
+        raise CablelabError(f"{source}: --map {field}: divisor column {name!r} is 0 in "
+                            f"{int(np.sum(np.asarray(x) == 0))} row(s) (first: data row {k + 1}); the "
+                            f"imported values would be infinite")
 
 
 def joint_topic(plant: str) -> tuple[str, tuple[str, ...]]:
@@ -183,7 +202,7 @@ def run(args) -> int:
     from ..atomic import atomic_output, check_target
     from ..bags import BagWriter
     from ..description import load_description
-    from ._workbench_args import dump_json
+    from ._workbench_args import dump_json, limits_from_args
 
     if not args.description:
         raise CablelabError(f"import --plant {args.plant}: give --description FILE or YAML text "
@@ -196,7 +215,7 @@ def run(args) -> int:
     s = import_series(args.file, args.plant, args.map)
     from ..timebase import check_stamps, raise_if_impossible
 
-    tb = check_stamps(s["t"], topic=f"{args.file}: time column")
+    tb = check_stamps(s["t"], topic=f"{args.file}: time column", limits=limits_from_args(args))
     raise_if_impossible(tb)                 # stamps in ms: refuse with the --map fix
     with atomic_output(args.out, overwrite=args.overwrite, inputs=inputs, option="-o") as tmp:
         with BagWriter(tmp) as w:

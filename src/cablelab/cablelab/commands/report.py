@@ -44,5 +44,9 @@ def run(args) -> int:
     if args.json:
         print(dump_json(out))
     else:
+        steps = res["steps"]
+        added = [s["added"] for s in steps[1:]]
+        print(f"missing: {', '.join(added) if added else 'no significant effect'} (held-out NRMSE "
+              f"{100 * steps[0]['error']:.2f} % -> {100 * steps[-1]['error']:.2f} %)")
         print(f"wrote {res['index']} ({len(res['figures'])} figures, {res['seconds']:.1f} s)")
     return 0

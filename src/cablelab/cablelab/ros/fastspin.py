@@ -231,11 +231,18 @@ def supports(node) -> bool:
     return not (list(node.clients) or list(node.guards))
 
 
-def executor_for(node, fast: bool = True):
-    """The executor a node's ``executor_factory`` hook returns: :class:`FastExecutor` when
-    ``fast`` and the node :func:`supports` it, else rclpy's SingleThreadedExecutor."""
+def executor_for(node, fast: bool = True, events: bool = False):
+    """The executor a node's ``executor_factory`` hook returns: rclpy's C++
+    ``rclpy.experimental.EventsExecutor`` when ``events`` (callbacks driven by rmw's event
+    callbacks, timers by its own timer thread; :func:`poll`-ed subscriptions are then serviced
+    like the others), else :class:`FastExecutor` when ``fast`` and the node :func:`supports` it,
+    else rclpy's SingleThreadedExecutor."""
     from rclpy.executors import SingleThreadedExecutor
 
+    if events:
+        from rclpy.experimental import EventsExecutor
+
+        return EventsExecutor(context=node.context)
     return FastExecutor() if fast and supports(node) else SingleThreadedExecutor()
 
 

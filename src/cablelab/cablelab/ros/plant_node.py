@@ -61,6 +61,7 @@ class PlantNode(Node):
 
     def use_fast_executor(self, default: bool = True) -> None:
         """Parameters ``fast_executor`` (spin with :class:`~cablelab.ros.fastspin.FastExecutor`),
+        ``events_executor`` (spin with rclpy's C++ ``EventsExecutor`` instead, for comparison),
         ``rt_priority`` (SCHED_FIFO priority, 0 = off; needs the privilege), and the placement a
         deployment gives a 1 kHz loop without privileges: ``cpu_affinity`` (CPU numbers the
         node's threads run on, [] = any), ``niceness`` (0-19: lower priority for a node off
@@ -72,6 +73,7 @@ class PlantNode(Node):
                                set_realtime_priority)
 
         self.fast = bool(self.param("fast_executor", default))
+        self.events = bool(self.param("events_executor", False))
         cpus = [int(c) for c in self.param("cpu_affinity", [-1]) if int(c) >= 0]
         if cpus:
             self.get_logger().info(f"cpu_affinity: {set_cpu_affinity(cpus)}")
@@ -91,7 +93,7 @@ class PlantNode(Node):
         """The executor :func:`cablelab.ros.runner.run_node` spins this node with."""
         from .fastspin import executor_for
 
-        return executor_for(self, self.fast)
+        return executor_for(self, self.fast, getattr(self, "events", False))
 
     # ------------------------------------------------------------------ description
     def listen_for_description(self, text: str = "") -> None:

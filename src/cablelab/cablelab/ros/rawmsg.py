@@ -25,7 +25,7 @@ import numpy as np
 from .. import cdr
 from . import convert
 
-__all__ = ["RawTemplate", "RawReader", "type_name", "joint_state_arrays", "multidof_arrays", "command_arrays"]
+__all__ = ["RawTemplate", "CommandTemplate", "RawReader", "type_name", "joint_state_arrays", "multidof_arrays", "command_arrays"]
 
 
 def type_name(cls) -> str:
@@ -107,6 +107,34 @@ class RawTemplate:
     def data(self) -> bytes:
         """The serialised message as it is now (a copy: safe to publish and keep patching)."""
         return bytes(self.buf)
+
+
+class CommandTemplate:
+    """Serialised effort commands that name the state they answer (:func:`convert.command_msg`:
+    data = the efforts, ``layout.dim[0].label = '<label> stamp=<t>'``), from one
+    :class:`RawTemplate` per label length and command length (only the digits and the numbers
+    change from one command to the next)."""
+
+    def __init__(self, label: str = "command"):
+        self.label = label
+        self._templates: dict = {}
+
+    def data(self, command, stamp: float) -> bytes:
+        """The serialised command ``command`` (n,) answering the state of ``stamp`` (s)."""
+        from std_msgs.msg import MultiArrayDimension
+
+        label = f"{self.label} stamp={float(stamp):.9f}"
+        key = (len(label), len(command))
+        entry = self._templates.get(key)
+        if entry is None:
+            msg = convert.float_array_msg(command)
+            msg.layout.dim = [MultiArrayDimension(label=label, size=len(command), stride=len(command))]
+            tpl = RawTemplate(msg)
+            entry = self._templates[key] = (tpl, tpl["data"], tpl.text_offset(label))
+        tpl, values, off = entry
+        values[:] = command
+        tpl.write_text(off, label)
+        return tpl.data()
 
 
 class RawReader:

@@ -45,7 +45,8 @@ def dataset_from_arrays(t, q, effort, description, options: dict | None = None, 
     ds = Dataset(
         plant="axis", t=c["t"], y=c["effort"].reshape(-1, 1), channels=("joint",), units=(unit,),
         signals={"q": c["q"].reshape(-1), "qd": qd_c, "qdd": c["qdd"].reshape(-1),
-                 "cutoff_hz": c["cutoff_hz"], "rest_velocity": qd_s[:, None]},
+                 "cutoff_hz": c["cutoff_hz"], "rest_velocity": qd_s[:, None],
+                 "load_warnings": c["warnings"]},
         actuators=("joint",), act_vel=qd_c[:, None], act_units=((unit, "rad" if revolute else "m"),),
         inputs={"velocity": qd_s, "acceleration": c["qdd_smooth"].reshape(-1)},
         regimes={"position": _position_bins(c["q"].reshape(-1))},
@@ -85,8 +86,11 @@ def dataset(bag, description, options: dict | None = None) -> Dataset:
         if not np.isfinite(arr).any():
             raise CablelabError(f"{bag.path}: {TOPIC} has no {name} values")
     qd = js.velocity[:, col]
+    # a measured velocity that contradicts the position (bagcheck) is not used: derived instead
+    distrusted = js.names[col] in ((options or {}).get("derived_velocity") or {}).get(TOPIC, ())
     return dataset_from_arrays(js.t, q, eff, description, options,
-                               qd=qd if np.isfinite(qd).all() else None, source=str(bag.path))
+                               qd=qd if np.isfinite(qd).all() and not distrusted else None,
+                               source=str(bag.path))
 
 
 def baseline(description) -> tuple[str, ...]:
@@ -189,16 +193,28 @@ def fit_free_run(ds: Dataset, start: dict, *, objective: str = "nmse",
     Args:
         start: start values by name (e.g. the inverse-model LS result); parameters not in
             ``free`` are held at their start value.
-        free: parameters to fit, bounded to [start / 5, start * 5] (positive ones).
+        free: parameters to fit, bounded to [start / 5, start * 5]; those the model does not have
+            (absent from ``start``) are left out (held at 0).
+    Raises:
+        CablelabError: a parameter of the model whose inverse-model value is not positive (a
+            negative inertia or friction cannot start a physical simulation), or none to fit.
     """
     from ...model import Param
 
     params = []
+    names = {"M": "inertia", "Fv": "viscous friction", "Fc": "Coulomb friction"}
     for k in free:
-        v = float(start.get(k, 0.0))
-        if v <= 0:
-            raise CablelabError(f"free-run fit: start value of {k} must be > 0 (got {v:g})")
+        if k not in start:
+            continue          # not in the model (e.g. Fc without joint_coulomb_friction)
+        v = float(start[k])
+        if not v > 0:
+            raise CablelabError(
+                f"free-run fit: the inverse-model fit gives {names.get(k, k)} {k} = {v:.4g}, not "
+                f"physical (a simulation needs {k} > 0); the model does not explain this record "
+                f"(check the effort's sign and units, or fix it: --fix {k}=VALUE)")
         params.append(Param(k, "", v, v / 5.0, v * 5.0))
+    if not params:
+        raise CablelabError(f"free-run fit: the model has none of {', '.join(free)} to fit")
     return fit_free_run_windows(lambda sets: free_run(ds, sets, horizon_s), ds.signals["q"], start,
                                 params, horizon_s, ds.dt, objective=objective, max_iter=max_iter,
                                 progress=progress)

@@ -278,13 +278,15 @@ class LiveController:
     _t_filter: float | None = None
 
     def estimate(self, t: float, mass: float, com=None) -> bool:
-        """Feed one live estimate (stamp t); rejected (False) when invalid."""
+        """Feed one live estimate (stamp t); rejected (False) when invalid. A CoM that is not
+        finite or lies farther from the platform origin than twice its farthest cable anchor (in
+        x or y: no load on this platform can put it there) is ignored: the previous CoM stays."""
         lo, hi = self.config.valid_mass
         nom = self.config.nominal_mass
         if not np.isfinite(mass) or not (lo * nom <= mass <= hi * nom):
             return False
         c = np.zeros(2) if com is None else np.asarray(com, float)[:2]
-        if not np.all(np.isfinite(c)):
+        if not np.all(np.isfinite(c)) or np.abs(c).max() > 2.0 * np.abs(self.desc.anchor_points[:, :2]).max():
             c = self.com
         if self.mass is None or self._t_filter is None:
             self.mass, self.com = float(mass), c

@@ -81,7 +81,8 @@ def _finite_rows(*arrays) -> np.ndarray:
     return ok
 
 
-def load_arrays(bag, description, tensions: str = "dynamometer", pose: str = "desired") -> CdprArrays:
+def load_arrays(bag, description, tensions: str = "dynamometer", pose: str = "desired",
+                derived_velocity=()) -> CdprArrays:
     """Read a contract bag into :class:`CdprArrays` (one-line errors naming the topic).
 
     Args:
@@ -90,6 +91,8 @@ def load_arrays(bag, description, tensions: str = "dynamometer", pose: str = "de
             per-winch torque balance against the motor torques, :func:`dataset_from_arrays`).
         pose: "desired" (``/cdpr/reference``; falls back to the measured pose when absent) or
             "measured" (``/cdpr/platform_pose``).
+        derived_velocity: winch names whose measured velocity contradicts their angle
+            (:func:`cablelab.bagcheck.velocity_checks`): derived from the angles instead.
     """
     c = description.cdpr
     if c is None:
@@ -120,10 +123,13 @@ def load_arrays(bag, description, tensions: str = "dynamometer", pose: str = "de
     jok = _finite_rows(js.t, js.position)
     jok &= np.r_[True, np.diff(js.t) > 0] if len(js.t) else jok     # repeated stamps
     qd = js.velocity
+    derived = np.gradient(js.position[jok], js.t[jok], axis=0) if jok.sum() > 1 else qd[jok]
     if not np.isfinite(qd[jok]).all():          # empty velocity: derive from the angles
-        qd = np.gradient(js.position[jok], js.t[jok], axis=0)
+        qd = derived
     else:
-        qd = qd[jok]
+        qd = qd[jok].copy()
+        distrusted = [i for i, nm in enumerate(js.names) if nm in set(derived_velocity)]
+        qd[:, distrusted] = derived[:, distrusted]
     motor_velocity = _interp(t, js.t[jok], qd)
     eok = jok & _finite_rows(js.effort)
     motor_effort = _interp(t, js.t[eok], js.effort[eok]) if eok.sum() > 1 else np.full_like(tens, np.nan)
@@ -292,7 +298,8 @@ def dataset(bag, description, options: dict | None = None) -> Dataset:
     ``conditioning.decimate``)."""
     options = options or {}
     arr = load_arrays(bag, description, options.get("tensions") or "dynamometer",
-                      options.get("pose") or "desired")
+                      options.get("pose") or "desired",
+                      (options.get("derived_velocity") or {}).get(JOINTS, ()))
     cond = options.get("conditioning")
     return dataset_from_arrays(arr, description, str(bag.path), getattr(cond, "decimate", 1) or 1)
 
@@ -334,6 +341,10 @@ class Estimate:
         """JSON of CONTRACT section 5 (cdpr) + the model, parameters and, when the bag has the
         ground truth, the mass error in %."""
         ok = np.isfinite(self.mass)
+        if not ok.any():
+            raise CablelabError("no sample gives a finite mass: the cable geometry of the "
+                                "description is degenerate at the recorded poses (e.g. an anchor "
+                                "closer to its pulley than the sheave radius)")
         m = self.mass[ok]
         out = {"plant": "cdpr", "samples": int(ok.sum()),
                "mass": {"mean": float(m.mean()), "std": float(m.std()),
@@ -402,7 +413,7 @@ def estimate_arrays(arr: CdprArrays, description, effects=(), params: dict | Non
 
 
 def estimate_bag(bag_path, description=None, *, tensions: str = "dynamometer", effects=(),
-                 pose: str = "desired", out=None) -> Estimate:
+                 pose: str = "desired", out=None, derived_velocity: dict | None = None) -> Estimate:
     """``cablelab estimate`` for a CDPR bag; ``out`` also writes ``/cdpr/payload_estimate``
     (InertiaStamped: m, com = (x_G, y_G, NaN), frame ``platform``) stamped like the tensions."""
     from ...bags import open_bag
@@ -411,7 +422,7 @@ def estimate_bag(bag_path, description=None, *, tensions: str = "dynamometer", e
     desc = description if description is not None else bag.description
     if desc is None:
         raise CablelabError(f"{bag_path}: no /plant_description in the bag; give --description FILE")
-    arr = load_arrays(bag, desc, tensions, pose)
+    arr = load_arrays(bag, desc, tensions, pose, (derived_velocity or {}).get(JOINTS, ()))
     est = estimate_arrays(arr, desc, effects)
     if out is not None:
         from ...bags import BagWriter
@@ -425,20 +436,86 @@ def estimate_bag(bag_path, description=None, *, tensions: str = "dynamometer", e
 
 
 def check_bag(bag, desc, options, series) -> list[str]:
-    """Before a fit: one winch and one cable per described cable, and no cable that pushes."""
+    """Before a fit: one winch and one cable per described cable, no cable that pushes, tensions
+    that are not all zero, and a geometry that can hold the platform (:func:`check_geometry`)."""
     from ...bagcheck import check_names, negative_tension_warnings
 
     warnings = []
     n = len(desc.cdpr.cables) if desc.cdpr is not None else None
+    source = options.get("tensions") or "dynamometer"
     for topic, prefix, noun in ((JOINTS, "winch", "winches"), (TENSIONS, "cable", "cables")):
         s = series.get(topic)
         if s is None or n is None:
             continue
         check_names(bag, topic, s.names, [f"{prefix}_{i}" for i in range(1, n + 1)], exact=True,
                     noun=noun, described="cables")
-        if topic == TENSIONS and (options.get("tensions") or "dynamometer") == "dynamometer":
+        if topic == TENSIONS and source in ("dynamometer", "both"):
             warnings.extend(negative_tension_warnings(s.effort, s.names, topic))
+        if (topic == TENSIONS) == (source in ("dynamometer", "both")):
+            _refuse_zero_load(bag, topic, s.effort, "tension" if topic == TENSIONS else "motor torque")
+    if desc.cdpr is not None:
+        pose = series.get(REFERENCE) if (options.get("pose") or "desired") == "desired" else None
+        pose = pose if pose is not None else series.get(POSE)
+        check_geometry(bag, desc.cdpr, None if pose is None else pose.position)
     return warnings
+
+
+def _refuse_zero_load(bag, topic: str, effort, what: str) -> None:
+    """All-zero (or empty) load measurements give a mass of 0 kg: refuse them."""
+    e = np.asarray(effort, dtype=float)
+    fin = e[np.isfinite(e)]
+    if fin.size and not np.any(fin != 0.0):
+        raise CablelabError(f"{bag.path}: {topic}: every {what} sample is exactly 0 (sensor not "
+                            f"connected or not recorded?); no load is measured, so no mass can be "
+                            f"estimated")
+
+
+def check_geometry(bag, c, positions=None) -> None:
+    """One-line errors for a description whose geometry cannot hold or measure the platform:
+    two cables with the same exit and anchor points, a force map (the force rows of the wrench
+    matrix) of rank below min(3, n) at the recorded poses, or poses where no cable pulls up
+    (every exit point at or below its anchor point: the cables cannot carry the weight).
+
+    Args:
+        c: the ``cdpr`` section; positions: (N, 3) recorded platform positions, or None (then
+            only the coincident cables are checked: the poses decide the rest).
+    """
+    A, B = c.exit_points, c.anchor_points
+    n = len(A)
+    size = max(float(np.ptp(A, axis=0).max()), 1e-3)
+    for i in range(n):
+        for j in range(i + 1, n):
+            if np.linalg.norm(A[i] - A[j]) < 1e-6 * size and np.linalg.norm(B[i] - B[j]) < 1e-6 * size:
+                raise CablelabError(
+                    f"{bag.path}: plant description: cables {i + 1} and {j + 1} have the same exit "
+                    f"point {A[i].tolist()} and anchor point {B[i].tolist()} (two cables cannot run "
+                    f"along one line; a copy-paste error in the description?)")
+    P = None if positions is None else np.asarray(positions, dtype=float)
+    if P is not None:
+        P = P[np.all(np.isfinite(P), axis=1)]
+        P = P[:: max(1, len(P) // 200)]
+    if P is None or not len(P):
+        return
+    geom = cable_geometry(A, B, P, None, 0.0, c.swivel_axes)
+    u = geom.directions                                          # (N, n, 3) anchor -> exit
+    up = u[:, :, 2].max(axis=1)
+    if np.any(up <= 1e-9):
+        k = int(np.argmin(up))
+        raise CablelabError(
+            f"{bag.path}: plant description: at the platform position {np.round(P[k], 3).tolist()} "
+            f"no cable pulls up (every exit point is at or below its anchor point: lowest exit "
+            f"point z = {A[:, 2].min():.3g} m, highest {A[:, 2].max():.3g} m); the cables cannot carry "
+            f"the weight: check the z of the exit points (world frame, z up)")
+    sv = np.linalg.svd(u.transpose(0, 2, 1), compute_uv=False)    # (N, 3) of the force map
+    need = min(3, n)
+    rel = sv[:, need - 1] / np.maximum(sv[:, 0], 1e-300)
+    if np.any(rel < 1e-6):
+        k = int(np.argmin(rel))
+        raise CablelabError(
+            f"{bag.path}: plant description: the cable directions at the platform position "
+            f"{np.round(P[k], 3).tolist()} span fewer than {need} dimensions (singular wrench "
+            f"matrix: all cables in one line or plane); the forces cannot be resolved, check the "
+            f"exit and anchor points")
 
 
 CDPR = register_plant(Plant(
@@ -468,4 +545,5 @@ CDPR = register_plant(Plant(
     estimate=estimate_bag,
     checked_topics=(TENSIONS, "/cdpr/reference", POSE),
     check_bag=check_bag,
+    options=("tensions", "pose"),
 ))

@@ -197,7 +197,7 @@ def analyse(out: Path, bag_dir: Path, *, folds: int = 5) -> PartResult:
         ["samples (100 Hz, lock-step over DDS)", f"{ds.n}", "-"],
         ["live swing RMS error theta1 / theta2 (deg)",
          f"{deg(sw['rms']['theta1']):.3f} / {deg(sw['rms']['theta2']):.3f}",
-         "exact inverse (CONTRACT), not eq. 6.6-6.7"],
+         "exact inverse of the measured pivots, not eq. 6.6-6.7"],
         ["max |theta1| / |theta2| swing (deg)",
          f"{deg(sw['range']['theta1']):.1f} / {deg(sw['range']['theta2']):.1f}", "-"],
         ["offline estimate RMS error theta1 / theta2 (deg)",

@@ -229,6 +229,92 @@ def _check_joint_names(bag, series) -> list[str]:
     return []
 
 
+#: the measured boom tip may differ from the one of the joint angles by this share of the boom
+#: length (motion-capture marker offset, boom bending) before the angles are called contradictory
+TIP_TOLERANCE = 0.25
+#: a pose that moves less than this (m) over the whole record is frozen
+FROZEN_SPAN_M = 1e-6
+
+
+def check_bag(bag, desc, options, series) -> list[str]:
+    """Before a fit or an estimate: the joint names (slew, luff, hoist), then contradicting
+    measurements (:func:`check_measurements`)."""
+    _check_joint_names(bag, series)
+    if JOINT_STATES not in series or desc.crane is None:
+        return []
+    return check_measurements(bag, desc.crane.boom_length, series[JOINT_STATES], series.get(TIP_POSE),
+                              series.get(PAYLOAD_POSE))
+
+
+def check_measurements(bag, boom_length: float, js, tip=None, payload=None) -> list[str]:
+    """Joint angles against the motion capture, and a payload that moves with the crane.
+
+    * slew / luff angles in degrees: the boom tip of the recorded angles (002 eq. A.3) is far
+      (more than :data:`TIP_TOLERANCE` x the boom length, median) from the measured tip, and the
+      same angles read as degrees put it three times closer -> error; far without that
+      explanation -> warning. Without a usable tip pose: a luff angle beyond +-pi/2 (the boom
+      would point below the horizon behind the slew axis) with values of more than 3 -> error.
+    * a payload pose that never moves (span below :data:`FROZEN_SPAN_M`) while slew, luff or
+      hoist move -> error (the swing angles would be the boom's motion, not a swing).
+    """
+    from .kinematics import boom_tip
+
+    names = list(js.names)
+    col = {j: names.index(j) for j in JOINTS if j in names}
+    if "slew" not in col or "luff" not in col:
+        return []
+    q = js.position
+    alpha, beta = q[:, col["slew"]], q[:, col["luff"]]
+    ok = np.isfinite(js.t) & np.isfinite(alpha) & np.isfinite(beta)
+    if ok.sum() < 10:
+        return []
+    t, alpha, beta = js.t[ok], alpha[ok], beta[ok]
+    warnings = []
+    degrees_hint = ("slew and luff must be in rad (import: --map position.slew=0.0174533*COLUMN, "
+                    "the same for luff)")
+    checked = False
+    if tip is not None and np.isfinite(tip.position).all(axis=1).sum() >= 10:
+        tok = np.isfinite(tip.position).all(axis=1) & np.isfinite(tip.t)
+        order = np.argsort(tip.t[tok])
+        tt, tp = tip.t[tok][order], tip.position[tok][order]
+        inside = (t >= tt[0]) & (t <= tt[-1])
+        if inside.sum() >= 10:
+            meas = np.stack([np.interp(t[inside], tt, tp[:, k]) for k in range(3)], axis=1)
+            e_rad = float(np.median(np.linalg.norm(
+                boom_tip(alpha[inside], beta[inside], boom_length) - meas, axis=1)))
+            e_deg = float(np.median(np.linalg.norm(
+                boom_tip(np.deg2rad(alpha[inside]), np.deg2rad(beta[inside]), boom_length) - meas, axis=1)))
+            checked = True
+            if e_rad > TIP_TOLERANCE * boom_length:
+                if e_deg < e_rad / 3:
+                    raise CablelabError(
+                        f"{bag.path}: {JOINT_STATES}: slew / luff look like degrees (luff "
+                        f"{np.min(beta):.3g}..{np.max(beta):.3g}): the boom tip they give is "
+                        f"{e_rad:.3g} m from {TIP_POSE} (median), read as degrees {e_deg:.3g} m; "
+                        f"{degrees_hint}")
+                warnings.append(
+                    f"{JOINT_STATES}: the boom tip of the slew / luff angles is {e_rad:.3g} m (median) "
+                    f"from {TIP_POSE} with a boom of {boom_length:g} m: the angles, the boom length "
+                    f"of the description or the tip's motion capture are wrong")
+    if not checked and np.max(np.abs(beta)) > max(np.pi / 2, 3.0):
+        raise CablelabError(
+            f"{bag.path}: {JOINT_STATES}: luff reaches {np.max(np.abs(beta)):.4g}, beyond +-pi/2 rad; "
+            f"the angles look like degrees: {degrees_hint}")
+    if payload is not None:
+        pok = np.isfinite(payload.position).all(axis=1)
+        if pok.sum() >= 10:
+            span = float(np.max(np.ptp(payload.position[pok], axis=0)))
+            moves = {j: float(np.nanmax(q[:, c]) - np.nanmin(q[:, c])) for j, c in col.items()}
+            moving = {j: v for j, v in moves.items() if v > 0.01}   # rad or m
+            if span < FROZEN_SPAN_M and moving:
+                what = ", ".join(f"{j} by {v:.3g} {'m' if j == 'hoist' else 'rad'}" for j, v in moving.items())
+                raise CablelabError(
+                    f"{bag.path}: {PAYLOAD_POSE} is frozen at {np.round(payload.position[pok][0], 4).tolist()} "
+                    f"for the whole recording while the crane moves ({what}): the payload's motion "
+                    f"capture did not track it, no swing can be measured")
+    return warnings
+
+
 CRANE = register_plant(Plant(
     name="crane",
     topics=((JOINT_STATES, JOINT_STATE), (TIP_POSE, POSE), (PAYLOAD_POSE, POSE)),
@@ -252,5 +338,5 @@ CRANE = register_plant(Plant(
     joints=JOINTS,
     capabilities=frozenset({"joint_actuators"}),
     estimate=estimate_bag,
-    check_bag=lambda bag, desc, options, series: _check_joint_names(bag, series),
+    check_bag=check_bag,
 ))

@@ -146,7 +146,7 @@ def _analyse(out_dir: Path, args, res: dict) -> PartResult:
             ["apex time MAE with / without impact (ms)",
              f"{f11['apex_time_mae_ms']['with_impact']:.1f} / {f11['apex_time_mae_ms']['without_impact']:.1f}",
              "Fig. 11: with < without"]]
-    return PartResult(rows=rows, bags=[res["bag"]], report=res["plot"], page=_page(Path(out_dir), rows),
+    return PartResult(rows=rows, bags=[res["bag"]], page=_page(Path(out_dir), rows),
                       first=w[1]["step"] if len(w) > 1 else "")
 
 

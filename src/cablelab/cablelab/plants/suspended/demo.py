@@ -148,7 +148,7 @@ def _analyse(out_dir: Path, args, res: dict):
                     "<h1>LiCAS (000): truth plant on four tendons vs the virtual-joint model</h1>"
                     f"<table border=1 cellpadding=4><tr><th>quantity</th><th>cablelab</th><th>000</th></tr>"
                     f"{table}</table>{plots}</body></html>")
-    return PartResult(rows=rows, bags=[d["bag"]], report=str(page), page=str(page), first=d["first"])
+    return PartResult(rows=rows, bags=[d["bag"]], page=str(page), first=d["first"])
 
 
 def _make_demo():

@@ -19,7 +19,7 @@ set it with a lock-step simulator to make sim -> estimator -> controller one det
 ``fast_executor`` (default true: :class:`cablelab.ros.fastspin.FastExecutor`; false = rclpy's
 SingleThreadedExecutor), ``rt_priority`` (0 = normal scheduling; 1-99 = SCHED_FIFO, see
 :func:`cablelab.ros.fastspin.set_realtime_priority`). Commands go out as pre-serialised messages
-(:class:`cablelab.ros.rawmsg.RawTemplate`).
+(:class:`cablelab.ros.rawmsg.CommandTemplate`).
 """
 from __future__ import annotations
 
@@ -28,7 +28,7 @@ import time
 import numpy as np
 from geometry_msgs.msg import InertiaStamped
 from sensor_msgs.msg import JointState
-from std_msgs.msg import Float64MultiArray, MultiArrayDimension
+from std_msgs.msg import Float64MultiArray
 from trajectory_msgs.msg import MultiDOFJointTrajectory
 
 from ....errors import CablelabError
@@ -42,7 +42,7 @@ from ....stamped import StampedBuffer
 from ....ros.plant_node import PlantNode
 from ....ros.qos import stream_qos
 from ....ros import rawmsg
-from ....ros.rawmsg import RawReader, RawTemplate
+from ....ros.rawmsg import CommandTemplate, RawReader
 
 
 class CdprController(PlantNode):
@@ -97,7 +97,7 @@ class CdprController(PlantNode):
         self.est_stamp = None       # newest estimate stamp received (valid or not)
         self.create_timer(0.002, self.on_timer)
         self.use_fast_executor()
-        self._cmd_templates = {}        # label length -> (pre-serialised command, data view, label offset)
+        self._cmd = CommandTemplate("winch")     # pre-serialised commands naming their state's stamp
         self.start_diagnostics()
 
     def set_description(self, desc) -> None:
@@ -232,26 +232,11 @@ class CdprController(PlantNode):
             self.last_problem = self.controller.status[-1][1]
             return
         # optional: the stamp of the state this command answers (a lock-step simulator matches it)
-        self.pub_cmd.publish(self._command_bytes(tau, f"winch stamp={t:.9f}"))
+        self.pub_cmd.publish(self._cmd.data(tau, t))
         self.sent += 1
         self.latency.append(time.perf_counter() - t0)
         if len(self.latency) > 100000:
             del self.latency[:50000]
-
-    def _command_bytes(self, tau: np.ndarray, label: str) -> bytes:
-        """Serialised Float64MultiArray (data = tau, layout.dim[0].label = label) from a
-        pre-serialised template per label length (only the digits and the torques change)."""
-        entry = self._cmd_templates.get((len(label), len(tau)))
-        if entry is None:
-            msg = convert.float_array_msg(tau)
-            msg.layout.dim = [MultiArrayDimension(label=label, size=len(tau), stride=len(tau))]
-            tpl = RawTemplate(msg)
-            entry = (tpl, tpl["data"], tpl.text_offset(label))
-            self._cmd_templates[(len(label), len(tau))] = entry
-        tpl, data, off = entry
-        data[:] = tau
-        tpl.write_text(off, label)
-        return tpl.data()
 
     def extend_status(self, level, msg, values):
         ctl = self.controller

@@ -43,7 +43,7 @@ from trajectory_msgs.msg import MultiDOFJointTrajectory
 
 from ....description import load_description
 from ....errors import CablelabError
-from ..trajectory import pick_and_place
+from ..trajectory import ReferenceTable, pick_and_place
 from ....ros import convert
 from ....rotations import wxyz_to_xyzw
 from ....ros.inputs import WARN
@@ -52,6 +52,7 @@ from ....ros.plant_node import PlantNode
 from ....ros.qos import stream_qos
 from ....ros import rawmsg
 from ....ros.rawmsg import RawTemplate
+from ..hardware import WinchBrakes
 from ..sim import CdprSim, CdprTruth, default_description_path
 
 
@@ -104,9 +105,7 @@ class CdprSimNode(PlantNode):
         self.nstep = max(1, int(round(1.0 / (self.rate * self.sim.truth.timestep))))
         # winch brakes: lock each motor angle where it was when the commands stopped, holding the
         # last torque that carried the load (stiff PD about the locked angle)
-        self.brake_gains = (5.0, 0.05)       # N m/rad, N m s/rad
-        self.brake_q = None
-        self.brake_u = None
+        self.brakes = WinchBrakes(self.sim)
         self.u = None
         self.commands = 0           # good commands received
         self.commands_at_pub = 0    # ... when the last state was published (lock-step)
@@ -130,7 +129,7 @@ class CdprSimNode(PlantNode):
         for _ in range(int(round(0.5 / self.sim.truth.timestep))):
             self.sim.step(self.brake(), 1)
         self.sim.data.time = 0.0
-        self.brake_q = None
+        self.brakes.release()
         self.inputs.add("effort_commands", timeout=self.command_timeout, length=self.n)
         self._last_pub_wall = time.monotonic()
         self._wall0 = None          # wall time of sim time 0 (real-time mode)
@@ -213,23 +212,10 @@ class CdprSimNode(PlantNode):
 
     def reference(self, t: float):
         """Desired pose/twist/acceleration of the s-curve at sim time t (held at A while
-        settling, at A after the return); tabulated once at the publishing rate, up to 1 s after
-        the return (a run that goes on holds the table's last row: evaluating the s-curve per
-        step cost ~0.13 ms of the simulator's 1 kHz step)."""
+        settling, at A after the return): :class:`~cablelab.plants.cdpr.trajectory.ReferenceTable`."""
         if getattr(self, "_ref_table", None) is None:
-            end = self.settle + 60.0 / self.speed + 1.0
-            grid = np.arange(int(end * self.rate) + 2) / self.rate
-            tt = np.maximum(0.0, grid - self.settle) * self.speed
-            tr = pick_and_place(tt)
-            self._ref_table = (tr.position, tr.velocity * self.speed, tr.acceleration * self.speed ** 2)
-        k = int(round(t * self.rate))
-        pos, vel, acc = self._ref_table
-        if k < len(pos) and abs(k / self.rate - t) < 1e-9:
-            return pos[k], vel[k], acc[k]
-        if k >= len(pos):           # the table ends 1 s after the return to A: held there since
-            return pos[-1], vel[-1], acc[-1]
-        tr = pick_and_place(np.array([max(0.0, t - self.settle) * self.speed]))
-        return tr.position[0], tr.velocity[0] * self.speed, tr.acceleration[0] * self.speed ** 2
+            self._ref_table = ReferenceTable(self.rate, self.settle, self.speed)
+        return self._ref_table.at(t)
 
     def tick(self) -> None:
         """Timer: lock-step, one step when answered; real time, as many steps as the wall clock
@@ -281,7 +267,7 @@ class CdprSimNode(PlantNode):
                 self.fallbacks_running += 1
                 missed = True
         else:
-            self.brake_q = None
+            self.brakes.release()
             if self.real_time and self.u_stamp is not None:
                 age = int(round((self.sim.time - self.u_stamp) * self.rate))   # 0: the last state
                 self.command_age[min(max(age, 0), 2)] += 1
@@ -303,13 +289,7 @@ class CdprSimNode(PlantNode):
 
     def brake(self) -> np.ndarray:
         """Torques of the locked winch brakes (the plant's own safety behaviour)."""
-        ms = self.sim.measure()
-        if self.brake_q is None:
-            self.brake_q = ms["motor_angle"].copy()
-            k = self.description.cdpr.drum_radius / self.description.cdpr.gear_ratio
-            self.brake_u = self.u.copy() if self.u is not None else k * self.sim.truth_state()["tension"]
-        kp, kd = self.brake_gains
-        return self.brake_u + kp * (self.brake_q - ms["motor_angle"]) - kd * ms["motor_velocity"]
+        return self.brakes.torque(self.u)
 
     def publish_state(self) -> None:
         """One sample of every output topic, from the pre-serialised templates (same bytes as
