@@ -10,7 +10,7 @@ from __future__ import annotations
 HELP = "record a plant's contract topics (or --topics) into a rosbag2 MCAP bag"
 DESCRIPTION = (HELP + ". Samples a publisher dropped before the recorder had them are counted per "
                "topic: WARN on /diagnostics, a warning at the end, and cablelab.lost.<topic> in the "
-               "bag's metadata.yaml custom_data (cablelab info shows them).")
+               "bag metadata's custom_data (cablelab info shows them).")
 
 
 def add_arguments(p) -> None:
