@@ -41,7 +41,7 @@ from .qos import recorder_qos
 class RecorderNode(Node):
     """Args: output bag path, topics (name -> type or None to discover), overwrite, duration
     (s, 0 = until stopped), flush_period (s), fast (spin with FastExecutor; False: rclpy's
-    executor, for comparison in bench/bench_recorder.py)."""
+    executor, for comparisons)."""
 
     def __init__(self, output, topics: dict[str, str | None], *, overwrite: bool = False,
                  duration: float = 0.0, flush_period: float = 1.0, quiet: bool = False,
