@@ -7,7 +7,7 @@ disk every ``flush_period`` s. Topics whose type is not known in advance (``--to
 subscribed as soon as they appear in the ROS graph.
 
 Draining: the node spins with :class:`~cablelab.ros.fastspin.FastExecutor` (one wait set, every
-queued sample taken in one wake-up, straight to the write), a few times cheaper per message than
+queued sample taken in one wake-up, straight to the write), cheaper per message than
 rclpy's executor, so that a recorder sharing a busy CPU with the nodes it records keeps up with
 them; the publishers keep seconds of history (:func:`~cablelab.ros.qos.publisher_qos`) for the
 moments it does not.
