@@ -604,6 +604,35 @@ def bag_info(path, *, recover: bool = False) -> dict:
         info["warnings"] = list(bag.warnings)
     info["contract_mismatches"] = [{"topic": t, "type": have, "contract_type": want}
                                    for t, have, want in bag.contract_mismatches()]
+    lost = recorder_lost(path)
+    if lost is not None:
+        info["lost"] = lost
     return info
+
+
+LOST_KEY = "cablelab.lost."   # metadata.yaml custom_data: samples the recorder lost, per topic
+
+
+def recorder_lost(path) -> dict[str, int] | None:
+    """Samples ``cablelab record`` counted as lost, per topic, from metadata.yaml's
+    ``custom_data`` (``cablelab.lost.<topic>: <count>``); None when the bag has no such record
+    (not written by ``cablelab record``, or the recorder was killed before closing it)."""
+    import yaml
+
+    path = Path(path)
+    meta = (path if path.is_dir() else path.parent) / "metadata.yaml"
+    try:
+        data = yaml.safe_load(meta.read_text(encoding="utf-8"))
+        custom = data["rosbag2_bagfile_information"].get("custom_data") or {}
+    except (OSError, UnicodeError, yaml.YAMLError, KeyError, TypeError, AttributeError):
+        return None
+    lost = {}
+    for key, value in custom.items():
+        if str(key).startswith(LOST_KEY):
+            try:
+                lost[str(key)[len(LOST_KEY):]] = int(value)
+            except (TypeError, ValueError):
+                continue
+    return lost if lost else None
 
 

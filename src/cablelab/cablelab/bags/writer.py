@@ -168,6 +168,12 @@ class BagWriter:
         self.counts[topic] = 0
         return conn
 
+    def set_custom_data(self, key: str, value: str) -> None:
+        """A key/value of metadata.yaml's ``custom_data`` (written when the bag is closed)."""
+        if self._writer is None:
+            self.open()
+        self._writer.set_custom_data(str(key), str(value))
+
     def write_raw(self, topic: str, t_ns: int, data: bytes) -> None:
         """Write one already-serialised CDR message (topic registered with :meth:`add_topic`)."""
         self._writer.write(self._conns[topic], int(t_ns), data)

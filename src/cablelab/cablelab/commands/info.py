@@ -1,4 +1,5 @@
-"""``cablelab info BAG``: topics, types, message counts and the plant description of a bag."""
+"""``cablelab info BAG``: topics, types, message counts, the plant description of a bag and the
+samples ``cablelab record`` counted as lost (metadata.yaml ``custom_data``)."""
 from __future__ import annotations
 
 import json
@@ -32,4 +33,12 @@ def run(args) -> int:
             print(f"warning:  {m['topic']} has type {m['type']}, the contract says {m['contract_type']}")
         if info.get("plant"):
             print(f"plant:    {info['plant']}")
+        lost = info.get("lost")
+        if lost is not None:
+            bad = {t: n for t, n in lost.items() if n}
+            if bad:
+                for t, n in sorted(bad.items()):
+                    print(f"warning:  the recorder lost {n} samples of {t}")
+            else:
+                print(f"lost:     0 samples (recorder checked {len(lost)} topics)")
     return 0

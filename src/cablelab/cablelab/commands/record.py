@@ -1,13 +1,18 @@
 """``cablelab record -o BAG (--plant P | --topics a,b)``: record contract topics into a bag.
 
 A real ROS 2 node (see :mod:`cablelab.ros.recorder`); stops on SIGINT/SIGTERM or after
-``--duration`` and closes the bag.
+``--duration`` and closes the bag. Samples a publisher dropped before the recorder had them are
+counted per topic: WARN on /diagnostics, a warning line at the end, ``cablelab.lost.<topic>`` in
+the bag's metadata.yaml ``custom_data`` (shown by ``cablelab info``).
 """
 from __future__ import annotations
 
 from .numeric import number
 
 HELP = "record a plant's contract topics (or --topics) into a rosbag2 MCAP bag"
+DESCRIPTION = (HELP + ". Samples a publisher dropped before the recorder had them are counted per "
+               "topic: WARN on /diagnostics, a warning at the end, and cablelab.lost.<topic> in the "
+               "bag metadata's custom_data (cablelab info shows them).")
 
 
 def add_arguments(p) -> None:

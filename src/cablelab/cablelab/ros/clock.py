@@ -4,7 +4,7 @@ from __future__ import annotations
 from rosgraph_msgs.msg import Clock
 
 from .convert import clock_msg
-from .qos import stream_qos
+from .qos import publisher_qos
 
 
 class ClockPublisher:
@@ -16,7 +16,7 @@ class ClockPublisher:
     """
 
     def __init__(self, node, period: float = 0.0):
-        self.pub = node.create_publisher(Clock, "/clock", stream_qos(10))
+        self.pub = node.create_publisher(Clock, "/clock", publisher_qos())
         self.period = float(period)
         self.last = None
 

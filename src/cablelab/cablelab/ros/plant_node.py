@@ -23,6 +23,7 @@ from .inputs import InputMonitor
 from .qos import DESCRIPTION_QOS
 
 PROBE_REPEAT = 5.0  # s wall: the start gate's probe state is published again (see waiting_for_subscribers)
+FINISH_ACK_TIMEOUT = 120.0  # s wall: a node that finished waits this long for acknowledgements (drain)
 NO_WAIT = Duration(seconds=0)
 
 
@@ -214,6 +215,25 @@ class PlantNode(Node):
         published (checked without waiting; /diagnostics, published on a timer, not counted)."""
         diag = getattr(getattr(self, "diag", None), "pub", None)
         return all(pub.wait_for_all_acked(NO_WAIT) for pub in self.publishers if pub is not diag)
+
+    def drain(self, executor, timeout: float = FINISH_ACK_TIMEOUT) -> None:
+        """Called by the runner after the spin loop. A node that finished by itself (``done``,
+        e.g. a simulator at its ``duration``) waits, up to ``timeout`` s, until every reliable
+        subscriber acknowledged every sample it published: its writers' history, which a
+        recorder that fell behind still needs, ends with the process. (Stopped by a signal it
+        exits at once.)"""
+        if not getattr(self, "done", False):
+            return
+        t_end = time.monotonic() + timeout
+        diag = getattr(getattr(self, "diag", None), "pub", None)
+        late = []
+        for pub in self.publishers:
+            left = max(0.0, t_end - time.monotonic())
+            if pub is not diag and not pub.wait_for_all_acked(Duration(seconds=left)):
+                late.append(pub.topic_name)
+        if late:
+            self.get_logger().warning(f"exiting with samples not acknowledged after {timeout:g} s "
+                                      f"on {', '.join(late)}")
 
     # ------------------------------------------------------------------ diagnostics
     def start_diagnostics(self) -> None:

@@ -5,7 +5,8 @@
   publishers keep :data:`PUBLISHER_DEPTH` samples (:func:`publisher_qos`) so that a reliable
   reader starved by a busy machine (a recorder) catches up instead of losing samples: a
   keep-last writer overwrites what a reader has not acknowledged yet;
-* recorder subscriptions: reliable keep-all, so a briefly busy recorder delays rather than drops.
+* recorder subscriptions: reliable keep-all, so a briefly busy recorder delays rather than drops
+  (what a writer dropped anyway is counted by the recorder, see :mod:`cablelab.ros.recorder`).
 """
 from __future__ import annotations
 
@@ -23,7 +24,7 @@ def stream_qos(depth: int = 100) -> QoSProfile:
                       durability=DurabilityPolicy.VOLATILE)
 
 
-PUBLISHER_DEPTH = 2000  # samples: 10 s of a 200 Hz stream
+PUBLISHER_DEPTH = 10000  # samples: 10 s of a 1 kHz stream
 
 
 def publisher_qos(depth: int = PUBLISHER_DEPTH) -> QoSProfile:
