@@ -404,17 +404,8 @@ def open_bag(path, *, recover: bool = False) -> Bag:
     if mcap_file is not None:
         return _open_mcap(given, mcap_file, recover, expected, warnings)
 
-    from rosbags.rosbag2 import Reader
-
     try:
-        with Reader(target) as reader:
-            conns = reader.connections
-            topics = {c.topic: c.msgtype for c in conns}
-            times = {c.topic: [] for c in conns}
-            raws = {c.topic: [] for c in conns}
-            for conn, stamp, data in reader.messages():
-                times[conn.topic].append(stamp)
-                raws[conn.topic].append(bytes(data))
+        topics, times, raws = _rosbags_file(target)
     except CablelabError:
         raise
     except Exception as exc:  # rosbags raises several error types for corrupt files
@@ -484,11 +475,11 @@ def _read_mcap(given, mcap_file: Path, recover: bool, expected=None):
     return topics, times, raws, [], False
 
 
-def _rosbags_file(mcap_file: Path):
-    """(topics, times, raws) of one .mcap file through rosbags' general reader."""
+def _rosbags_file(path: Path):
+    """(topics, times, raws) of a bag directory or one .mcap file through rosbags' general reader."""
     from rosbags.rosbag2 import Reader
 
-    with Reader(mcap_file) as reader:
+    with Reader(path) as reader:
         conns = reader.connections
         topics = {c.topic: c.msgtype for c in conns}
         times = {c.topic: [] for c in conns}

@@ -43,7 +43,7 @@ from ..control import PdffConfig
 from ..hardware import SimulatedCdpr
 from ..live import ControllerConfig, LiveController
 from ..loop import ReferenceLaw
-from ..sim import CdprTruth, default_description_path
+from ..sim import default_description_path
 from ..trajectory import ReferenceTable
 from . import controller as _controller
 from . import sim as _sim
@@ -113,20 +113,7 @@ class CdprControlLoop(ControlLoopNode):
     def _hardware(self, spec: str, desc):
         names = [f"winch_{i}" for i in range(1, self.n + 1)]
         if spec == "sim":
-            v = self.v
-            bias = v.tension_bias
-            if len(bias) not in (1, self.n):
-                raise CablelabError(f"{self.get_name()}: parameter tension_bias:={bias}: expected 1 or "
-                                    f"{self.n} numbers (one per cable) [N]")
-            if 0 < v.timestep < 1e-5:
-                raise CablelabError(f"{self.get_name()}: parameter timestep:={v.timestep!r}: expected 0 "
-                                    "(auto) or a step of at least 1e-05 [s]")
-            truth = CdprTruth(
-                pulleys=v.pulleys, payload_mass=v.payload_mass, payload_com=tuple(v.payload_com),
-                winch_coulomb=v.winch_coulomb, winch_viscous=v.winch_viscous,
-                motor_inertia=v.motor_inertia, tension_noise=v.tension_noise,
-                tension_bias=tuple(bias) if any(bias) else None, torque_noise=v.torque_noise,
-                pose_noise=v.pose_noise, timestep=v.timestep or min(0.002, 1.0 / self.rate), seed=v.seed)
+            truth = _sim.truth_from_parameters(self.get_name(), self.v, self.n, self.rate)
             return SimulatedCdpr(desc, truth, self.rate, self.reference.at(0.0)[0])
         cls = DriverStub if spec == "stub" else load_hardware_class(spec)
         return cls(names, desc)

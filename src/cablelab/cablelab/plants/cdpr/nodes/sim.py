@@ -92,6 +92,25 @@ PARAMETERS = merge((
 ), START_GATE, executor_params(True))
 
 
+def truth_from_parameters(node: str, v, n: int, rate: float) -> CdprTruth:
+    """The simulated CDPR's truth from the validated simulator parameters ``v`` (the specs of
+    :data:`PARAMETERS`) for ``n`` cables at ``rate`` Hz; one-line errors naming ``node`` for what
+    the specs alone cannot check (the bias length against the cable count, the smallest step)."""
+    bias = v.tension_bias
+    if len(bias) not in (1, n):
+        raise CablelabError(f"{node}: parameter tension_bias:={bias}: expected 1 or {n} numbers "
+                            "(one per cable) [N]")
+    if 0 < v.timestep < 1e-5:
+        raise CablelabError(f"{node}: parameter timestep:={v.timestep!r}: expected 0 (auto) or a step "
+                            "of at least 1e-05 [s]")
+    return CdprTruth(
+        pulleys=v.pulleys, payload_mass=v.payload_mass, payload_com=tuple(v.payload_com),
+        winch_coulomb=v.winch_coulomb, winch_viscous=v.winch_viscous,
+        motor_inertia=v.motor_inertia, tension_noise=v.tension_noise,
+        tension_bias=tuple(bias) if any(bias) else None, torque_noise=v.torque_noise,
+        pose_noise=v.pose_noise, timestep=v.timestep or min(0.002, 1.0 / rate), seed=v.seed)
+
+
 class CdprSimNode(PlantNode):
     def __init__(self):
         super().__init__("cable_sim_node", start_parameter_services=False)  # smaller wait set
@@ -101,19 +120,7 @@ class CdprSimNode(PlantNode):
         if c is None:
             raise CablelabError("cable_sim_node --plant cdpr: the description has no cdpr section")
         self.n = len(c.cables)
-        bias = v.tension_bias
-        if len(bias) not in (1, self.n):
-            raise CablelabError(f"{self.get_name()}: parameter tension_bias:={bias}: expected 1 or "
-                                f"{self.n} numbers (one per cable) [N]")
-        if 0 < v.timestep < 1e-5:
-            raise CablelabError(f"{self.get_name()}: parameter timestep:={v.timestep!r}: expected 0 (auto) "
-                                "or a step of at least 1e-05 [s]")
-        truth = CdprTruth(
-            pulleys=v.pulleys, payload_mass=v.payload_mass, payload_com=tuple(v.payload_com),
-            winch_coulomb=v.winch_coulomb, winch_viscous=v.winch_viscous,
-            motor_inertia=v.motor_inertia, tension_noise=v.tension_noise,
-            tension_bias=tuple(bias) if any(bias) else None, torque_noise=v.torque_noise,
-            pose_noise=v.pose_noise, timestep=v.timestep or min(0.002, 1.0 / v.rate), seed=v.seed)
+        truth = truth_from_parameters(self.get_name(), v, self.n, v.rate)
         self.rate = v.rate
         self.real_time = v.real_time
         self.publish_reference = v.publish_reference
