@@ -89,7 +89,7 @@ def model_files(out_dir: Path) -> tuple[Path, Path]:
     """The simulator's MjModel at 1 kHz (1 ms physics) holding the start pose, as MJB + state."""
     import mujoco
 
-    from bench_realtime import cdpr_hold
+    from realtime_runs import cdpr_hold
 
     sim, hold = cdpr_hold(timestep=0.001)
     mjb, state = out_dir / "cdpr.mjb", out_dir / "state.txt"
@@ -202,7 +202,7 @@ def main(argv=None) -> int:
         log(f"rcl loop in C, {args.seconds:g} s ...")
         result["rcl loop in C"] = run_floor(exe, mjb, state, args.seconds, args.listener, args.pin, log)
     if args.compare or args.mixed:
-        from bench_realtime import closed_loop
+        from realtime_runs import closed_loop
     if args.compare:
         log(f"cablelab nodes, {args.seconds:g} s ...")
         result["cablelab nodes"] = closed_loop(args.seconds, log, pin=args.pin)
