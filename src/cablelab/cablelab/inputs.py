@@ -27,6 +27,8 @@ def check_regular_file(path, what: str, max_bytes: int) -> int:
         raise CablelabError(f"{path}: {what} file not found") from None
     except OSError as exc:
         raise CablelabError(f"{path}: cannot read {what} ({exc.strerror})") from None
+    except ValueError:          # a NUL byte in the name (e.g. junk text taken for a path)
+        raise CablelabError(f"{path!r}: not a {what} file name (it holds a NUL byte)") from None
     if not stat.S_ISREG(st.st_mode):
         kind = "a directory" if stat.S_ISDIR(st.st_mode) else "a device or pipe, not a regular file"
         raise CablelabError(f"{path}: {what} is {kind}; give a YAML file")
