@@ -57,6 +57,8 @@ IDS = [n for n, _ in SPECS]
 
 def valid(spec, value) -> bool:
     """Independent oracle: is ``value`` (as rclpy hands it over) allowed by ``spec``?"""
+    from cablelab.ros import params
+
     def scalar(x):
         k = spec.scalar
         if k == "bool":
@@ -66,6 +68,8 @@ def valid(spec, value) -> bool:
         if isinstance(x, bool) or not isinstance(x, (int, float)):
             return False
         if k == "int" and isinstance(x, float) and not (math.isfinite(x) and x == int(x)):
+            return False
+        if k == "int" and not params.INT64[0] <= int(x) <= params.INT64[1]:   # ROS integers are int64
             return False
         if isinstance(x, float) and math.isnan(x):
             return spec.nan

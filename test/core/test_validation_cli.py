@@ -176,7 +176,7 @@ def test_random_numeric_options(data):
             x = math.nan
         err = io.StringIO()
         positional = ["x", "-o", "y"] if verb in ("batch", "report") else ["-o", "y", "--plant", "axis"] if verb == "record" \
-            else ["x"]
+            else ["x", "--params", "a", "-o", "y"] if verb == "excite" else ["x"]
         with contextlib.redirect_stderr(err):
             try:
                 args = parser.parse_args(positional + [f"{opt}={text}"])

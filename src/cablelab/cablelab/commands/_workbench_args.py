@@ -199,8 +199,7 @@ def load_from_args(args, *, check_out: bool = False):
                                           recover=getattr(args, "recover", False),
                                           before_dataset=lambda p: check_plant_options(args, p),
                                           limits=limits_from_args(args))
-    args.warnings = list(check.warnings)
-    check_measured(ds)
+    args.warnings = list(check.warnings) + check_measured(ds)
     baseline = None
     if args.baseline is not None:
         baseline = () if args.baseline.strip() in ("", "none") else parse_effect_list(args.baseline)
@@ -220,20 +219,26 @@ def load_from_args(args, *, check_out: bool = False):
     return plant, desc, ds, model
 
 
-def check_measured(ds) -> None:
-    """A measured channel that is exactly zero in every usable sample holds no measurement (an
-    effort never recorded, a dead sensor): nothing to compare or fit, one line naming it."""
+def check_measured(ds) -> list[str]:
+    """Measured channels that are exactly zero in every usable sample. All of them: nothing to
+    compare or fit (an effort never recorded, a dead sensor), one line naming them. Some: a
+    warning line each (a channel the motion never moves, e.g. the sideways swing of a planar
+    free swing, is fitted with the others)."""
     import numpy as np
 
     from ..errors import CablelabError
 
     y = np.asarray(ds.y, dtype=float)
     ok = np.asarray(ds.valid, dtype=bool) & np.isfinite(y).all(axis=1)
-    for c, ch in enumerate(ds.channels):
-        if ok.any() and not np.any(y[ok, c]):
-            raise CablelabError(f"channel {ch!r} is zero in all {int(ok.sum())} usable samples: no "
-                                "measurement to compare or fit (was it recorded? check the bag's "
-                                "effort / tension fields)")
+    if not ok.any():
+        return []
+    zero = [ch for c, ch in enumerate(ds.channels) if not np.any(y[ok, c])]
+    if len(zero) == len(ds.channels):
+        raise CablelabError(f"channel {', '.join(repr(ch) for ch in zero)} is zero in all "
+                            f"{int(ok.sum())} usable samples: no measurement to compare or fit (was "
+                            "it recorded? check the bag's effort / tension fields)")
+    return [f"channel {ch!r} is zero in all {int(ok.sum())} usable samples (not measured, or never "
+            "moved by this recording)" for ch in zero]
 
 
 def flag_impossible(args, effects, params: dict, units: dict | None = None, where: str = "") -> None:
