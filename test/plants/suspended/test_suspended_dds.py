@@ -16,6 +16,7 @@ import time
 import numpy as np
 
 from cablelab.bags import open_bag
+from cablelab.bags.reader import recorder_lost
 from cablelab.plants.suspended.controller import ArmGravity, fig7_excitation, gains, pd_gravity
 from cablelab.plants.suspended.params import parameter_set
 from cablelab.rotations import quat_to_matrix, xyzw_to_wxyz
@@ -49,7 +50,9 @@ def test_lockstep_closed_loop_sim_estimator_controller_recorder(launcher, tmp_pa
     # time started only when every counted subscriber had acknowledged a state (not just been
     # counted on the simulator's side of the match, which can be seconds earlier on a busy
     # machine): the recorder gets every step; wait until the bag holds the end of the run
-    launcher.wait_for_recorded(bag_dir, {"/suspended/joint_states": n, "/suspended/swing_estimate": n,
+    # (the estimator answers the newest state of each of its polls: on a loaded machine it may
+    # skip one, which is not a recording loss; the recorder's own lost counts are checked below)
+    launcher.wait_for_recorded(bag_dir, {"/suspended/joint_states": n, "/suspended/swing_estimate": int(0.9 * n),
                                          "/suspended/ground_truth/swing": n}, timeout=300)
     deadline = time.monotonic() + 60
     while open_bag(bag_dir, recover=True).joint_state("/suspended/joint_states").t.max() < DURATION - 1e-6:
@@ -58,6 +61,8 @@ def test_lockstep_closed_loop_sim_estimator_controller_recorder(launcher, tmp_pa
     codes = launcher.stop_all()
     assert codes == {"sim": 0, "controller": 0, "estimator": 0, "recorder": 0}, codes
 
+    lost = recorder_lost(bag_dir)
+    assert lost is not None and not any(lost.values()), lost   # nothing published was lost
     bag = open_bag(bag_dir)
     js = bag.joint_state("/suspended/joint_states")
     _, first = np.unique(js.t, return_index=True)          # (the start state may be resent)
