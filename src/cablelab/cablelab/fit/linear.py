@@ -93,6 +93,13 @@ def _combo(names: Sequence[str], vec: np.ndarray, tol: float = 0.05) -> str:
     return text
 
 
+def _as_channels(phi, y):
+    """``phi`` as (N, C, p) and ``y`` as (N, C) float arrays (one channel when given 2-D / 1-D)."""
+    phi = np.asarray(phi, dtype=float)
+    y = np.asarray(y, dtype=float)
+    return (phi[:, None, :] if phi.ndim == 2 else phi), (y[:, None] if y.ndim == 1 else y)
+
+
 def solve_linear(phi: np.ndarray, y: np.ndarray, params: Sequence[Param], *,
                  valid: np.ndarray | None = None, channel_scale: np.ndarray | str | None = "rms",
                  bounded: bool = True, rank_tol: float = RANK_TOL,
@@ -113,12 +120,7 @@ def solve_linear(phi: np.ndarray, y: np.ndarray, params: Sequence[Param], *,
     Raises:
         CablelabError: too few samples, or a rank-deficient regressor with ``on_deficient="raise"``.
     """
-    phi = np.asarray(phi, dtype=float)
-    y = np.asarray(y, dtype=float)
-    if phi.ndim == 2:
-        phi = phi[:, None, :]
-    if y.ndim == 1:
-        y = y[:, None]
+    phi, y = _as_channels(phi, y)
     n_s, n_c, p = phi.shape
     names = tuple(pp.name for pp in params)
     units = tuple(pp.unit for pp in params)
@@ -220,12 +222,7 @@ def unexcited_columns(phi: np.ndarray, y: np.ndarray, params: Sequence[Param], *
 
     Args: as :func:`solve_linear` (``y`` only sets the channel weights).
     """
-    phi = np.asarray(phi, dtype=float)
-    y = np.asarray(y, dtype=float)
-    if phi.ndim == 2:
-        phi = phi[:, None, :]
-    if y.ndim == 1:
-        y = y[:, None]
+    phi, y = _as_channels(phi, y)
     n_s, n_c, p = phi.shape
     mask = np.ones(n_s, dtype=bool) if valid is None else np.asarray(valid, dtype=bool).copy()
     mask &= np.isfinite(y).all(axis=1) & np.isfinite(phi).all(axis=(1, 2))
