@@ -83,8 +83,7 @@ def build_report(ds: Dataset, model: Model, candidates, out_dir, *, folds: int =
     white = {}
     for c, (ch, unit) in enumerate(zip(ds.channels, ds.units)):
         plots.residual_regimes(fig(f"regimes_{c}.png"), reg_b, reg_f, ch, unit)
-        # a filtered residual is coloured: test it on (nearly) independent samples
-        white[ch] = whiteness(fin.residual[:, c], ds.inputs, decimate=_decimation(ds))
+        white[ch] = whiteness(fin.residual[:, c], ds.inputs, decimate=_decimation(ds))  # issue 10
         plots.correlations(fig(f"whiteness_{c}.png"), white[ch], ch)
 
     parts = [f"<h1>{html.escape(title or 'cablelab report')}</h1>",
