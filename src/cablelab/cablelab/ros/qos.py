@@ -51,8 +51,3 @@ def recorder_qos(transient_local: bool = False, reliable: bool = True) -> QoSPro
                           durability=DurabilityPolicy.TRANSIENT_LOCAL)
     return QoSProfile(history=HistoryPolicy.KEEP_ALL, depth=1000, reliability=reliability,
                       durability=DurabilityPolicy.VOLATILE)
-
-
-def qos_for(topic: str, depth: int = 100) -> QoSProfile:
-    """The publisher/subscriber QoS of a contract topic."""
-    return DESCRIPTION_QOS if topic == "/plant_description" else stream_qos(depth)
