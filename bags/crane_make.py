@@ -1,6 +1,6 @@
 """Regenerate the crane reference bags (``./run python bags/crane_make.py``).
 
-* ``crane_control``: the crane of ``cablelab/data/crane.yaml`` exactly as described (nothing missing);
+* ``crane_control``: the crane of ``plants/crane/data/crane.yaml`` exactly as described (nothing missing);
 * ``crane_tilt``: the same crane on a base tilted by 3.3 deg (002 sec. 6.5: -0.2 N m on the slew
   joint at rest at beta = 0.5 rad), 1 mm motion-capture noise and 1 % dropouts;
 * ``crane_no_counterbalance``: the crane with its counterbalance, described without it (002 sec. 6.4).

@@ -3,7 +3,7 @@
 Writes --seconds s of a 1 kHz JointState topic with --joints joints (position, velocity, effort)
 into a rosbag2 MCAP bag with cablelab's BagWriter, reads it back into numpy with open_bag(...)
 .joint_state(...), and for reference reads it with rosbags' generic per-message deserialiser.
-Targets (issue 2): read >= 200 000 msg/s, write >= 100 000 msg/s.
+Targets: read >= 200 000 msg/s, write >= 100 000 msg/s.
 """
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""CDPR benchmarks (issue 4 speed targets).
+"""CDPR benchmarks (speed targets).
 
 1. Offline estimation, Model I and Model II (001 eq. 6-9, 12-13), --samples samples of 8 cables
    on one core (``mass_com_batch``; the general ``cable_geometry + mass_com`` path for reference).

@@ -1,7 +1,7 @@
 """Crane benchmarks: stacked regressor build + solve (002 sec. 5.2: 25 000 equations... here
 25 000 samples = 125 000 equations), offline swing-angle estimation, simulation, diagnosis.
 
-Targets (issue 5): stacked regressor for 25 000 samples built and solved < 0.1 s; swing-angle
+Targets: stacked regressor for 25 000 samples built and solved < 0.1 s; swing-angle
 estimation >= 1 000 000 samples/s offline.
 """
 from __future__ import annotations

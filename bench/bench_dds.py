@@ -5,7 +5,7 @@
    p99 in microseconds.
 2. Recorder throughput: a publisher process sends 3 topics at 1 kHz (/cdpr/joint_states and
    /cdpr/cable_tensions JointState with 8 joints, /cdpr/effort_commands Float64MultiArray) for
-   --seconds s (issue 2 target: 60 s, zero drops) while ``cablelab record`` records them; the
+   --seconds s (target: 60 s, zero drops) while ``cablelab record`` records them; the
    published counts are compared with the bag's, and the header stamps checked for gaps.
 """
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Hopping-leg benchmarks (issue 12): hybrid MuJoCo simulation speed against real time and against a
+"""Hopping-leg benchmarks: hybrid MuJoCo simulation speed against real time and against a
 bare ``mj_step`` loop of the same model (no phase logic), staged identification of ~60 strides
 (003 sec. 3.4), and the live hop estimator's per-sample latency at 1 kHz.
 

@@ -1,4 +1,4 @@
-"""The floor under the 1 kHz closed loop (issue 14): how many cycles does the lightest ROS 2 stack
+"""The floor under the 1 kHz closed loop: how many cycles does the lightest ROS 2 stack
 miss on this machine, without real-time privileges, and how many does the machine itself miss?
 
 First the bare timer: one process sleeping to absolute 1 ms deadlines (``clock_nanosleep``) with

@@ -1,4 +1,4 @@
-"""Speed of the suspended plant (issue 11): CRANEbot simulation vs real time, the LiCAS
+"""Speed of the suspended plant: CRANEbot simulation vs real time, the LiCAS
 7-experiment identification, and the live swing estimator per pose sample.
 
     ./run python bench/bench_suspended.py [--json] [--full]

@@ -1,4 +1,4 @@
-"""Randomized CDPR diagnosis cases (issue 10 benchmark), generated WITHOUT the fitting code.
+"""Randomized CDPR diagnosis cases (bench_diagnosis.py), generated WITHOUT the fitting code.
 
 * geometry: the CAROCA-like description (plants/cdpr/data/caroca.yaml: 8 cables, exit points
   A_i, platform anchor points b_i); the structure matrix is computed here from those points

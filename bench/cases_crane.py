@@ -1,4 +1,4 @@
-"""Randomized boom-crane diagnosis cases (issue 10 benchmark), generated WITHOUT the fitting code.
+"""Randomized boom-crane diagnosis cases (bench_diagnosis.py), generated WITHOUT the fitting code.
 
 * truth: the MuJoCo crane of :mod:`cablelab.plants.crane.sim` (``build_model``: slew, luff, gimbal
   swing joints and the hoist, built from the plant description; 002 ch. 3). The crane's fitting

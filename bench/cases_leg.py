@@ -1,4 +1,4 @@
-"""Randomized hopping-leg diagnosis cases (issue 10 benchmark), generated WITHOUT the fitting code.
+"""Randomized hopping-leg diagnosis cases (bench_diagnosis.py), generated WITHOUT the fitting code.
 
 * truth: the leg's independent reference, :func:`cablelab.plants.leg.reference.sampled_trajectory`
   (scipy ``solve_ivp`` per phase with terminal events, rtol 1e-10; it shares nothing with the

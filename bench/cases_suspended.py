@@ -1,4 +1,4 @@
-"""Randomized suspended-platform diagnosis cases (issue 10 benchmark), generated WITHOUT the fitting
+"""Randomized suspended-platform diagnosis cases (bench_diagnosis.py), generated WITHOUT the fitting
 code.
 
 * truth: the LiCAS *truth plant* of :func:`cablelab.plants.suspended.mjcf.build_truth` - a free

@@ -1,4 +1,4 @@
-"""Randomized diagnosis cases, generated WITHOUT the fitting code (issue 10 benchmark).
+"""Randomized diagnosis cases, generated WITHOUT the fitting code (bench_diagnosis.py).
 
 Each case is a drive recording as a real machine would produce it, written as an MCAP bag:
 

@@ -1,4 +1,4 @@
-"""Run the hostile cases of issue 14 through ``cablelab.cli.main`` (in-process) and print the
+"""Run the hostile cases through ``cablelab.cli.main`` (in-process) and print the
 markdown table of docs/robustness.md: case, command, exit status, the one stderr line or the
 warnings (nothing here is written by hand). The last table, the numeric-validation cases (ROS
 parameters of the nodes, numeric options, description numbers, CSV cells), can be printed alone.

@@ -1,4 +1,4 @@
-"""The LiCAS closed loop through DDS with and without lock-step (issue 11): simulator (truth
+"""The LiCAS closed loop through DDS with and without lock-step: simulator (truth
 plant, arm torque motors, 1 kHz), controller (PD + gravity, 000 Fig. 7 y excitation) and recorder
 as separate processes on their own ROS_DOMAIN_ID, 3 s simulated from a pushed start
 (swing_x = 0.05 rad). Without lock-step the commands arrive late (the 1 kHz loop through Python

@@ -1,4 +1,4 @@
-"""The hostile options listed in issue 14, each a one-line error naming the option and value
+"""Hostile command-line options, each a one-line error naming the option and value
 (exit 2, nothing on stdout), and the advice in messages names flags the verb really has."""
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Crane parameter accuracy on realistic recordings (issue 10, bench/cases_crane.py): fixed-seed
+"""Crane parameter accuracy on realistic recordings (bench/cases_crane.py): fixed-seed
 cases of the benchmark generator (MuJoCo crane with smooth friction, quantized encoders, AR(1)
 effort noise with outliers, rests) through bag -> cablelab.workbench.load -> diagnose --greedy.
 

@@ -1,4 +1,4 @@
-"""Diagnosis on realistic recordings of the crane, CDPR, leg and suspended platform (issue 10):
+"""Diagnosis on realistic recordings of the crane, CDPR, leg and suspended platform:
 fixed-seed cases of the benchmark generators bench/cases_<plant>.py through the real path
 (bag -> cablelab.workbench.load -> diagnose --greedy, as `cablelab diagnose --greedy`).
 

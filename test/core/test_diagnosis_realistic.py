@@ -1,4 +1,4 @@
-"""Diagnosis on realistic drive recordings (issue 10), fixed-seed cases of the benchmark generator.
+"""Diagnosis on realistic drive recordings: fixed-seed cases of the benchmark generator.
 
 Oracle: bench/diagnosis_cases.py integrates the closed-loop drive with scipy solve_ivp and a
 SMOOTH friction law (tanh Coulomb band), quantizes the encoder, holds the drive at rest 40 % of

@@ -1,4 +1,4 @@
-"""Helpers shared across plants (wave-2 de-duplication): each against an independent oracle."""
+"""Helpers shared across plants, each against an independent oracle."""
 from __future__ import annotations
 
 import numpy as np

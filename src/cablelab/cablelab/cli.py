@@ -49,12 +49,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     sub = parser.add_subparsers(dest="verb", metavar="VERB", parser_class=OneLineParser)
     for verb, module in VERBS.items():
-        try:
-            mod = importlib.import_module(f"cablelab.commands.{module}")
-        except ModuleNotFoundError as exc:
-            if exc.name != f"cablelab.commands.{module}":
-                raise
-            continue  # verb not built yet
+        mod = importlib.import_module(f"cablelab.commands.{module}")
         p = sub.add_parser(verb, help=mod.HELP, description=getattr(mod, "DESCRIPTION", mod.HELP))
         mod.add_arguments(p)
         p.set_defaults(_run=mod.run)

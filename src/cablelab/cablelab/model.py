@@ -1,4 +1,4 @@
-"""Models: a plant plus a set of effects plus known parameters (issue 3, "Models and effects").
+"""Models: a plant plus a set of effects plus known parameters.
 
 :class:`Model` holds the :class:`~cablelab.effects.base.Effect` objects of its effects, looked up
 once in the effect registry when the model is made. Linear in the free parameters:

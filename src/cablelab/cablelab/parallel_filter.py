@@ -7,7 +7,7 @@ Butterworth low-pass (``scipy.signal.sosfiltfilt``) applied to the measured outp
 regressor column, whatever the column is (an acceleration, ``sign(qd)``, ``sin(q)``, a column
 mapped through a pose-dependent matrix).
 
-Why (issue 10): a quantized encoder forces a low cut-off for the acceleration (a few Hz for a
+Why: a quantized encoder forces a low cut-off for the acceleration (a few Hz for a
 slow 100 Hz slew axis). When only the positions are filtered, the inertia column is attenuated
 where the effort is not, and the Coulomb column ``sign(H qd)`` is a sharp step where the
 measured friction is smoothed by nothing; under 1-3 Hz chirps the least squares then moves

@@ -8,8 +8,7 @@ speed (a narrow tanh band, stiction while stopped). Near and at zero speed:
   smooth band the friction is somewhere between -F_c and +F_c;
 * the sign of a low-pass-filtered, differentiated (quantized) encoder position is filter noise,
   so a ``sign(qd)`` Coulomb column is wrong exactly there. With 40 % of the time at rest this
-  biases the fitted Coulomb level 30-45 % low and lets viscous friction absorb the rest
-  (issue 10, failure 1).
+  biases the fitted Coulomb level 30-45 % low and lets viscous friction absorb the rest.
 
 The remedy here is to *exclude* those samples from every fit (the same samples for every
 candidate model, so scores stay comparable): a sample is in the zero-speed zone of an actuator

@@ -36,7 +36,7 @@ def test_greedy_diagnosis_rediscovers_coulomb_then_offset_and_the_published_para
     assert errs == sorted(errs)
     assert sum(r["significant"] for r in rank) == 1
     steps = out["greedy"]
-    # issue 10: with the zero-speed zone excluded, a sub-sample lead of the force command (the
+    # with the zero-speed zone excluded, a sub-sample lead of the force command (the
     # controller's zero-order hold, about half a 1 ms sample) is significant after the two
     added = [s["added"] for s in steps]
     assert added[:3] == [None, "joint_coulomb_friction", "torque_sensor_offset"]
@@ -68,7 +68,7 @@ def test_identify_and_compare_on_emps(capsys):
         assert abs(p[k]["value"] - v) < 3 * p[k]["stderr"], k
     assert p["M"]["unit"] == "kg" and p["Fv"]["unit"] == "N s/m"
     assert ident["fit"]["rank"] == 4 and ident["fit"]["unidentifiable"] == []
-    # issue 10: the zero-speed zone (1.8 % of EMPS) is not fitted: 4.1 % instead of 4.4 %
+    # the zero-speed zone (1.8 % of EMPS) is not fitted: 4.1 % instead of 4.4 %
     assert ident["fit"]["nrmse"] == pytest.approx(0.041, abs=0.003)
     cmp_ = _json(capsys, ["compare", str(BAG), "--json"])
     ch = cmp_["joint"]

@@ -1,4 +1,4 @@
-"""CDPR ``--tensions both``: the per-winch torque balance ``(R/r) tau_i - d_i`` (issue 10).
+"""CDPR ``--tensions both``: the per-winch torque balance ``(R/r) tau_i - d_i``.
 
 With the dynamometers alone the eight tension offsets reach the six wrench channels through W,
 whose two-dimensional null space (internal forces) is invisible at each pose; the balance of the

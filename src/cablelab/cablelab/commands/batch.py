@@ -31,10 +31,6 @@ def add_arguments(p) -> None:
 
 def run(args) -> int:
     from ..errors import CablelabError
-    from ..fleet import analyse
-    from ..fleet.engine import run_batch
-    from ..fleet.report import summary, write_report
-    from ..model import parse_effect_list
 
     if args.workers is not None and args.workers < 1:
         raise CablelabError(f"--workers {args.workers}: must be at least 1")

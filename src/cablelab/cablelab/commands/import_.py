@@ -207,7 +207,7 @@ def import_series(path: str, plant: str, spec: str) -> dict:
     fields = parse_spec(spec)
     topic, joints = joint_topic(plant)
     if "time" not in fields:
-        raise CablelabError(f"--map: missing 'time=' (e.g. time=t)")
+        raise CablelabError("--map: missing 'time=' (e.g. time=t)")
     fields_time = fields.pop("time")
     t = evaluate("time", fields_time, table, path)
     n = t.size

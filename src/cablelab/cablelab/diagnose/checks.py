@@ -1,4 +1,4 @@
-"""Data a diagnosis cannot handle, refused before any ranking (issue 10, "Bad input").
+"""Data a diagnosis cannot handle, refused before any ranking.
 
 Every check raises a one-line :class:`~cablelab.errors.CablelabError` naming the problem (file,
 channel, value) and the recording that would fix it, instead of a confident ranking of noise:

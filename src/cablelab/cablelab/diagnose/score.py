@@ -5,7 +5,7 @@
   held-out Gaussian negative log-likelihood with a separate (profiled) variance per channel, so a
   channel counts by its relative improvement, not by its share of the pooled error: a 40 %
   drop on the one channel an effect acts on (CDPR Fz and ``platform_inertia``) is not averaged
-  away by five channels that do not care (issue 10, failure 4). One channel: the plain NRMSE.
+  away by five channels that do not care. One channel: the plain NRMSE.
   The per-channel NRMSE stays in the output for humans.
 * Practical gain (:func:`practical_gain`): the relative drop of that geometric mean over the
   channels whose held-out prediction the candidate changes at all. A channel an effect cannot

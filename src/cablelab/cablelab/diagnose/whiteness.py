@@ -41,7 +41,8 @@ def whiteness(residual: np.ndarray, inputs: dict[str, np.ndarray] | None = None,
         decimate: test every k-th sample only. A residual of low-pass-filtered signals (cut-off
             f_c) is coloured below f_c even when the model is exact; at k = fs / (2 f_c) its
             samples are (nearly) independent again, so the test is valid on filtered data
-            (issue 10, failure 5). The cross-correlation band is Bartlett's
+            (tested on every sample, the filtered residual of a correct model is called not
+            white). The cross-correlation band is Bartlett's
             ``z sqrt(sum_j rho_rr(j) rho_uu(j) / N)``, valid for a coloured input.
     Returns:
         ``{"band", "lags", "autocorr", "white", "outside", "cross": {name: {"xcorr",

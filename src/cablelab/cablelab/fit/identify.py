@@ -102,8 +102,6 @@ class Identification:
         """``(params, internal)``: every parameter of the model in the user's terms (the
         effects' :meth:`physical` parameters where they have them, with ``fixed``/``held``
         flags for the others) and the internal coefficients those replace."""
-        from ..effects import get_effect
-
         table = {r["name"]: {k: v for k, v in r.items() if k != "name"} for r in self.table()}
         params, internal = {}, {}
         for eid in self.model.effects:

@@ -167,14 +167,3 @@ def consolidate(out, refs_hashes: list[tuple[object, str]]) -> pa.Table:
     table = table.set_column(1, "url", pa.array(url, pa.string()))
     write_atomic(table, Path(out) / RESULTS)
     return table
-
-
-def read_results(path) -> pa.Table:
-    """A results table (file or OUT directory)."""
-    p = Path(path)
-    if p.is_dir():
-        p = p / RESULTS
-    try:
-        return pq.read_table(p)
-    except (OSError, pa.ArrowInvalid) as exc:
-        raise CablelabError(f"{p}: unreadable results table ({exc})") from None

@@ -15,10 +15,6 @@ MAX_POINTS = 4000
 DPI = 90
 
 
-def _thin(n: int) -> slice:
-    return slice(None, None, max(1, n // MAX_POINTS))
-
-
 def _save(fig, path) -> None:
     fig.tight_layout()
     fig.savefig(path, dpi=DPI)

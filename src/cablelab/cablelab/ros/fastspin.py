@@ -23,8 +23,8 @@ needs and drops the rest:
 Services are answered (synchronous callbacks). Not serviced: clients, guard conditions and
 waitables (the QoS event handlers that log incompatible-QoS warnings). Use it for nodes that have
 no clients or guard conditions (:func:`supports` says whether a node qualifies). Same interface as
-the part of rclpy's executor the runner uses: ``add_node``, ``spin_once(timeout_sec)``,
-``spin_until(condition)``. Measured gain: docs/benchmarks.md, CDPR section.
+the part of rclpy's executor the runner uses: ``add_node``, ``spin_once(timeout_sec)``.
+Measured gain: docs/benchmarks.md, CDPR section.
 """
 from __future__ import annotations
 
@@ -327,11 +327,6 @@ class FastExecutor:
                     srv.send_response(srv.callback(request, srv.srv_type.Response()), header)
         # drain every queue, one sample per topic per round
         self.taken += _take_all([e for p, e in self._subs if p in subs_ready])
-
-    def spin_until(self, condition, timeout_sec: float = 0.1) -> None:
-        """Spin until ``condition()`` is true (checked after every wake-up or ``timeout_sec``)."""
-        while not condition():
-            self.spin_once(timeout_sec)
 
     def shutdown(self, timeout_sec: float | None = None) -> bool:
         if self._stack is not None:

@@ -86,10 +86,10 @@ def _die_with_parent() -> None:
 def ros_env(domain_id: int, extra: dict | None = None) -> dict:
     """Environment of the launched processes: their own domain, discovery on this host only, and
     Fast DDS data over shared memory only (``FASTDDS_BUILTIN_TRANSPORTS=SHM`` unless already set):
-    with the default transports the samples between the launched processes went over UDP
-    loopback, and one 8-double publish cost ~65 us of thread CPU instead of ~27 us, p99 wall
-    ~500 us instead of ~50 us (docs/benchmarks.md, "Real time"). The launched processes are on one
-    host by construction (discovery range LOCALHOST)."""
+    with the default transports the samples between the launched processes go over UDP
+    loopback, and one 8-double publish costs more thread CPU and wall time (docs/benchmarks.md,
+    ``bench_publish.py``). The launched processes are on one host by
+    construction (discovery range LOCALHOST)."""
     env = dict(os.environ)
     env.setdefault("FASTDDS_BUILTIN_TRANSPORTS", "SHM")
     env.update({"ROS_DOMAIN_ID": str(domain_id), "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST",

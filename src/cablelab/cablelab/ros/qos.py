@@ -62,8 +62,3 @@ def recorder_qos(transient_local: bool = True, reliable: bool = True, *,
                           durability=durability)
     return QoSProfile(history=HistoryPolicy.KEEP_ALL, depth=1000, reliability=reliability,
                       durability=durability)
-
-
-def qos_for(topic: str, depth: int = 100) -> QoSProfile:
-    """The publisher/subscriber QoS of a contract topic."""
-    return DESCRIPTION_QOS if topic == "/plant_description" else stream_qos(depth)

@@ -56,7 +56,8 @@ def dataset_from_arrays(t, q, effort, description, options: dict | None = None, 
         from ...parallel_filter import edge_mask
 
         ds = ds.replace(parallel_hz=c["parallel_hz"], valid=ds.valid & edge_mask(ds.t, c["parallel_hz"]))
-    # drives that stop: the zero-speed zone is not fitted (cablelab.velocity, issue 10)
+    # drives that stop: the zero-speed zone is not fitted (cablelab.velocity: there the effort
+    # is not a function of the motion and a filtered encoder's sign(qd) is noise)
     from ...velocity import exclude_zero_speed, position_quantum, speed_resolution
 
     res = 0.0 if qd is not None else speed_resolution(position_quantum(q), c["cutoff_hz"])

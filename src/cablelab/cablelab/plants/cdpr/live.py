@@ -2,7 +2,7 @@
 
 The nodes (payload_estimator, pd_feedforward) and the offline closed-loop simulation call these
 two small state holders; all the physics is in the vectorised functions of
-:mod:`cdpr_geometry`, :mod:`cdpr_estimation` and :mod:`cdpr_control`. Bad input (NaN, inf,
+:mod:`.geometry`, :mod:`.estimation` and :mod:`.control`. Bad input (NaN, inf,
 wrong length, negative tension, slack cable, ill-conditioned W, stale data) never produces an
 output: the update returns None (estimator) or holds/falls back (controller) and says why in
 ``status`` (a list of (level, message); level 0 OK, 1 WARN, 2 ERROR as in diagnostic_msgs).

@@ -4,7 +4,7 @@
     tau = Kp (q_ref - q) + Kd (qd_ref - qd) + G_a(q) + M_aa(q) qdd_ref
 
 over the actuated joints a = [slew, luff, hoist] (N m, N m, N); G and M from the symbolic model
-(:mod:`.crane_model`) with the measured swing angles when given (else a hanging payload).
+(:mod:`.model`) with the measured swing angles when given (else a hanging payload).
 With stale inputs :func:`hold_command` gives the fallback: gravity compensation at the last
 measured position with velocity damping only (no PD on an old reference).
 """

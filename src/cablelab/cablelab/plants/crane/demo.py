@@ -157,7 +157,7 @@ def record(out: Path, *, duration: float = 30.0, domain: int = 1) -> Path:
 
 
 def described_params():
-    """:class:`CraneParams` of ``cablelab/data/crane.yaml`` (the crane the simulator runs)."""
+    """:class:`CraneParams` of ``plants/crane/data/crane.yaml`` (the crane the simulator runs)."""
     from ...description import load_description
     from .model import CraneParams
 

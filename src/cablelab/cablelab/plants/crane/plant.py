@@ -3,14 +3,14 @@ the offline swing estimate behind ``cablelab estimate``.
 
 Pieces, one module each:
 
-* :mod:`.crane_kinematics` - boom tip, payload, exact swing angles (CONTRACT sec. 2, 002 sec. 6.3);
-* :mod:`.crane_symbolic` -> :mod:`.crane_dynamics_generated` - regressor Y(q, qd, qdd) from the
+* :mod:`.kinematics` - boom tip, payload, exact swing angles (CONTRACT sec. 2, 002 sec. 6.3);
+* :mod:`.symbolic` -> :mod:`.dynamics_generated` - regressor Y(q, qd, qdd) from the
   energies of 002 eq. A.3-A.4 (sympy, generated once);
-* :mod:`.crane_model` - :class:`CraneParams`, pi of 002 eq. 4.2, M, G, inverse dynamics;
-* :mod:`.crane_identify` - stacked regressor, rank 6, base parameters, 002's fixing, bounds;
-* :mod:`.crane_swing` - swing estimation offline (vectorised) and live (:class:`SwingTracker`);
-* :mod:`.crane_control` - PD + gravity compensation + reference-acceleration feedforward;
-* :mod:`.crane_freerun` - free-run comparison of an identified model (002 sec. 6.1, 6.4);
+* :mod:`.model` - :class:`CraneParams`, pi of 002 eq. 4.2, M, G, inverse dynamics;
+* :mod:`.identify` - stacked regressor, rank 6, base parameters, 002's fixing, bounds;
+* :mod:`.swing` - swing estimation offline (vectorised) and live (:class:`SwingTracker`);
+* :mod:`.control` - PD + gravity compensation + reference-acceleration feedforward;
+* :mod:`.freerun` - free-run comparison of an identified model (002 sec. 6.1, 6.4);
 * :mod:`cablelab.plants.crane.effects` - ``crane_rigid_body``, ``counterbalance``, ``base_tilt``;
 * :mod:`cablelab.plants.crane.sim` - the MuJoCo crane with its truth switches.
 
@@ -104,7 +104,7 @@ def dataset_from_arrays(t, q_joints, effort, t_mocap, tip, payload, description,
         regimes={"payload swing": _swing_regimes(q[:, 3], q[:, 4])},
         description=description, source=source,
     )
-    # drives that stop (issue 10): samples in the zero-speed zone of slew, luff or hoist are not
+    # drives that stop: samples in the zero-speed zone of slew, luff or hoist are not
     # fitted, as for the axis (cablelab.velocity): there the smooth friction band holds any
     # effort and the sign of a filtered, quantized encoder velocity is noise
     from ...velocity import exclude_zero_speed, position_quantum, speed_resolution

@@ -1,4 +1,4 @@
-"""The leg section of ``./run demo`` (issue 12): data from the MuJoCo plant with the impact map and
+"""The leg section of ``./run demo``: data from the MuJoCo plant with the impact map and
 a 2.7 N spring preload hidden; ``diagnose --greedy`` on 003's model without impact adds
 ``impact_restitution`` then ``spring_preload`` (error waterfall); the 003 Fig. 11 comparison of
 apex height and time errors with and without the impact map; plots of the apex-to-apex return

@@ -1,4 +1,4 @@
-"""``./run demo`` section of the suspended plant (issue 11).
+"""``./run demo`` section of the suspended plant.
 
 1. LiCAS truth plant (4 length-limited tendons, spec 3.3) driven by the 000 Fig. 7 arm
    excitation (y mode, joints 2 and 3 at 0.25 Hz, 17 deg, 2 s fade-in), platform pose with
