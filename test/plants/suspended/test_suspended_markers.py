@@ -101,3 +101,29 @@ def test_cables_carry_the_hanging_weight_at_rest(variant, kind):
     assert ten.shape == ((4,) if variant == "licas" else (1,))
     np.testing.assert_allclose(ten.sum(), weight, rtol=0.02)
     assert np.all(ten > 0)
+
+
+def test_overlay_bag_draws_the_recorded_platform(tmp_path):
+    """compare --out of a simulated CRANEbot swing: the rope of each array ends at the recorded
+    platform pose of its stamp, at about 30 Hz."""
+    from cablelab.bags import open_bag
+    from cablelab.cli import main
+    from cablelab.plants.suspended.bag import description_yaml, write_run
+    from cablelab.plants.suspended.sim import simulate
+
+    p = parameter_set("cranebot")
+    m = build_virtual(p)
+    run = simulate(m, initial_state(m, {"J8": 0.2}), 8.0)[0]
+    write_run(tmp_path / "swing", run, p.S, description_yaml("cranebot"))
+    assert main(["compare", str(tmp_path / "swing"), "--out", str(tmp_path / "ov"), "--json"]) == 0
+    bag = open_bag(tmp_path / "ov")
+    pose = bag.pose("/suspended/platform_pose")
+    t_ns, raws = bag.raw("/suspended/markers")
+    t = np.asarray(t_ns) * 1e-9
+    assert 25.0 < len(t) / (t[-1] - t[0]) < 35.0
+    for k in range(0, len(raws), 20):
+        msg = TS.deserialize_cdr(raws[k], "visualization_msgs/msg/MarkerArray")
+        j = int(np.argmin(np.abs(pose.t - t[k])))
+        assert abs(pose.t[j] - t[k]) < 1e-6
+        rope = _pts([m for m in msg.markers if m.ns == "cables"][0])
+        np.testing.assert_allclose(rope, [p.S, pose.position[j]], atol=1e-9)
