@@ -73,3 +73,37 @@ def test_foot_from_a_record_follows_the_simulator():
     sim_foot = np.array([_pts(r[4]["links"])[2, 2] for r in rows])
     np.testing.assert_allclose(foot_heights(z, contact, p.z_td), sim_foot, atol=2e-3)
     assert np.ptp(sim_foot) > 5e-3                                      # the foot really leaves the ground
+
+
+def test_overlay_bag_draws_the_recorded_hops(tmp_path):
+    """compare --out of a simulated hopping run: at about 30 Hz, the body at the recorded encoder
+    height of each stamp, the foot on the ground whenever the contact switch is closed."""
+    from pathlib import Path
+
+    import cablelab.plants.leg as leg_pkg
+    from cablelab.bags import open_bag
+    from cablelab.cli import main
+    from cablelab.plants.leg.sim import open_loop, simulate, write_bag
+
+    p = LegParams()
+    write_bag(tmp_path / "hops", simulate(p, p.z_td + 0.03, 0.0, 6.0, open_loop(3.0, 0.3)),
+              (Path(leg_pkg.__file__).parent / "data" / "leg.yaml").read_text())
+    assert main(["compare", str(tmp_path / "hops"), "--out", str(tmp_path / "ov"), "--json"]) == 0
+    bag = open_bag(tmp_path / "ov")
+    js = bag.joint_state("/leg/joint_states", ["body"])
+    contact = bag.joint_state("/leg/contact", ["contact"])
+    t_ns, raws = bag.raw("/leg/markers")
+    t = np.asarray(t_ns) * 1e-9
+    assert 25.0 < len(t) / (t[-1] - t[0]) < 35.0
+    phases = set()
+    for k in range(len(raws)):
+        by = {m.ns: m for m in TS.deserialize_cdr(raws[k], "visualization_msgs/msg/MarkerArray").markers}
+        j = int(np.argmin(np.abs(js.t - t[k])))
+        assert abs(js.t[j] - t[k]) < 1e-6
+        assert by["body"].pose.position.z == js.position[j, 0]
+        foot = _pts(by["links"])[2, 2]
+        if contact.position[j, 0] > 0.5:
+            assert foot == 0.0
+        phases.add(contact.position[j, 0] > 0.5)
+        assert foot > -1e-12
+    assert phases == {True, False}
