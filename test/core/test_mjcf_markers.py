@@ -6,6 +6,7 @@ at the site positions of MuJoCo's forward kinematics, the pulley site ending one
 starting the next, tangent points on the wrapping cylinder. One layout in every state (wrapping
 or not), so one MarkerEncoder serves them all."""
 import mujoco
+import pytest
 import numpy as np
 from hypothesis import given, settings, strategies as st
 from rosbags.typesys import Stores, get_typestore
@@ -110,3 +111,34 @@ def test_one_layout_whether_the_tendon_wraps_or_not():
     msgs = _decode(b, a)
     pts = np.array([[p.x, p.y, p.z] for p in [m for m in msgs if m.ns == "tendons"][0].points])
     np.testing.assert_allclose(pts[0], free.site_xpos[MODEL.site("sa").id], atol=1e-12)
+
+
+HANG = """<mujoco><option timestep="0.002"/><worldbody>
+ <site name="top" pos="0 0 2"/>
+ <body name="load" pos="0 0 1"><joint name="z" type="slide" axis="0 0 1" damping="40"/>
+   <geom type="sphere" size="0.05" mass="{m}"/><site name="hook"/></body>
+</worldbody>
+<tendon><spatial name="rope" {attrs}><site site="top"/><site site="hook"/></spatial></tendon>
+{act}</mujoco>"""
+
+
+@pytest.mark.parametrize("attrs,act", [
+    ('limited="true" range="0 1"', ""),                                    # taut at its limit
+    ('stiffness="2000" springlength="0 0.9"', ""),                           # an elastic rope
+    ("", '<actuator><motor tendon="rope" gear="2" ctrllimited="false"/></actuator>'),  # a winch
+], ids=["limit", "spring", "actuator"])
+def test_tendon_tension_carries_the_hanging_weight(attrs, act):
+    """A 3 kg load hanging at rest on a rope: the rope's tension is its weight m g, whichever of
+    the limit, the spring or an actuator (ctrl = -m g / gear: pulling) holds it."""
+    from cablelab.mjcf_markers import tendon_tension
+
+    m = 3.0
+    model = mujoco.MjModel.from_xml_string(HANG.format(m=m, attrs=attrs, act=act))
+    d = mujoco.MjData(model)
+    if act:
+        d.ctrl[0] = -m * 9.81 / 2
+    for _ in range(3000):
+        mujoco.mj_step(model, d)
+    mujoco.mj_forward(model, d)
+    assert abs(d.qvel[0]) < 1e-6
+    np.testing.assert_allclose(tendon_tension(model, d), [m * 9.81], rtol=1e-3)

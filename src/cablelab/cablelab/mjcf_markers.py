@@ -16,7 +16,7 @@ tendons as lines, in the model's world frame, for a plant whose machine is an MJ
   segments at its last point): one model gives one layout, which
   :class:`cablelab.markers.MarkerEncoder` and the simulators' timers need. Colour: by
   ``tendon_force`` (N, :func:`cablelab.markers.tension_colour` up to ``top``) when given, else
-  ``tendon_rgba``.
+  ``tendon_rgba``; :func:`tendon_tension` gives the force of a state.
 
 ns ``geoms`` / ``tendons``, id = the geom / tendon index, so a Foxglove user finds an element by
 the index MuJoCo gives it.
@@ -66,6 +66,25 @@ def tendon_paths(model: mujoco.MjModel, data: mujoco.MjData) -> list[list[np.nda
         bounds = np.r_[-1, cut, num]
         out.append([p[a + 1:b].copy() for a, b in zip(bounds[:-1], bounds[1:]) if b - a > 1])
     return out
+
+
+def tendon_tension(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
+    """(ntendon,) pulling force along each tendon, N, of a state after ``mj_forward``: the
+    actuators acting on it (``actuator_force`` x gear, a force that lengthens the tendon counted
+    negative), its limit constraint (``efc_force`` of its ``LIMIT_TENDON`` row: pulling at the
+    upper end of the range, pushing at the lower) and its passive spring-damper
+    (``tendon_stiffness`` beyond ``tendon_lengthspring``, ``tendon_damping`` x velocity)."""
+    f = np.zeros(model.ntendon)
+    on = np.flatnonzero(model.actuator_trntype == int(mujoco.mjtTrn.mjTRN_TENDON))
+    np.add.at(f, model.actuator_trnid[on, 0], -data.actuator_force[on] * model.actuator_gear[on, 0])
+    n = data.nefc
+    rows = np.flatnonzero(data.efc_type[:n] == int(mujoco.mjtConstraint.mjCNSTR_LIMIT_TENDON))
+    t = data.efc_id[rows]
+    L, lo, hi = data.ten_length[t], model.tendon_range[t, 0], model.tendon_range[t, 1]
+    np.add.at(f, t, np.where(np.abs(L - hi) <= np.abs(L - lo), 1.0, -1.0) * data.efc_force[rows])
+    L, (lo, hi) = data.ten_length, model.tendon_lengthspring.T
+    stretch = np.where(L > hi, L - hi, np.where(L < lo, L - lo, 0.0))
+    return f + model.tendon_stiffness * stretch + model.tendon_damping * data.ten_velocity
 
 
 def _segments(branches: list[np.ndarray], capacity: int) -> np.ndarray:
@@ -126,4 +145,4 @@ def model_markers(model: mujoco.MjModel, data: mujoco.MjData, tendon_force=None,
     return out
 
 
-__all__ = ["PLANE_SIZE", "model_markers", "tendon_capacity", "tendon_paths"]
+__all__ = ["PLANE_SIZE", "model_markers", "tendon_capacity", "tendon_paths", "tendon_tension"]

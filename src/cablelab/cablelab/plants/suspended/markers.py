@@ -8,8 +8,8 @@ it); both arms as lines through their joints to the last link's centre of mass, 
 kinematics of the parameter set's arm chain (joint origins, axes; the right arm mirrors y) at
 the measured joint angles.
 
-Tensions from a MuJoCo state (:func:`cable_tensions`): the four tendons' limit forces of the
-LiCAS truth plant, or the force the cable link passes to the platform link (``cfrc_int`` of
+Tensions from a MuJoCo state (:func:`cable_tensions`): the four tendons' tensions of the LiCAS
+truth plant (:func:`cablelab.mjcf_markers.tendon_tension`), or the force the cable link passes to the platform link (``cfrc_int`` of
 ``link10`` along the cable) in the virtual-joint models, shared by the drawn cables.
 """
 from __future__ import annotations
@@ -18,6 +18,7 @@ import mujoco
 import numpy as np
 
 from ...markers import CUBE, Marker, decimate_times, line, tension_colour
+from ...mjcf_markers import tendon_tension
 from ...rotations import matrix_to_quat, quat_to_matrix, wxyz_to_xyzw, xyzw_to_wxyz
 from .mjcf import CABLE_SEPARATION, arm_joint_names
 from .params import VirtualParams
@@ -82,10 +83,8 @@ def cable_tensions(p: VirtualParams, model: mujoco.MjModel, data: mujoco.MjData)
     n = cable_count(p)
     tendons = {model.tendon(i).name for i in range(model.ntendon)}
     if n == 4 and {f"cable{i}" for i in range(4)} <= tendons:
-        rows = data.efc_type[:data.nefc] == mujoco.mjtConstraint.mjCNSTR_LIMIT_TENDON
-        out = np.zeros(model.ntendon)
-        np.add.at(out, data.efc_id[:data.nefc][rows], data.efc_force[:data.nefc][rows])
-        return np.array([out[model.tendon(f"cable{i}").id] for i in range(4)])
+        ten = tendon_tension(model, data)
+        return np.array([ten[model.tendon(f"cable{i}").id] for i in range(4)])
     mujoco.mj_rnePostConstraint(model, data)
     b = model.body("link10").id
     u = data.site_xpos[model.site("S").id] - data.xpos[b]
