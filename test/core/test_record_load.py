@@ -110,7 +110,9 @@ def test_recorder_gets_every_sample_of_a_1khz_simulator_beside_cpu_hogs(launcher
         np.testing.assert_array_equal(k[k > 0], k_all, err_msg=topic)
         assert np.allclose(t * RATE, np.round(t * RATE), atol=1e-6), topic
     lost = recorder_lost(bag_dir)
-    assert lost is not None and set(streams) <= set(lost) and not any(lost.values()), lost
+    # (the 3D view /suspended/markers is a keep-last-1 stream: a stopped recorder misses frames
+    # of it by design, so only the data streams must be complete)
+    assert lost is not None and set(streams) <= set(lost) and not any(lost[t] for t in streams), lost
     assert _info(bag_dir)["lost"] == lost
 
 

@@ -5,7 +5,8 @@ type, namespace, id, pose, scale, colour, points, per-point colours) in frame ``
 module turns such a list into the serialised MarkerArray (CDR bytes, the same for a ROS
 publisher, which publishes bytes as they are, and for a bag: :func:`marker_array_cdr`) and writes
 a series of them into a bag (:func:`write_markers`). Cables are coloured by tension
-(:func:`tension_colour`: blue slack, green mid, red at the top of the scale).
+(:func:`tension_colour`: blue slack, green mid, red at the top of the scale). A machine given as
+a MuJoCo model draws itself from its geoms and tendons: :mod:`cablelab.mjcf_markers`.
 """
 from __future__ import annotations
 

@@ -290,5 +290,12 @@ DESCRIPTION = Param("description", "", "plant description: a YAML file path or Y
                     "(empty = the node's default)")
 
 
+def markers_rate(what: str) -> Param:
+    """The simulators' ``markers_rate``: how often the 3D view ``what`` (topic and content) is
+    published (:func:`cablelab.ros.markers.start_markers`)."""
+    return Param("markers_rate", 30.0, f"rate of the 3D view {what} (visualization_msgs/MarkerArray "
+                 "in world; 0 = off)", "Hz wall", ge=0.0, le=1000.0)
+
+
 __all__ = ["Param", "check_all", "merge", "help_text", "markdown_table", "executor_params",
-           "START_GATE", "DESCRIPTION", "ROS_TYPES"]
+           "START_GATE", "DESCRIPTION", "ROS_TYPES", "markers_rate"]

@@ -238,10 +238,18 @@ AXIS = register_plant(Plant(
         "/axis/effort_command": "std_msgs/msg/Float64MultiArray",
         "/axis/parameter_estimate": "std_msgs/msg/Float64MultiArray",
         "/axis/ground_truth/joint_states": JOINT_STATE,
+        "/axis/markers": "visualization_msgs/msg/MarkerArray",
     },
     joint_topic=TOPIC,
     joints=("joint",),
     capabilities=frozenset({"joint_actuators"}),
     channels=("joint",),
     topic_names=lambda desc: {TOPIC: ["joint"], "/axis/ground_truth/joint_states": ["joint"]},
+    markers=lambda bag, desc: _bag_markers(bag, desc),
 ))
+
+
+def _bag_markers(bag, desc):
+    from .markers import bag_markers
+
+    return bag_markers(bag, desc)

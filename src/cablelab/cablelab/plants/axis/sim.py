@@ -36,6 +36,17 @@ class AxisTruth:
     timestep: float = 0.001
 
 
+def pendulum_arm(inertia: float, gravity_moment: float) -> tuple[float, float]:
+    """(c m, m kg) of the revolute axis's point mass: m c = ``gravity_moment`` with c at most 1 m
+    and half of ``inertia`` at most in m c^2 (so the armature stays positive); (0, 1e-6) without
+    a gravity load."""
+    gm = float(gravity_moment)
+    if gm > 0:
+        c = min(1.0, 0.5 * float(inertia) / gm)
+        return c, gm / c
+    return 0.0, 1e-6
+
+
 def axis_mjcf(joint_type: str, truth: AxisTruth, gravity_moment: float = 0.0,
               gravity: float = 9.81) -> str:
     """MJCF text of the axis.
@@ -57,11 +68,7 @@ def axis_mjcf(joint_type: str, truth: AxisTruth, gravity_moment: float = 0.0,
         gm = float(gravity_moment)
         if gm < 0:
             raise CablelabError(f"axis simulator: gravity_moment must be >= 0, got {gm}")
-        if gm > 0:
-            c = min(1.0, 0.5 * truth.inertia / gm)  # keeps the armature positive
-            m = gm / c
-        else:
-            c, m = 0.0, 1e-6
+        c, m = pendulum_arm(truth.inertia, gm)
         armature = truth.inertia - m * c * c
         body = (f'<body name="load"><joint name="joint" type="hinge" axis="0 1 0" '
                 f'armature="{armature!r}" {joint_common}/>'

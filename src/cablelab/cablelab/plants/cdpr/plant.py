@@ -541,6 +541,7 @@ CDPR = register_plant(Plant(
         "/cdpr/payload_estimate": "geometry_msgs/msg/InertiaStamped",
         "/cdpr/ground_truth/pose": "geometry_msgs/msg/PoseStamped",
         "/cdpr/ground_truth/payload": "geometry_msgs/msg/InertiaStamped",
+        "/cdpr/markers": "visualization_msgs/msg/MarkerArray",
     },
     joint_topic=JOINTS,
     joints=tuple(f"winch_{i}" for i in range(1, 9)),

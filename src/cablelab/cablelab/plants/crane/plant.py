@@ -333,6 +333,7 @@ CRANE = register_plant(Plant(
         "/crane/effort_commands": "std_msgs/msg/Float64MultiArray",
         "/crane/swing_estimate": JOINT_STATE,
         "/crane/ground_truth/swing": JOINT_STATE,
+        "/crane/markers": "visualization_msgs/msg/MarkerArray",
     },
     joint_topic=JOINT_STATES,
     joints=JOINTS,

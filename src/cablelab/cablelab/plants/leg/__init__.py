@@ -38,6 +38,7 @@ LEG = register_plant(Plant(
         "/leg/effort_commands": "std_msgs/msg/Float64MultiArray",
         "/leg/hop_estimate": JOINT_STATE,
         "/leg/ground_truth/state": JOINT_STATE,
+        "/leg/markers": "visualization_msgs/msg/MarkerArray",
     },
     joint_topic="/leg/joint_states",
     joints=("body", "motor"),
@@ -47,6 +48,13 @@ LEG = register_plant(Plant(
     topic_names=lambda desc: {"/leg/joint_states": ["body", "motor"], "/leg/contact": ["contact"],
                               **{t: ["height", "phase", "apex_height", "grf"] for t in
                                  ("/leg/hop_estimate", "/leg/ground_truth/state")}},
+    markers=lambda bag, desc: _bag_markers(bag, desc),
 ))
+
+
+def _bag_markers(bag, desc):
+    from .markers import bag_markers
+
+    return bag_markers(bag, desc)
 
 PLANT = LEG

@@ -25,7 +25,7 @@ from trajectory_msgs.msg import JointTrajectory
 from ...description import load_description
 from ...ros import convert
 from ...ros.clock import ClockPublisher
-from ...ros.params import Param
+from ...ros.params import Param, markers_rate
 from ...ros.plant_node import PlantNode
 from ...ros.qos import publisher_qos, stream_qos
 from .controller import ApexController
@@ -49,6 +49,7 @@ PARAMETERS = {
         Param("rate", 1000.0, "simulation and publishing rate", "Hz", ge=1.0, le=100000.0),
         Param("command_timeout", 0.5, "a torque command older than this means zero torque",
               "s wall", gt=0.0),
+        markers_rate("/leg/markers: body, links, spring coloured by its force, foot"),
     ),
     "estimator": (
         _DESCRIPTION,
@@ -103,6 +104,10 @@ class LegSimNode(PlantNode):
         self.create_subscription(Float64MultiArray, "/leg/effort_commands", self.on_command, stream_qos())
         self.start_diagnostics()
         self.timer = self.create_timer(1.0 / self.rate, self.tick)
+        from ...ros.markers import start_markers
+        from .markers import sim_markers
+
+        start_markers(self, "/leg/markers", lambda: sim_markers(self.sim), lambda: self.sim.t, v.markers_rate)
 
     def extend_status(self, level, msg, values):
         values["sim time s"] = f"{self.sim.t:.3f}"

@@ -58,10 +58,18 @@ SUSPENDED = register_plant(Plant(
         "/suspended/ground_truth/swing": JOINT_STATE,
         "/suspended/ground_truth/virtual_joints": JOINT_STATE,
         SUSPENSION_TOPIC: POSE,                # optional, docs/contract-additions.md (suspension_motion)
+        "/suspended/markers": "visualization_msgs/msg/MarkerArray",
     },
     channels=_CHANNELS,
     topic_names=lambda desc: {t: ["swing_x", "swing_y", "yaw", "r_x", "r_y"] for t in
                               ("/suspended/swing_estimate", "/suspended/ground_truth/swing")},
+    markers=lambda bag, desc: _bag_markers(bag, desc),
 ))
+
+
+def _bag_markers(bag, desc):
+    from .markers import bag_markers
+
+    return bag_markers(bag, desc)
 
 PLANT = SUSPENDED

@@ -34,6 +34,8 @@ VJ = ("J7", "J8", "J9", "J10", "J11", "J12")
 #: hook body carrying S in the ``moving_suspension`` truth, kg, and its position-servo bandwidth, Hz
 HOOK_MASS = 200.0
 HOOK_BANDWIDTH_HZ = 5.0
+#: LiCAS truth plant: side of the square of the four cables' attachment points, m (spec sec. 3.3)
+CABLE_SEPARATION = 0.25
 AXES = {"x": "1 0 0", "y": "0 1 0", "z": "0 0 1"}
 _AXIS_IDX = {"x": 0, "y": 1, "z": 2}
 #: cable joint turning about each axis (where an inertia excess goes as armature, spec 4.2)
@@ -253,7 +255,7 @@ def levelling_ctrl(p: VirtualParams, qpos_J, qvel_J) -> np.ndarray:
                      p.kp12 * (-q[..., 2] - q[..., 5]) + p.kd12 * (-qd[..., 2] - qd[..., 5])], -1)
 
 
-def truth_xml(p: VirtualParams, *, platform_mass: float = 0.7, cable_separation: float = 0.25,
+def truth_xml(p: VirtualParams, *, platform_mass: float = 0.7, cable_separation: float = CABLE_SEPARATION,
               timestep: float = 1e-3, integrator: str = "implicitfast", cable_elasticity=None,
               arm_motors: bool = False) -> str:
     """MJCF of the physical truth plant.

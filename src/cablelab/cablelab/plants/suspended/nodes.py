@@ -38,7 +38,7 @@ import math
 import time
 
 from ...errors import CablelabError
-from ...ros.params import START_GATE, Param, executor_params, merge
+from ...ros.params import START_GATE, Param, executor_params, markers_rate, merge
 from .params import VARIANTS, parameter_set
 from .swing import CHANNELS, SwingEstimator
 
@@ -88,6 +88,7 @@ PARAMETERS = {
               "s wall", gt=0.0),
         Param("imu", True, "publish /suspended/imu (orientation, gyro, accelerometer in the "
               "platform frame)"),
+        markers_rate("/suspended/markers: cables coloured by tension, platform, arms"),
     ), START_GATE, executor_params(True)),
     "controller": merge((
         _VARIANT,
@@ -253,6 +254,11 @@ def _sim_class():
                 self.create_subscription(JointTrajectory, "/suspended/reference", self.on_reference, stream_qos())
             self.start_diagnostics()
             self.timer = self.create_timer(1.0 / self.rate, self.tick)
+            from ...ros.markers import start_markers
+            from .markers import state_markers
+
+            start_markers(self, "/suspended/markers", lambda: state_markers(self.params, self.model, self.data),
+                          lambda: float(self.data.time), v.markers_rate)
             self.publish_state()
 
         def extend_status(self, level, msg, values):

@@ -28,7 +28,8 @@ from ..sim import AxisSim, AxisTruth
 from ....ros import convert
 from ....ros.clock import ClockPublisher
 from ....ros.lockstep import ADVANCE, FREE, RESEND, LockStep
-from ....ros.params import DESCRIPTION, START_GATE, Param, merge
+from ....ros.markers import start_markers
+from ....ros.params import DESCRIPTION, START_GATE, Param, markers_rate, merge
 from ....ros.plant_node import PlantNode
 from ....ros.qos import publisher_qos, stream_qos
 
@@ -50,6 +51,7 @@ PARAMETERS = merge((
           "arrived"),
     Param("lockstep_resend", 0.25, "lock-step: the state is republished this often while waiting",
           "s wall", gt=0.0, le=60.0),
+    markers_rate("/axis/markers: carriage on its rail or link and load"),
 ), START_GATE)
 
 
@@ -78,6 +80,10 @@ class AxisSimNode(PlantNode):
         self.create_subscription(Float64MultiArray, "/axis/effort_command", self.on_command, stream_qos())
         self.start_diagnostics()
         self.timer = self.create_timer(1.0 / self.rate, self.tick)
+        from ..markers import axis_markers
+
+        start_markers(self, "/axis/markers", lambda: axis_markers(self.description, self.sim.state()[1], truth.inertia),
+                      lambda: self.sim.t, v.markers_rate)
         self.publish_state()
 
     def extend_status(self, level, msg, values):

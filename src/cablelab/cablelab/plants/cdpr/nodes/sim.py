@@ -36,7 +36,7 @@ from ....rotations import wxyz_to_xyzw
 from ....ros.inputs import WARN
 from ....ros.fastspin import poll, take_newest
 from ....ros.markers import start_markers
-from ....ros.params import DESCRIPTION, START_GATE, Param, executor_params, merge
+from ....ros.params import DESCRIPTION, START_GATE, Param, executor_params, markers_rate, merge
 from ....ros.plant_node import PlantNode
 from ....ros.qos import publisher_qos, stream_qos
 from ....ros import rawmsg
@@ -85,9 +85,7 @@ PARAMETERS = merge((
           "mass_change_time (a payload change while running, e.g. to test a model monitor; the "
           "ground truth follows)", "kg", ge=-1e5, le=1e5),
     Param("mass_change_time", -1.0, "sim time of the mass change (negative = never)", "s", le=1e9),
-    Param("markers_rate", 30.0, "rate of the 3D view /cdpr/markers (visualization_msgs/MarkerArray "
-          "in world: cables coloured by tension, platform, exit points; 0 = off)", "Hz wall",
-          ge=0.0, le=1000.0),
+    markers_rate("/cdpr/markers: cables coloured by tension, platform, exit points"),
     Param("seed", 0, "seed of the noise generator", ge=0),
 ), START_GATE, executor_params(True))
 

@@ -38,7 +38,7 @@ from ..model import JOINTS, CraneParams
 from ....ros.markers import start_markers
 from ....ros import convert
 from ....ros.lockstep import ADVANCE, FREE, LockStep
-from ....ros.params import DESCRIPTION, START_GATE, Param, merge
+from ....ros.params import DESCRIPTION, START_GATE, Param, markers_rate, merge
 from ....ros.plant_node import PlantNode
 from ....ros.qos import publisher_qos, stream_qos
 from ..sim import CraneSim, CraneTruth
@@ -71,8 +71,7 @@ PARAMETERS = merge((
           "state arrived"),
     Param("lockstep_timeout", 10.0, "lock-step: without an answer for this long, back to real time "
           "holding the crane", "s wall", gt=0.0),
-    Param("markers_rate", 30.0, "rate of the 3D view /crane/markers (visualization_msgs/MarkerArray: "
-          "mast, boom, rope, payload; 0 = off)", "Hz wall", ge=0.0, le=1000.0),
+    markers_rate("/crane/markers: mast, boom, rope, payload"),
 ), START_GATE)
 
 
