@@ -93,5 +93,5 @@ class PendulumSim(PlantNode):
         return level, msg, values
 
 
-def make_node(args) -> PlantNode:
+def make_node() -> PlantNode:
     return PendulumSim()

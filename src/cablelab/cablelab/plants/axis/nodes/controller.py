@@ -105,5 +105,5 @@ class AxisController(PlantNode):
         self.pub_cmd.publish(convert.command_msg([u], stamp=t, label="joint"))
 
 
-def make_node(args) -> PlantNode:
+def make_node() -> PlantNode:
     return AxisController()

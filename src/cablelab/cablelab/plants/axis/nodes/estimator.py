@@ -84,5 +84,5 @@ class AxisEstimator(PlantNode):
             self.pub.publish(convert.float_array_msg(self.rls.theta))
 
 
-def make_node(args) -> PlantNode:
+def make_node() -> PlantNode:
     return AxisEstimator()

@@ -115,5 +115,5 @@ class AxisSimNode(PlantNode):
         self.pub_truth.publish(convert.joint_state_msg(t, ["joint"], [q], [qd], [self.u]))
 
 
-def make_node(args) -> PlantNode:
+def make_node() -> PlantNode:
     return AxisSimNode()

@@ -209,5 +209,5 @@ class CdprControlLoop(ControlLoopNode):
         tpl.vector("pose.orientation", "xyzw")[:] = wxyz_to_xyzw(quat_wxyz)
 
 
-def make_node(args) -> CdprControlLoop:
+def make_node() -> CdprControlLoop:
     return CdprControlLoop()

@@ -273,5 +273,5 @@ class CdprController(PlantNode):
         return level, msg, values
 
 
-def make_node(args) -> PlantNode:
+def make_node() -> PlantNode:
     return CdprController()

@@ -255,5 +255,5 @@ class CdprPayloadEstimator(PlantNode):
         return level, msg, values
 
 
-def make_node(args) -> PlantNode:
+def make_node() -> PlantNode:
     return CdprPayloadEstimator()

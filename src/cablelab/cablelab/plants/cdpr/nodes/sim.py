@@ -404,5 +404,5 @@ class CdprSimNode(PlantNode):
         tpl.vector("pose.orientation", "xyzw")[:] = wxyz_to_xyzw(quat_wxyz)
 
 
-def make_node(args) -> PlantNode:
+def make_node() -> PlantNode:
     return CdprSimNode()

@@ -156,5 +156,5 @@ class CraneController(PlantNode):
         return self._start
 
 
-def make_node(args) -> PlantNode:
+def make_node() -> PlantNode:
     return CraneController()

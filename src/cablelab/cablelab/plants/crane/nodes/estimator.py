@@ -122,5 +122,5 @@ class CraneSwingEstimator(PlantNode):
                 self.pub.publish(convert.joint_state_msg(t, NAMES, x, v))
 
 
-def make_node(args) -> PlantNode:
+def make_node() -> PlantNode:
     return CraneSwingEstimator()

@@ -166,5 +166,5 @@ class CraneSimNode(PlantNode):
         self.pub_truth.publish(convert.joint_state_msg(t, SWING, [q[3], q[4], q[2]], [qd[3], qd[4], qd[2]]))
 
 
-def make_node(args) -> PlantNode:
+def make_node() -> PlantNode:
     return CraneSimNode()
