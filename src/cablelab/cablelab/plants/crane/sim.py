@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 import mujoco
 import numpy as np
 
+from . import topics
 from .kinematics import gimbal_rates_to_swing, gimbal_to_swing, swing_to_gimbal
 from .model import CraneParams, gravity_vector, mass_matrix
 from ...rotations import wxyz_to_xyzw
@@ -401,12 +402,12 @@ def write_bag(path, res: SimResult, description_yaml: str, *, overwrite: bool = 
     with BagWriter(path, overwrite=overwrite) as w:
         w.write_description(description_yaml)
         w.write_clock(res.t)
-        w.write_joint_states("/crane/joint_states", res.t, ("slew", "luff", "hoist"),
+        w.write_joint_states(topics.JOINT_STATES, res.t, ("slew", "luff", "hoist"),
                              position=res.q[:, :3], velocity=res.qd[:, :3], effort=res.effort)
-        w.write_poses("/crane/boom_tip_pose", res.t, res.tip, wxyz_to_xyzw(res.tip_quat))
-        w.write_poses("/crane/payload_pose", res.t, res.payload, wxyz_to_xyzw(res.payload_quat))
-        w.write_joint_states("/crane/ground_truth/swing", res.t, ("theta1", "theta2", "rope_length"),
+        w.write_poses(topics.TIP_POSE, res.t, res.tip, wxyz_to_xyzw(res.tip_quat))
+        w.write_poses(topics.PAYLOAD_POSE, res.t, res.payload, wxyz_to_xyzw(res.payload_quat))
+        w.write_joint_states(topics.SWING_TRUTH, res.t, ("theta1", "theta2", "rope_length"),
                              position=res.q[:, [3, 4, 2]], velocity=res.qd[:, [3, 4, 2]])
-        w.write_joint_trajectory("/crane/reference", res.t, ("slew", "luff", "hoist"), res.q_ref,
+        w.write_joint_trajectory(topics.REFERENCE, res.t, ("slew", "luff", "hoist"), res.q_ref,
                                  res.qd_ref, res.qdd_ref)
-        w.write_float_arrays("/crane/effort_commands", res.t, res.motor)
+        w.write_float_arrays(topics.EFFORT_COMMANDS, res.t, res.motor)

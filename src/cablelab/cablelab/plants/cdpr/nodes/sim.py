@@ -30,6 +30,7 @@ from trajectory_msgs.msg import MultiDOFJointTrajectory
 
 from ....description import load_description
 from ....errors import CablelabError
+from .. import topics
 from ..trajectory import ReferenceTable, pick_and_place
 from ....ros import convert
 from ....rotations import wxyz_to_xyzw
@@ -177,12 +178,12 @@ class CdprSimNode(PlantNode):
         self._wall0 = None          # wall time of sim time 0 (real-time mode)
 
         q = stream_qos()
-        self.pub_js = self.create_publisher(JointState, "/cdpr/joint_states", q)
-        self.pub_ten = self.create_publisher(JointState, "/cdpr/cable_tensions", q)
-        self.pub_pose = self.create_publisher(PoseStamped, "/cdpr/platform_pose", q)
-        self.pub_ref = self.create_publisher(MultiDOFJointTrajectory, "/cdpr/reference", q)
-        self.pub_tpose = self.create_publisher(PoseStamped, "/cdpr/ground_truth/pose", q)
-        self.pub_tpay = self.create_publisher(InertiaStamped, "/cdpr/ground_truth/payload", q)
+        self.pub_js = self.create_publisher(JointState, topics.JOINT_STATES, q)
+        self.pub_ten = self.create_publisher(JointState, topics.CABLE_TENSIONS, q)
+        self.pub_pose = self.create_publisher(PoseStamped, topics.PLATFORM_POSE, q)
+        self.pub_ref = self.create_publisher(MultiDOFJointTrajectory, topics.REFERENCE, q)
+        self.pub_tpose = self.create_publisher(PoseStamped, topics.GROUND_TRUTH_POSE, q)
+        self.pub_tpay = self.create_publisher(InertiaStamped, topics.GROUND_TRUTH_PAYLOAD, q)
         self.pub_clock = self.create_publisher(Clock, "/clock", stream_qos(10))
         self.publish_description(self.description)
         if not self.real_time and v.rt_priority > 0:
@@ -192,14 +193,14 @@ class CdprSimNode(PlantNode):
         # real time: the commands wait queued until the step that applies them takes the newest
         # (one wake-up per step, the timer's; a keep-last-1 queue, so one take); lock-step: a
         # command wakes the node (it is the trigger)
-        cmd = self.create_subscription(Float64MultiArray, "/cdpr/effort_commands", self.on_command,
+        cmd = self.create_subscription(Float64MultiArray, topics.EFFORT_COMMANDS, self.on_command,
                                        stream_qos(1) if self.real_time else q, raw=True)
         self.polled = [cmd] if self.real_time else []
         for sub in self.polled:
             poll(self, sub)
         self.start_diagnostics()
         self.timer = self.create_timer(1.0 / self.rate if self.real_time else 0.0002, self.tick)
-        start_markers(self, "/cdpr/markers", self._marker_frame, lambda: self.sim.time,
+        start_markers(self, topics.MARKERS, self._marker_frame, lambda: self.sim.time,
                       v.markers_rate)
         self.publish_state()
 
