@@ -28,12 +28,12 @@ from trajectory_msgs.msg import JointTrajectory
 from .. import topics
 from ..control import LIVE_GAINS, Gains, control_law, hold_command
 from ..model import JOINTS, CraneParams
+from ..reference import reference_trajectory
 from ....ros import convert
 from ....ros.inputs import WARN
 from ....ros.params import Param
 from ....ros.plant_node import PlantNode
 from ....ros.qos import publisher_qos, stream_qos
-from ..sim import reference_trajectory
 
 
 PARAMETERS = (
