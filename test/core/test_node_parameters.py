@@ -8,7 +8,7 @@ The validation is checked against an independent predicate written here from the
 issue's cases against real nodes built in-process with ``--ros-args -p`` overrides."""
 from __future__ import annotations
 
-import importlib.util
+import importlib
 import math
 import os
 import sys
@@ -26,14 +26,21 @@ TOY = REPO / "test" / "plants" / "toy_pendulum"
 
 
 def _toy_specs():
+    """The toy plant's simulator parameters (its package imported from its folder, then forgotten
+    again with its registration, so no other test sees a plant the registry does not find)."""
+    from cablelab import effects, registry
+
+    before = dict(effects._REGISTRY)
     sys.path.insert(0, str(TOY))
     try:
-        spec = importlib.util.spec_from_file_location("toy_pendulum_sim", TOY / "pendulum_plant" / "nodes" / "sim.py")
-        mod = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(mod)
-        return mod.PARAMETERS
+        return importlib.import_module("pendulum_plant.nodes.sim").PARAMETERS
     finally:
         sys.path.remove(str(TOY))
+        registry._REGISTRY.pop("pendulum", None)
+        effects._REGISTRY.clear()
+        effects._REGISTRY.update(before)
+        for name in [m for m in sys.modules if m == "pendulum_plant" or m.startswith("pendulum_plant.")]:
+            del sys.modules[name]
 
 
 def _all_specs():

@@ -1,6 +1,6 @@
-"""Tests of the pendulum plant (written by ``cablelab new-plant``; extend them with the plant's law).
+"""Tests of the pendulum plant (written by ``cablelab new-plant``, the closed form the pendulum's).
 
-Oracles: the closed form of a torque-driven rigid body; the damping MuJoCo integrates against
+Oracles: the equilibrium and small-oscillation period of a torque-driven pendulum; the damping MuJoCo integrates against
 the viscous friction ``cablelab diagnose`` identifies from a recorded run; the entry-point
 discovery in a fresh interpreter."""
 from __future__ import annotations
@@ -51,18 +51,24 @@ def test_description_section_round_trip_and_one_line_errors():
     sec = section()
     assert parse_section(dump_section(sec)) == sec
     with pytest.raises(CablelabError) as err:
-        parse_section({"inertia": -1.0})
-    assert "inertia" in str(err.value) and "\n" not in str(err.value)
+        parse_section({"mass": 0.5, "length": -1.0})
+    assert "length" in str(err.value) and "\n" not in str(err.value)
 
 
 def test_simulator_follows_the_closed_form():
-    """Constant torque on the undamped hinge: q = tau t^2 / (2 I), qd = tau t / I."""
+    """Constant torque on the undamped pendulum: it comes to rest (on average) at the angle where
+    gravity balances the torque, m g l sin q = tau, and swings about it with the small-oscillation
+    period 2 pi sqrt(l / (g cos q*)) of the linearised pendulum."""
     from pendulum_plant.sim import simulate
 
-    sec, tau = section(), 0.2
-    run = simulate(sec, 2.0, 100.0, lambda t: tau)
-    assert np.allclose(run["q"], tau * run["t"] ** 2 / (2 * sec.inertia), rtol=1e-2, atol=1e-4)
-    assert np.allclose(run["qd"], tau * run["t"] / sec.inertia, rtol=1e-2, atol=1e-4)
+    sec, tau, g = section(), 0.2, 9.81
+    q_eq = np.arcsin(tau / (sec.mass * g * sec.length))
+    run = simulate(sec, 20.0, 1000.0, lambda t: tau)
+    q = run["q"][1:]
+    assert abs(q.mean() - q_eq) < 0.02 * q_eq
+    up = np.flatnonzero((q[:-1] < q_eq) & (q[1:] >= q_eq))        # upward crossings of q_eq
+    period = np.mean(np.diff(run["t"][1:][up]))
+    assert period == pytest.approx(2 * np.pi * np.sqrt(sec.length / (g * np.cos(q_eq))), rel=0.02)
 
 
 def test_diagnose_finds_the_hidden_damping(tmp_path):

@@ -10,16 +10,23 @@ from cablelab.fields import check_keys, mapping, number
 
 @dataclass(frozen=True)
 class PendulumDescription:
-    """``pendulum:`` section. inertia: of the moving body about the hinge, kg m^2."""
+    """``pendulum:`` section: bob mass (kg), rod length (m); a point-like bob on a massless rod."""
 
-    inertia: float
+    mass: float
+    length: float
+
+    @property
+    def inertia(self) -> float:
+        """Inertia about the hinge, kg m^2 (m l^2)."""
+        return self.mass * self.length ** 2
 
 
 def parse_section(obj) -> PendulumDescription:
     """The validated section (``obj``: the YAML mapping under ``pendulum:``)."""
     obj = mapping(obj, "pendulum")
-    check_keys(obj, "pendulum", ("inertia",), ())
-    return PendulumDescription(number(obj, "inertia", "pendulum", positive=True))
+    check_keys(obj, "pendulum", ("mass", "length"), ())
+    return PendulumDescription(number(obj, "mass", "pendulum", positive=True),
+                               number(obj, "length", "pendulum", positive=True))
 
 
 def dump_section(section: PendulumDescription) -> dict:

@@ -7,13 +7,13 @@ from cablelab.registry import Plant
 
 from . import topics
 from .dataset import dataset
-from .description import parse_section
+from .description import dump_section, parse_section
 from .mjcf import JOINT
 
 
 def baseline(description) -> tuple[str, ...]:
     """Effect ids of the nominal model (:mod:`.effects`)."""
-    return ("pendulum_inertia",)
+    return ("pendulum_inertia", "pendulum_gravity")
 
 
 def candidates(description) -> tuple[str, ...]:
@@ -30,6 +30,7 @@ PLANT = Plant(
     candidates=candidates,
     channels_doc=f"{JOINT}: applied torque (N m)",
     section=parse_section,
+    dump_section=dump_section,
     contract_topics=topics.TYPES,
     joint_topic=topics.JOINT_STATES,
     joints=(JOINT,),
