@@ -13,9 +13,9 @@ DESCRIPTION = (HELP + ". The package works as written (a torque-driven hinge, it
 
 
 def add_arguments(p) -> None:
-    p.add_argument("name", help="plant id: a lowercase identifier (also the description section "
+    p.add_argument("name", metavar="NAME", help="plant id: a lowercase identifier (also the description section "
                    "and topic prefix /NAME/...)")
-    p.add_argument("-o", "--output", type=Path, default=None,
+    p.add_argument("-o", "--output", type=Path, default=None, metavar="DIR",
                    help="directory to create (default: ./NAME); must not exist")
 
 

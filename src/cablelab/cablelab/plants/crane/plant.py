@@ -37,8 +37,8 @@ from .freerun import fit_free_run, free_run_compare
 from .kinematics import SwingAngles
 from .model import JOINTS, CraneParams
 from .swing import SwingReport, estimate_swing
-from .topics import (EFFORT_COMMANDS, JOINT_STATE, JOINT_STATES, PAYLOAD_POSE, POSE, REFERENCE,
-                     SWING_ESTIMATE, SWING_TRUTH, TIP_POSE)
+from .topics import (JOINT_STATE, JOINT_STATES, PAYLOAD_POSE, POSE, REFERENCE, SWING_ESTIMATE,
+                     SWING_TRUTH, TIP_POSE)
 
 SWING_NAMES = ("theta1", "theta2", "rope_length")
 #: default low-pass cut-off of the crane's positions, Hz (when --cutoff is not given). The payload

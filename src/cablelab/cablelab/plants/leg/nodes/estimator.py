@@ -6,7 +6,6 @@ ROS parameters: :data:`PARAMETERS` (``payload_estimator --plant leg --help``).
 """
 from __future__ import annotations
 
-import math
 import time
 
 from sensor_msgs.msg import JointState
