@@ -44,7 +44,7 @@ from ....ros import rawmsg
 from ....ros.rawmsg import RawTemplate
 from ..geometry import check_pulley_radius
 from ..hardware import WinchBrakes
-from ..sim import CdprSim, CdprTruth, default_description_path
+from ..sim import CdprSim, default_description_path, truth_from_parameters
 
 
 PARAMETERS = merge((
@@ -91,25 +91,6 @@ PARAMETERS = merge((
           ge=0.0, le=1000.0),
     Param("seed", 0, "seed of the noise generator", ge=0),
 ), START_GATE, executor_params(True))
-
-
-def truth_from_parameters(node: str, v, n: int, rate: float) -> CdprTruth:
-    """The simulated CDPR's truth from the validated simulator parameters ``v`` (the specs of
-    :data:`PARAMETERS`) for ``n`` cables at ``rate`` Hz; one-line errors naming ``node`` for what
-    the specs alone cannot check (the bias length against the cable count, the smallest step)."""
-    bias = v.tension_bias
-    if len(bias) not in (1, n):
-        raise CablelabError(f"{node}: parameter tension_bias:={bias}: expected 1 or {n} numbers "
-                            "(one per cable) [N]")
-    if 0 < v.timestep < 1e-5:
-        raise CablelabError(f"{node}: parameter timestep:={v.timestep!r}: expected 0 (auto) or a step "
-                            "of at least 1e-05 [s]")
-    return CdprTruth(
-        pulleys=v.pulleys, payload_mass=v.payload_mass, payload_com=tuple(v.payload_com),
-        winch_coulomb=v.winch_coulomb, winch_viscous=v.winch_viscous,
-        motor_inertia=v.motor_inertia, tension_noise=v.tension_noise,
-        tension_bias=tuple(bias) if any(bias) else None, torque_noise=v.torque_noise,
-        pose_noise=v.pose_noise, timestep=v.timestep or min(0.002, 1.0 / rate), seed=v.seed)
 
 
 class CdprSimNode(PlantNode):
