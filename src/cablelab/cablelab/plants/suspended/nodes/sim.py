@@ -91,11 +91,11 @@ class SuspendedSimNode(PlantNode):
         self.inputs.add("reference", timeout=1e9, length=len(self.names))
         self.inputs.add("effort_commands", timeout=v.command_timeout, length=len(self.names))
         pub = lambda kind, topic: self.create_publisher(kind, topic, publisher_qos())  # noqa: E731
-        self.pub_imu = pub(Imu, topics.IMU) if v.imu else None
-        self.pub_pose = pub(PoseStamped, topics.PLATFORM_POSE)
         self.pub_js = pub(JointState, topics.JOINT_STATES)
+        self.pub_pose = pub(PoseStamped, topics.PLATFORM_POSE)
         self.pub_sw = pub(JointState, topics.GROUND_TRUTH_SWING)
         self.pub_vj = pub(JointState, topics.GROUND_TRUTH_VIRTUAL)
+        self.pub_imu = pub(Imu, topics.IMU) if v.imu else None
         self.clock = ClockPublisher(self)
         self.publish_description(self.description)
         if self.motors:
