@@ -28,7 +28,6 @@ PLANT = Plant(
     dataset=dataset,
     baseline=baseline,
     candidates=candidates,
-    channels_doc=f"{JOINT}: applied torque (N m)",
     section=parse_section,
     dump_section=dump_section,
     contract_topics=topics.TYPES,
