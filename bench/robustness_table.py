@@ -519,7 +519,7 @@ def run_node_check(package, role, plant, params):
         args += ["-p", p]
     rclpy.init(args=args, domain_id=dom)
     try:
-        node_module(plant, role).make_node(None).destroy_node()
+        node_module(plant, role).make_node().destroy_node()
         return 0, "(node built: parameters declared and checked)"
     except CablelabError as exc:
         return 2, f"{package} --plant {plant}: error: {exc}"

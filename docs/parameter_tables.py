@@ -34,7 +34,7 @@ def section() -> str:
                 continue
             node = f"{package} --plant {plant}"
             parts += [f"### `{node}`", "", f"<!-- parameters: {node} -->",
-                      markdown_table(parameters_of(module, role)), "<!-- end parameters -->", ""]
+                      markdown_table(parameters_of(module)), "<!-- end parameters -->", ""]
     from cablelab.ros.monitor_node import PARAMETERS as MONITOR
 
     parts += ["### `model_monitor --plant P` (any plant)", "", "<!-- parameters: model_monitor -->",

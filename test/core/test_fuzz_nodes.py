@@ -165,7 +165,7 @@ def test_node_survives_hostile_messages(ros, plant, role):
     descriptions = _descriptions()
     if plant not in descriptions:
         pytest.skip(f"no working description of plant {plant} for the fuzz test yet")
-    node = node_module(plant, role).make_node(None)
+    node = node_module(plant, role).make_node()
     cls = type(node).__name__
     published = []
     node.diag.pub.publish = published.append
@@ -225,7 +225,7 @@ def test_node_refuses_random_bad_parameters(ros, monkeypatch, plant, role):
     from test_node_parameters import any_value, valid
 
     module = node_module(plant, role)
-    specs = parameters_of(module, role)
+    specs = parameters_of(module)
     overrides = []
     init = Node.__init__
 
@@ -247,7 +247,7 @@ def test_node_refuses_random_bad_parameters(ros, monkeypatch, plant, role):
                                                  and v is not None))
         overrides[:] = [Parameter(spec.name, value=value)]
         with pytest.raises(CablelabError) as exc:
-            module.make_node(None).destroy_node()
+            module.make_node().destroy_node()
         text = str(exc.value)
         assert "\n" not in text and f"parameter {spec.name}:=" in text, text
 

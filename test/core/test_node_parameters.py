@@ -8,7 +8,7 @@ The validation is checked against an independent predicate written here from the
 issue's cases against real nodes built in-process with ``--ros-args -p`` overrides."""
 from __future__ import annotations
 
-import importlib.util
+import importlib
 import math
 import os
 import sys
@@ -26,14 +26,21 @@ TOY = REPO / "test" / "plants" / "toy_pendulum"
 
 
 def _toy_specs():
+    """The toy plant's simulator parameters (its package imported from its folder, then forgotten
+    again with its registration, so no other test sees a plant the registry does not find)."""
+    from cablelab import effects, registry
+
+    before = dict(effects._REGISTRY)
     sys.path.insert(0, str(TOY))
     try:
-        spec = importlib.util.spec_from_file_location("toy_pendulum_sim", TOY / "pendulum_plant" / "nodes" / "sim.py")
-        mod = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(mod)
-        return mod.PARAMETERS
+        return importlib.import_module("pendulum_plant.nodes.sim").PARAMETERS
     finally:
         sys.path.remove(str(TOY))
+        registry._REGISTRY.pop("pendulum", None)
+        effects._REGISTRY.clear()
+        effects._REGISTRY.update(before)
+        for name in [m for m in sys.modules if m == "pendulum_plant" or m.startswith("pendulum_plant.")]:
+            del sys.modules[name]
 
 
 def _all_specs():
@@ -46,7 +53,7 @@ def _all_specs():
         for package, role in {**ROLES, "control_loop": "control_loop"}.items():
             module = node_module(plant, role)
             if module is not None:
-                out.append((f"{package} --plant {plant}", parameters_of(module, role)))
+                out.append((f"{package} --plant {plant}", parameters_of(module)))
     out.append(("cable_sim_node --plant pendulum", _toy_specs()))
     return out
 
@@ -164,7 +171,7 @@ def test_random_parameter_values_are_validated(node, specs):
 def test_descriptor_carries_range_and_read_only():
     from cablelab.ros.runner import node_module, parameters_of
 
-    specs = {s.name: s for s in parameters_of(node_module("cdpr", "sim"), "sim")}
+    specs = {s.name: s for s in parameters_of(node_module("cdpr", "sim"))}
     d = specs["rate"].descriptor()
     assert d.read_only
     assert d.floating_point_range[0].from_value == 1.0 and d.floating_point_range[0].to_value == 10000.0
@@ -203,7 +210,7 @@ def ros_with():
 def _make(plant, role):
     from cablelab.ros.runner import node_module
 
-    return node_module(plant, role).make_node(None)
+    return node_module(plant, role).make_node()
 
 
 @pytest.mark.parametrize("plant, role, overrides, name, value", [
@@ -268,7 +275,7 @@ def test_node_help_lists_the_plant_parameters(capsys):
             plant_main("cable_sim_node", "sim", argv, "simulator")
         assert exc.value.code == 0
         out = capsys.readouterr().out
-        for spec in parameters_of(node_module("cdpr", "sim"), "sim"):
+        for spec in parameters_of(node_module("cdpr", "sim")):
             line = next(ln for ln in out.splitlines() if ln.startswith(f"  {spec.name} ("))
             assert spec.allowed() in line and spec.default_text() in line
         assert "rate (double, default 100.0; a number in [1, 10000] [Hz], read-only)" in out
@@ -279,7 +286,7 @@ def test_unparsable_ros_args_are_one_line(capsys):
     """rcl refuses a list mixing integers and numbers: one line with the fix, exit 2."""
     from cablelab.ros.runner import run_node
 
-    code = run_node(lambda a: None, None, ["--ros-args", "-p", "payload_com:=[0, 0.5, 1]"],
+    code = run_node(lambda: None, ["--ros-args", "-p", "payload_com:=[0, 0.5, 1]"],
                     "cable_sim_node --plant cdpr")
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 2 and len(err) == 1

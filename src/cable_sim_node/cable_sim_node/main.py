@@ -1,6 +1,6 @@
 """``cable_sim_node --plant PLANT``: the MuJoCo simulator node of a plant.
 
-The node is the plant's ``nodes/sim.py`` (``make_node(args)``; any plant of the registry); see
+The node is the plant's ``nodes/sim.py`` (``make_node()``; any plant of the registry); see
 :func:`cablelab.ros.runner.plant_main` and docs/nodes.md.
 """
 import sys

@@ -29,6 +29,7 @@ VERBS = {
     "batch": "batch",
     "layout": "layout",
     "excite": "excite",
+    "new-plant": "new_plant",
 }
 
 

@@ -1,6 +1,6 @@
 """``payload_estimator --plant PLANT``: estimator node of a plant.
 
-The node is the plant's ``nodes/estimator.py`` (``make_node(args)``; any plant of the registry); see
+The node is the plant's ``nodes/estimator.py`` (``make_node()``; any plant of the registry); see
 :func:`cablelab.ros.runner.plant_main` and docs/nodes.md.
 """
 import sys

@@ -1,7 +1,7 @@
 """``control_loop --plant PLANT``: a plant's hardware (its simulator, or a driver) and its
 PD + feedforward law in one process on absolute deadlines, the ros2_control way.
 
-The node is the plant's ``nodes/control_loop.py`` (``make_node(args)``); see
+The node is the plant's ``nodes/control_loop.py`` (``make_node()``); see
 :mod:`cablelab.ros.control_loop` and docs/nodes.md.
 """
 import sys

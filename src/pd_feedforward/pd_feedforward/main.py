@@ -1,6 +1,6 @@
 """``pd_feedforward --plant PLANT``: PD + feedforward controller node of a plant.
 
-The node is the plant's ``nodes/controller.py`` (``make_node(args)``; any plant of the registry); see
+The node is the plant's ``nodes/controller.py`` (``make_node()``; any plant of the registry); see
 :func:`cablelab.ros.runner.plant_main` and docs/nodes.md.
 """
 import sys

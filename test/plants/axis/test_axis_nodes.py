@@ -256,7 +256,7 @@ def test_run_node_applies_ros_parameters_and_yaml_files(tmp_path, domain_id, mon
     params.write_text("/**:\n  ros__parameters:\n    inertia: 3.5\n    rate: 100.0\n")
     seen = {}
 
-    def factory(_args):
+    def factory():
         from cablelab.plants.axis.nodes.sim import AxisSimNode
 
         node = AxisSimNode()
@@ -265,13 +265,13 @@ def test_run_node_applies_ros_parameters_and_yaml_files(tmp_path, domain_id, mon
         return node
 
     argv = ["--ros-args", "--params-file", str(params), "-p", "viscous:=7.0"]
-    assert run_node(factory, None, argv, "cable_sim_node") == 0
+    assert run_node(factory, argv, "cable_sim_node") == 0
     assert seen["truth"].inertia == 3.5 and seen["truth"].viscous == 7.0 and seen["rate"] == 100.0
 
-    def broken(_args):
+    def broken():
         raise CablelabError("description: bad thing")
 
-    assert run_node(broken, None, [], "cable_sim_node") == 2
+    assert run_node(broken, [], "cable_sim_node") == 2
 
 
 def test_clock_publisher_is_monotonic_and_throttled(ros_context):

@@ -61,3 +61,26 @@ def test_control_law_is_vectorised_and_pd_signs():
     q = np.zeros((n, 3))
     tau = control_law(q, q, q + 0.1, q, q, P, g, feedforward=False)
     np.testing.assert_allclose(tau, np.tile(0.1 * np.array(g.kp), (n, 1)))
+
+
+def test_controller_node_loads_neither_the_simulator_nor_mujoco():
+    """The live controller evaluates the multi-sine excitation from the ROS-free reference module:
+    importing its node module (fresh interpreter) loads neither ``crane/sim.py`` nor MuJoCo, and
+    the reference the simulator uses is that same function."""
+    import subprocess
+    import sys
+
+    code = ("import sys, cablelab.plants.crane.nodes.controller; "
+            "print(sorted(m for m in ('mujoco', 'cablelab.plants.crane.sim') if m in sys.modules))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.strip() == "[]"
+    from cablelab.plants.crane import reference, sim
+
+    assert sim.reference_trajectory is reference.reference_trajectory
+    t = np.linspace(0.0, 10.0, 2001)
+    q, qd, qdd = reference.reference_trajectory(t, seed=3)
+    assert np.allclose(q[0], (0.0, 0.5, 0.6))                      # starts at q0 (fade-in)
+    # the returned rates are the derivatives of the returned positions (central differences)
+    dt = t[1] - t[0]
+    assert np.allclose(np.gradient(q, dt, axis=0)[1:-1], qd[1:-1], atol=2e-3)
+    assert np.allclose(np.gradient(qd, dt, axis=0)[1:-1], qdd[1:-1], atol=2e-2)

@@ -136,3 +136,22 @@ def test_b5_e1_frozen_length_guard():
     st = sim.phase == STANCE
     assert grf(sim.z[st], sim.zd[st], sim.f_in[st], ni).min() > -0.5
     assert math.isfinite(sim.z[-1])
+
+
+def test_encoder_reading_and_motor_angle_of_the_node_and_the_offline_measurement():
+    """What the simulator node publishes per sample (:func:`quantise`, :func:`motor_angle`) is the
+    offline measurement model's (:func:`measure`, no encoder offset) and the linkage's geometry:
+    readings on the encoder grid within half a count, and z = 2 L cos(theta) back."""
+    from cablelab.plants.leg.sim import Trajectory, measure, motor_angle, quantise
+
+    rng = np.random.default_rng(2)
+    z, res, L = rng.uniform(0.05, 0.29, 200), 9e-5, 0.15
+    zq = np.array([float(quantise(x, res)) for x in z])
+    assert np.all(np.abs(zq - z) <= res / 2 + 1e-15)
+    assert np.allclose(zq / res, np.round(zq / res))
+    n = z.size
+    traj = Trajectory(np.arange(n) * 1e-3, z, np.zeros(n), np.zeros(n, int), np.zeros(n), np.zeros(n),
+                      np.zeros(n))
+    assert np.array_equal(measure(traj, resolution=res, seed=None).z_meas, zq)
+    assert np.allclose(2 * L * np.cos(motor_angle(zq, L)), zq)
+    assert quantise(0.1234567, 0.0) == 0.1234567

@@ -43,10 +43,10 @@ def test_closed_loop_over_dds(ros_context):
     from sensor_msgs.msg import JointState
     from std_msgs.msg import Float64MultiArray
 
-    from cablelab.plants.leg.nodes import make_node
+    from cablelab.plants.leg.nodes import controller, estimator, sim
     from cablelab.ros.qos import stream_qos
 
-    nodes = [make_node(r) for r in ("sim", "estimator", "controller")]
+    nodes = [m.make_node() for m in (sim, estimator, controller)]
     probe = Node("probe")
     est, cmd = [], []
     probe.create_subscription(JointState, "/leg/hop_estimate", est.append, stream_qos())
@@ -70,9 +70,9 @@ def test_closed_loop_over_dds(ros_context):
 
 
 def test_estimator_without_contact_says_so(ros_context):
-    from cablelab.plants.leg.nodes import make_node
+    from cablelab.plants.leg.nodes.estimator import make_node
 
-    node = make_node("estimator")
+    node = make_node()
     level, msg, values = node.status()
     assert "phase from height" in msg and values["phase source"].startswith("height")
     node.destroy_node()

@@ -22,7 +22,6 @@ def test_estimator_node_publishes_swing_and_survives_nan(ros_context):
     from sensor_msgs.msg import JointState
     from geometry_msgs.msg import PoseStamped
 
-    from cablelab.plants.suspended.nodes import make_node
     from cablelab.plants.suspended.params import parameter_set
     from cablelab.plants.suspended.swing import swing_from_pose
     from cablelab.ros import convert
@@ -72,7 +71,6 @@ def test_sim_node_to_estimator_node_chain(ros_context):
     from geometry_msgs.msg import PoseStamped
     from trajectory_msgs.msg import JointTrajectory
 
-    from cablelab.plants.suspended.nodes import make_node
     from cablelab.plants.suspended.params import parameter_set
     from cablelab.ros import convert
     from cablelab.ros.qos import catch_up_qos, publisher_qos
@@ -110,6 +108,13 @@ def test_sim_node_to_estimator_node_chain(ros_context):
         n.destroy_node()
 
 
+def make_node(role):
+    """The suspended plant's node of ``role`` (its module's ``make_node()``)."""
+    from cablelab.ros.runner import node_module
+
+    return node_module("suspended", role).make_node()
+
+
 def make_node_with(make_node, role, overrides):
     """A node with ROS parameter overrides (as --ros-args -p would give)."""
     import rclpy.node as rn
@@ -141,7 +146,6 @@ def test_controller_node_law_sway_offset_and_bad_input(ros_context):
     from std_msgs.msg import Float64MultiArray
 
     from cablelab.plants.suspended.controller import ArmGravity, gains, pd_gravity, sway_offset
-    from cablelab.plants.suspended.nodes import make_node
     from cablelab.plants.suspended.params import parameter_set
     from cablelab.ros import convert
     from cablelab.ros.qos import catch_up_qos, publisher_qos
@@ -200,7 +204,6 @@ def test_estimator_node_takes_yaw_rate_from_the_imu_and_reports_a_bad_one(ros_co
     from rclpy.executors import SingleThreadedExecutor
     from sensor_msgs.msg import Imu, JointState
 
-    from cablelab.plants.suspended.nodes import make_node
     from cablelab.ros import convert
     from cablelab.ros.qos import catch_up_qos, publisher_qos
 
@@ -228,7 +231,7 @@ def test_estimator_node_takes_yaw_rate_from_the_imu_and_reports_a_bad_one(ros_co
     pairs = np.array([(m.velocity[2], rate[st(m)]) for m in estim if st(m) in rate])
     assert len(pairs) > 30 and np.abs(pairs[:, 1]).max() > 0.5              # it yaws
     assert np.abs(pairs[:, 0] - pairs[:, 1]).max() < 0.01
-    bad.publish(convert.imu_msg(sim.data.time, [np.nan, 0, 0, 1.0], [0, 0, 0]))
+    bad.publish(convert.imu_msg(sim.sim.t, [np.nan, 0, 0, 1.0], [0, 0, 0]))
     for _ in range(30):
         ex.spin_once(timeout_sec=0.01)
     level, msg, values = est.status()

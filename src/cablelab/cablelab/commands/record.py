@@ -64,10 +64,10 @@ def run(args) -> int:
     check_target(args.output, overwrite=args.overwrite, option="-o")   # read-only / missing parent
     writer = BagWriter(args.output, overwrite=args.overwrite)  # refuses an existing path first
 
-    def factory(_args):
+    def factory():
         from ..ros.recorder import RecorderNode
 
         return RecorderNode(writer, topics, duration=args.duration,
                             flush_period=args.flush_period, quiet=args.quiet)
 
-    return run_node(factory, args, [], "cablelab record")
+    return run_node(factory, [], "cablelab record")

@@ -47,14 +47,14 @@ def run(args) -> int:
         tmp_dir = tempfile.mkdtemp(prefix="cablelab-replay-")
         source = repair_bag(args.bag, f"{tmp_dir}/bag")["bag"]
 
-    def factory(_args):
+    def factory():
         from ..ros.replayer import ReplayNode
 
         return ReplayNode(source, args.rate, start_delay=args.start_delay, topics=topics,
                           quiet=args.quiet)
 
     try:
-        return run_node(factory, args, [], "cablelab replay")
+        return run_node(factory, [], "cablelab replay")
     finally:
         if tmp_dir is not None:
             shutil.rmtree(tmp_dir, ignore_errors=True)

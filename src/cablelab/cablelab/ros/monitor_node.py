@@ -139,8 +139,8 @@ class ModelMonitorNode(PlantNode):
         return max(level, mlevel), text, values
 
 
-def make_node(args) -> PlantNode:
-    return ModelMonitorNode(args.plant)
+def make_node(plant: str) -> PlantNode:
+    return ModelMonitorNode(plant)
 
 
 def main(argv=None) -> int:
@@ -162,4 +162,4 @@ def main(argv=None) -> int:
                f"{help_text(PARAMETERS)}\n\nStops cleanly on SIGINT/SIGTERM.")
     parser.add_argument("--plant", choices=available_plants(), required=True, help="which plant")
     args = parser.parse_args(user)
-    return run_node(make_node, args, ros_args, "model_monitor")
+    return run_node(lambda: make_node(args.plant), ros_args, "model_monitor")

@@ -2,8 +2,8 @@
 
 ``plant_main(package, role, argv)`` is the whole ``main`` of every node package: it parses
 ``--plant`` (any plant of :mod:`cablelab.registry`), imports the plant's node module for the
-role (``<plant package>.nodes.<role>``, which exposes ``make_node(args) -> rclpy Node`` and
-optionally ``add_arguments(parser)``) and runs it with :func:`run_node`. ``--help`` never needs ROS. Standard ROS arguments (``--ros-args -p name:=value
+role (``<plant package>.nodes.<role>``, which exposes ``PARAMETERS`` and
+``make_node() -> rclpy Node``) and runs it with :func:`run_node`. ``--help`` never needs ROS. Standard ROS arguments (``--ros-args -p name:=value
 --params-file f.yaml -r from:=to``) pass through to rclpy.
 
 A node may define ``executor_factory()`` returning the executor to spin it with (e.g.
@@ -65,8 +65,8 @@ def _tight_timers() -> None:
         pass
 
 
-def run_node(node_factory, args, ros_args: list[str], prog: str) -> int:
-    """Init rclpy with ``ros_args``, build the node with ``node_factory(args)``, spin until
+def run_node(node_factory, ros_args: list[str], prog: str) -> int:
+    """Init rclpy with ``ros_args``, build the node with ``node_factory()``, spin until
     SIGINT/SIGTERM (or ``node.done`` becomes True), shut down cleanly. Returns the exit code."""
     import rclpy
     from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
@@ -92,7 +92,7 @@ def run_node(node_factory, args, ros_args: list[str], prog: str) -> int:
     code = 0
     try:
         try:
-            node = node_factory(args)
+            node = node_factory()
         except CablelabError as exc:
             print(f"{prog}: error: {exc}", file=sys.stderr)
             return 2
@@ -169,12 +169,10 @@ def mixed_lists(ros_args: list[str]) -> str:
     return ""
 
 
-def parameters_of(module, role: str) -> tuple:
-    """The parameter specs (:class:`~cablelab.ros.params.Param`) of a plant's node module for
-    ``role``: its ``PARAMETERS`` (a tuple, or a mapping role -> tuple for a one-module
-    ``nodes``)."""
-    specs = getattr(module, "PARAMETERS", ())
-    return tuple(specs.get(role, ())) if isinstance(specs, dict) else tuple(specs)
+def parameters_of(module) -> tuple:
+    """The parameter specs (:class:`~cablelab.ros.params.Param`) of a plant's node module: its
+    ``PARAMETERS``."""
+    return tuple(getattr(module, "PARAMETERS", ()))
 
 
 #: node role of each node package (its executable is ``main(role)`` over the plant registry)
@@ -182,38 +180,17 @@ ROLES = {"cable_sim_node": "sim", "payload_estimator": "estimator", "pd_feedforw
 
 
 def node_module(plant: str, role: str):
-    """What runs a plant's node for ``role`` (``sim``, ``estimator``, ``controller``): an object
-    with ``make_node(args)`` and optionally ``add_arguments(parser)``. A plant's ``nodes`` is
-    either a package with one module per role (``nodes/sim.py``, each with ``make_node(args)``)
-    or one module with ``make_node(role, args)`` (and optionally ``add_arguments(role, parser)``
-    and ``ROLES``, the roles it has). None when the plant has no node for that role."""
-    import types
-
+    """The module of a plant's node for ``role`` (``sim``, ``estimator``, ``controller``,
+    ``control_loop``): ``<plant package>.nodes.<role>``, with ``PARAMETERS`` and
+    ``make_node() -> rclpy Node``. None when the plant has no node for that role."""
     from ..registry import plant_module
 
-    def missing(exc: ModuleNotFoundError, *names: str) -> bool:
-        return bool(exc.name) and exc.name.endswith(names)
-
     try:
-        nodes = plant_module(plant, "nodes")
+        return plant_module(plant, f"nodes.{role}")
     except ModuleNotFoundError as exc:
-        if missing(exc, ".nodes"):
+        if exc.name and exc.name.endswith((".nodes", f".nodes.{role}")):
             return None
         raise
-    if hasattr(nodes, "__path__"):
-        try:
-            return plant_module(plant, f"nodes.{role}")
-        except ModuleNotFoundError as exc:
-            if missing(exc, f".nodes.{role}"):
-                return None
-            raise
-    if role not in getattr(nodes, "ROLES", (role,)) or not hasattr(nodes, "make_node"):
-        return None
-    adapter = types.SimpleNamespace(make_node=lambda args: nodes.make_node(role, args),
-                                    PARAMETERS=parameters_of(nodes, role))
-    if hasattr(nodes, "add_arguments"):
-        adapter.add_arguments = lambda parser: nodes.add_arguments(role, parser)
-    return adapter
 
 
 def role_main(package: str, role: str, description: str):
@@ -255,12 +232,10 @@ def plant_main(package: str, role: str, argv: list[str] | None, description: str
         if module is None and "-h" not in user and "--help" not in user:
             print(f"{package}: error: plant {known.plant!r} has no {role} node", file=sys.stderr)
             return 2
-        if module is not None and hasattr(module, "add_arguments"):
-            module.add_arguments(parser)
-        specs = parameters_of(module, role) if module is not None else ()
+        specs = parameters_of(module) if module is not None else ()
         if specs:
             parser.epilog = (f"ROS parameters of {package} --plant {known.plant} (--ros-args -p "
                              f"name:=value, or --params-file FILE.yaml):\n{help_text(specs)}\n\n"
                              "Stops cleanly on SIGINT/SIGTERM.")
     args = parser.parse_args(user)
-    return run_node(module.make_node, args, ros_args, f"{package} --plant {args.plant}")
+    return run_node(module.make_node, ros_args, f"{package} --plant {args.plant}")

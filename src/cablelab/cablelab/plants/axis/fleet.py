@@ -20,6 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
+from . import topics
+
 #: first day of the synthetic campaign (UTC)
 EPOCH = _dt.datetime(2026, 1, 1, 8, 0, 0, tzinfo=_dt.timezone.utc)
 DAY_S = 86400.0
@@ -163,7 +165,7 @@ def write_fleet(root, machines: int = 6, days: int = 10, drifts=None, *, duratio
         path.parent.mkdir(parents=True, exist_ok=True)
         with BagWriter(path, overwrite=True) as w:
             w.write_description(description_yaml(m), t=t0)
-            w.write_joint_states("/axis/joint_states", t0 + t, ["joint"], position=q[:, None],
+            w.write_joint_states(topics.JOINT_STATES, t0 + t, ["joint"], position=q[:, None],
                                  effort=eff[:, None])
     return drifts
 

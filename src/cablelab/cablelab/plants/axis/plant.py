@@ -17,10 +17,9 @@ from ...errors import CablelabError
 from ...fit.simulation import fit_free_run_windows, free_run_windows, window_length, window_starts
 from ...model import Dataset
 from ...registry import Plant, register_plant
+from . import topics
 from .description import parse_section
-
-TOPIC = "/axis/joint_states"
-JOINT_STATE = "sensor_msgs/msg/JointState"
+from .topics import JOINT_STATE, JOINT_STATES as TOPIC
 
 
 def dataset_from_arrays(t, q, effort, description, options: dict | None = None, *, qd=None,
@@ -231,20 +230,12 @@ AXIS = register_plant(Plant(
     simulate=free_run_compare,
     simulation_fit=fit_free_run,
     section=parse_section,
-    contract_topics={
-        TOPIC: JOINT_STATE,
-        "/axis/reference": "trajectory_msgs/msg/JointTrajectory",
-        # additions (docs/nodes.md): command input, live parameter estimate, simulation truth
-        "/axis/effort_command": "std_msgs/msg/Float64MultiArray",
-        "/axis/parameter_estimate": "std_msgs/msg/Float64MultiArray",
-        "/axis/ground_truth/joint_states": JOINT_STATE,
-        "/axis/markers": "visualization_msgs/msg/MarkerArray",
-    },
+    contract_topics=topics.TYPES,
     joint_topic=TOPIC,
     joints=("joint",),
     capabilities=frozenset({"joint_actuators"}),
     channels=("joint",),
-    topic_names=lambda desc: {TOPIC: ["joint"], "/axis/ground_truth/joint_states": ["joint"]},
+    topic_names=lambda desc: {TOPIC: ["joint"], topics.GROUND_TRUTH: ["joint"]},
     markers=lambda bag, desc: _bag_markers(bag, desc),
 ))
 

@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from ...demo import DemoPart, PartResult, log
+from . import topics
 
 PAYLOAD = 249.0
 TRUE_MASS = 366.0 + PAYLOAD
@@ -45,12 +46,12 @@ def run_nodes(out: Path, name: str, feedforward: bool, duration: float, domain: 
                     {"feedforward": feedforward, "estimate_wait": 5.0 if feedforward else 0.0})
         # every reader discovered before time starts (the estimator reads /cdpr/cable_tensions,
         # not /cdpr/joint_states: waiting there for 3 subscribers cost 60 s of timeout per run)
-        launch.wait_for_subscribers(["/cdpr/joint_states", "/cdpr/cable_tensions", "/cdpr/reference",
-                                     "/cdpr/payload_estimate", "/cdpr/effort_commands"],
+        launch.wait_for_subscribers([topics.JOINT_STATES, topics.CABLE_TENSIONS, topics.REFERENCE,
+                                     topics.PAYLOAD_ESTIMATE, topics.EFFORT_COMMANDS],
                                     timeout=90, node_name="cablelab_recorder")
-        launch.wait_for_subscribers(["/cdpr/cable_tensions", "/cdpr/reference"], timeout=90,
+        launch.wait_for_subscribers([topics.CABLE_TENSIONS, topics.REFERENCE], timeout=90,
                                     node_name="payload_estimator")
-        launch.wait_for_subscribers(["/cdpr/joint_states", "/cdpr/reference"], timeout=90,
+        launch.wait_for_subscribers([topics.JOINT_STATES, topics.REFERENCE], timeout=90,
                                     node_name="pd_feedforward")
         launch.node("sim", "cable_sim_node", "cdpr", {"real_time": False, "payload_mass": PAYLOAD,
                                                       "duration": duration, "settle": 1.0,
@@ -78,8 +79,8 @@ def z_error(bag: Path) -> tuple[np.ndarray, np.ndarray]:
     from ...bags import open_bag
 
     b = open_bag(bag)
-    gt = b.pose("/cdpr/ground_truth/pose")
-    ref = b.multidof_trajectory("/cdpr/reference")
+    gt = b.pose(topics.GROUND_TRUTH_POSE)
+    ref = b.multidof_trajectory(topics.REFERENCE)
     zr = np.interp(gt.t, ref.t, ref.position[:, 2])
     sel = gt.t > 1.0
     return gt.t[sel] - 1.0, gt.position[sel, 2] - zr[sel]

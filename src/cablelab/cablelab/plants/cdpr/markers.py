@@ -7,6 +7,7 @@ import numpy as np
 
 from ...markers import CUBE, LINE_LIST, SPHERE_LIST, Marker, decimate_times, line, tension_colour
 from ...rotations import matrix_to_quat, quat_to_matrix, wxyz_to_xyzw, xyzw_to_wxyz
+from . import topics
 
 
 def tension_top(desc) -> float:
@@ -47,13 +48,13 @@ def bag_markers(bag, desc):
     ground truth, else the reference), the dynamometer tensions when recorded; None without a
     pose."""
     pose = None
-    for topic in ("/cdpr/platform_pose", "/cdpr/ground_truth/pose"):
+    for topic in (topics.PLATFORM_POSE, topics.GROUND_TRUTH_POSE):
         if bag.has(topic) and bag.counts.get(topic):
             s = bag.pose(topic)
             pose = (s.t, s.position, s.quaternion)
             break
-    if pose is None and bag.has("/cdpr/reference") and bag.counts.get("/cdpr/reference"):
-        s = bag.multidof_trajectory("/cdpr/reference")
+    if pose is None and bag.has(topics.REFERENCE) and bag.counts.get(topics.REFERENCE):
+        s = bag.multidof_trajectory(topics.REFERENCE)
         pose = (s.t, s.position, s.quaternion)
     if pose is None or desc is None or desc.cdpr is None:
         return None
@@ -61,8 +62,8 @@ def bag_markers(bag, desc):
     keep = decimate_times(t)
     t, p, R = t[keep], p[keep], quat_to_matrix(xyzw_to_wxyz(q[keep]))
     ten = None
-    if bag.has("/cdpr/cable_tensions") and bag.counts.get("/cdpr/cable_tensions"):
-        s = bag.joint_state("/cdpr/cable_tensions", [f"cable_{i}" for i in range(1, len(desc.cdpr.cables) + 1)])
+    if bag.has(topics.CABLE_TENSIONS) and bag.counts.get(topics.CABLE_TENSIONS):
+        s = bag.joint_state(topics.CABLE_TENSIONS, [f"cable_{i}" for i in range(1, len(desc.cdpr.cables) + 1)])
         ten = np.stack([np.interp(t, s.t, s.effort[:, i]) for i in range(s.effort.shape[1])], axis=1)
     frames = [cdpr_markers(desc, p[k], R[k], None if ten is None else ten[k]) for k in range(len(t))]
     return t, frames

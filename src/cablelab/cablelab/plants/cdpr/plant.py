@@ -21,17 +21,14 @@ from ...errors import CablelabError
 from ...model import Dataset
 from ...rotations import quat_to_matrix, xyzw_to_wxyz
 from ...registry import Plant, register_plant
+from . import topics
 from .description import dump_section, parse_section
 from .estimation import mass_com, mass_com_batch
 from .geometry import cable_geometry, check_pulley_radius, wrench_matrix
+from .topics import (CABLE_TENSIONS as TENSIONS, GROUND_TRUTH_PAYLOAD as TRUTH, JOINT_STATE,
+                     JOINT_STATES as JOINTS, PAYLOAD_ESTIMATE as ESTIMATE, PLATFORM_POSE as POSE,
+                     REFERENCE)
 
-JOINT_STATE = "sensor_msgs/msg/JointState"
-TENSIONS = "/cdpr/cable_tensions"
-JOINTS = "/cdpr/joint_states"
-REFERENCE = "/cdpr/reference"
-POSE = "/cdpr/platform_pose"
-TRUTH = "/cdpr/ground_truth/payload"
-ESTIMATE = "/cdpr/payload_estimate"
 CHANNELS = ("Fx", "Fy", "Fz", "Mx", "My", "Mz")
 UNITS = ("N", "N", "N", "N m", "N m", "N m")
 
@@ -532,22 +529,12 @@ CDPR = register_plant(Plant(
                  "the platform origin, world axes",
     section=parse_section,
     dump_section=dump_section,
-    contract_topics={
-        JOINTS: JOINT_STATE,
-        "/cdpr/cable_tensions": JOINT_STATE,
-        "/cdpr/platform_pose": "geometry_msgs/msg/PoseStamped",
-        "/cdpr/reference": "trajectory_msgs/msg/MultiDOFJointTrajectory",
-        "/cdpr/effort_commands": "std_msgs/msg/Float64MultiArray",
-        "/cdpr/payload_estimate": "geometry_msgs/msg/InertiaStamped",
-        "/cdpr/ground_truth/pose": "geometry_msgs/msg/PoseStamped",
-        "/cdpr/ground_truth/payload": "geometry_msgs/msg/InertiaStamped",
-        "/cdpr/markers": "visualization_msgs/msg/MarkerArray",
-    },
+    contract_topics=topics.TYPES,
     joint_topic=JOINTS,
     joints=tuple(f"winch_{i}" for i in range(1, 9)),
     capabilities=frozenset({"winch_actuators"}),
     estimate=estimate_bag,
-    checked_topics=(TENSIONS, "/cdpr/reference", POSE),
+    checked_topics=(TENSIONS, REFERENCE, POSE),
     check_bag=check_bag,
     channels=CHANNELS,
     topic_names=lambda desc: _topic_names(desc),

@@ -30,11 +30,12 @@ import numpy as np
 from ...description import Description
 from ...errors import CablelabError
 from ...rotations import wxyz_to_xyzw
+from . import topics
 from .geometry import cable_geometry, swivel_reference
 
 __all__ = ["CdprTruth", "CdprSim", "CdprRun", "build_model_xml", "simulate", "write_run_bag", "PAYLOADS",
            "default_description", "default_description_path", "scaled_reference",
-           "without_pulley_radius"]
+           "without_pulley_radius", "truth_from_parameters"]
 
 #: 001 sec. II-C: the empty platform and the two payloads M1, M2 (kg)
 PAYLOADS = {"MP": 0.0, "MP+M1": 122.0, "MP+M2": 249.0}
@@ -477,20 +478,40 @@ def write_run_bag(run: CdprRun, path, *, overwrite: bool = True, pose: bool = Tr
     with BagWriter(path, overwrite=overwrite) as w:
         w.write_description(run.desc.yaml_text or dump_description(run.desc), float(t[0]))
         w.write_clock(t)
-        w.write_joint_states("/cdpr/joint_states", t, [f"winch_{i}" for i in range(1, n + 1)],
+        w.write_joint_states(topics.JOINT_STATES, t, [f"winch_{i}" for i in range(1, n + 1)],
                              A["motor_angle"], A["motor_velocity"], A["motor_torque"])
-        w.write_joint_states("/cdpr/cable_tensions", t, [f"cable_{i}" for i in range(1, n + 1)],
+        w.write_joint_states(topics.CABLE_TENSIONS, t, [f"cable_{i}" for i in range(1, n + 1)],
                              A["cable_length"], None, A["tension"])
-        w.write_multidof_trajectory("/cdpr/reference", t, A["ref_position"], wxyz_to_xyzw(A["ref_quat"]),
+        w.write_multidof_trajectory(topics.REFERENCE, t, A["ref_position"], wxyz_to_xyzw(A["ref_quat"]),
                                     A["ref_velocity"], None, A["ref_acceleration"], None)
         if pose:
-            w.write_poses("/cdpr/platform_pose", t, A["position"], wxyz_to_xyzw(A["quat"]))
+            w.write_poses(topics.PLATFORM_POSE, t, A["position"], wxyz_to_xyzw(A["quat"]))
         if commands:
-            w.write_float_arrays("/cdpr/effort_commands", t, A["command"])
+            w.write_float_arrays(topics.EFFORT_COMMANDS, t, A["command"])
         if ground_truth:
-            w.write_poses("/cdpr/ground_truth/pose", t, A["true_position"], wxyz_to_xyzw(A["true_quat"]))
+            w.write_poses(topics.GROUND_TRUTH_POSE, t, A["true_position"], wxyz_to_xyzw(A["true_quat"]))
             com = np.broadcast_to(A["true_com"], (len(t), 3))
-            w.write_inertia("/cdpr/ground_truth/payload", t, np.full(len(t), A["true_mass"]), com)
+            w.write_inertia(topics.GROUND_TRUTH_PAYLOAD, t, np.full(len(t), A["true_mass"]), com)
+
+
+def truth_from_parameters(node: str, v, n: int, rate: float) -> CdprTruth:
+    """The simulated CDPR's truth from the validated simulator node parameters ``v`` (the specs
+    of :data:`cablelab.plants.cdpr.nodes.sim.PARAMETERS`) for ``n`` cables at ``rate`` Hz;
+    one-line errors naming ``node`` for what the specs alone cannot check (the bias length
+    against the cable count, the smallest step)."""
+    bias = v.tension_bias
+    if len(bias) not in (1, n):
+        raise CablelabError(f"{node}: parameter tension_bias:={bias}: expected 1 or {n} numbers "
+                            "(one per cable) [N]")
+    if 0 < v.timestep < 1e-5:
+        raise CablelabError(f"{node}: parameter timestep:={v.timestep!r}: expected 0 (auto) or a step "
+                            "of at least 1e-05 [s]")
+    return CdprTruth(
+        pulleys=v.pulleys, payload_mass=v.payload_mass, payload_com=tuple(v.payload_com),
+        winch_coulomb=v.winch_coulomb, winch_viscous=v.winch_viscous,
+        motor_inertia=v.motor_inertia, tension_noise=v.tension_noise,
+        tension_bias=tuple(bias) if any(bias) else None, torque_noise=v.torque_noise,
+        pose_noise=v.pose_noise, timestep=v.timestep or min(0.002, 1.0 / rate), seed=v.seed)
 
 
 def main(argv=None) -> int:

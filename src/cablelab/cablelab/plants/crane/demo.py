@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from ...demo import DemoPart, PartResult, log
+from . import topics
 
 PAPER_REST_TORQUE = -0.2   # N m on the slew joint at rest at beta = 0.5 rad (002 sec. 6.5)
 REST_LUFF = 0.5            # rad, the luff angle of that measurement (and of the sim's start)
@@ -56,11 +57,11 @@ def run_nodes(out: Path, duration: float, domain: int, tilt: float) -> Path:
                                   "-o", bag, "--overwrite", "--quiet"])
         launch.node("estimator", "payload_estimator", "crane", {})
         launch.node("controller", "pd_feedforward", "crane", {"reference_source": "excitation"})
-        launch.wait_for_subscribers(["/crane/joint_states", "/crane/swing_estimate",
-                                     "/crane/effort_commands", "/crane/ground_truth/swing"],
+        launch.wait_for_subscribers([topics.JOINT_STATES, topics.SWING_ESTIMATE,
+                                     topics.EFFORT_COMMANDS, topics.SWING_TRUTH],
                                     timeout=90, node_name="cablelab_recorder")
-        launch.wait_for_subscribers(["/crane/joint_states"], timeout=90, node_name="pd_feedforward")
-        launch.wait_for_subscribers(["/crane/boom_tip_pose"], timeout=90)
+        launch.wait_for_subscribers([topics.JOINT_STATES], timeout=90, node_name="pd_feedforward")
+        launch.wait_for_subscribers([topics.TIP_POSE], timeout=90)
         launch.node("sim", "cable_sim_node", "crane", {
             "rate": rate, "base_tilt": f"[{tilt!r}, 0.0]", "mocap_noise": 0.001,
             "mocap_dropout": 0.01, "wait_for_subscribers": 3})   # recorder, estimator, controller
@@ -89,8 +90,8 @@ def run_nodes(out: Path, duration: float, domain: int, tilt: float) -> Path:
 def swing_errors(bag) -> dict:
     """Live ``/crane/swing_estimate`` vs ``/crane/ground_truth/swing`` at equal stamps:
     ``{"t", "est", "true", "rms"}`` (rad, rad, m)."""
-    tru = bag.joint_state("/crane/ground_truth/swing", list(SWING_NAMES))
-    est = bag.joint_state("/crane/swing_estimate", list(SWING_NAMES))
+    tru = bag.joint_state(topics.SWING_TRUTH, list(SWING_NAMES))
+    est = bag.joint_state(topics.SWING_ESTIMATE, list(SWING_NAMES))
     idx = np.clip(np.searchsorted(tru.t, est.t), 0, tru.t.size - 1)
     ok = np.abs(tru.t[idx] - est.t) < 1e-6
     e, tr = est.position[ok], tru.position[idx[ok]]

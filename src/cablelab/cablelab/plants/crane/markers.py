@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...markers import SPHERE, Marker, decimate_times, line
+from . import topics
 from .kinematics import boom_tip
 
 
@@ -29,7 +30,7 @@ def crane_markers(desc, tip, payload, alpha: float) -> list[Marker]:
 def bag_markers(bag, desc):
     """``(t, frames)`` at about 30 Hz: the recorded boom-tip and payload poses (motion capture)
     and the slew angle; None when the bag lacks them."""
-    need = ("/crane/boom_tip_pose", "/crane/payload_pose", "/crane/joint_states")
+    need = (topics.TIP_POSE, topics.PAYLOAD_POSE, topics.JOINT_STATES)
     if desc is None or desc.crane is None or not all(bag.has(t) and bag.counts.get(t) for t in need):
         return None
     tip = bag.pose(need[0])

@@ -30,22 +30,16 @@ from ...conditioning import Conditioning, condition_motion
 from ...errors import CablelabError
 from ...model import STANDARD_GRAVITY, Dataset
 from ...registry import Plant, register_plant
+from . import topics
 from .description import parse_section
 from .dynamics_generated import regressor
 from .freerun import fit_free_run, free_run_compare
 from .kinematics import SwingAngles
 from .model import JOINTS, CraneParams
 from .swing import SwingReport, estimate_swing
+from .topics import (JOINT_STATE, JOINT_STATES, PAYLOAD_POSE, POSE, REFERENCE, SWING_ESTIMATE,
+                     SWING_TRUTH, TIP_POSE)
 
-JOINT_STATES = "/crane/joint_states"
-TIP_POSE = "/crane/boom_tip_pose"
-PAYLOAD_POSE = "/crane/payload_pose"
-SWING_ESTIMATE = "/crane/swing_estimate"
-SWING_TRUTH = "/crane/ground_truth/swing"
-REFERENCE = "/crane/reference"
-EFFORT_COMMANDS = "/crane/effort_commands"
-JOINT_STATE = "sensor_msgs/msg/JointState"
-POSE = "geometry_msgs/msg/PoseStamped"
 SWING_NAMES = ("theta1", "theta2", "rope_length")
 #: default low-pass cut-off of the crane's positions, Hz (when --cutoff is not given). The payload
 #: swings at sqrt(g / d) / (2 pi) ~ 0.6-1 Hz and the excitation stays below ~0.5 Hz, while
@@ -325,16 +319,7 @@ CRANE = register_plant(Plant(
     simulate=free_run_compare,
     simulation_fit=fit_free_run,
     section=parse_section,
-    contract_topics={
-        JOINT_STATES: JOINT_STATE,
-        TIP_POSE: POSE,
-        PAYLOAD_POSE: POSE,
-        "/crane/reference": "trajectory_msgs/msg/JointTrajectory",
-        "/crane/effort_commands": "std_msgs/msg/Float64MultiArray",
-        "/crane/swing_estimate": JOINT_STATE,
-        "/crane/ground_truth/swing": JOINT_STATE,
-        "/crane/markers": "visualization_msgs/msg/MarkerArray",
-    },
+    contract_topics=topics.TYPES,
     joint_topic=JOINT_STATES,
     joints=JOINTS,
     capabilities=frozenset({"joint_actuators"}),
@@ -343,7 +328,7 @@ CRANE = register_plant(Plant(
     channels=JOINTS,
     markers=lambda bag, desc: _bag_markers(bag, desc),
     topic_names=lambda desc: {JOINT_STATES: list(JOINTS), **{t: ["theta1", "theta2", "rope_length"] for t in
-                                                          ("/crane/swing_estimate", "/crane/ground_truth/swing")}},
+                                                          (SWING_ESTIMATE, SWING_TRUTH)}},
 ))
 
 

@@ -23,8 +23,10 @@ from dataclasses import dataclass, field
 import mujoco
 import numpy as np
 
+from . import topics
 from .kinematics import gimbal_rates_to_swing, gimbal_to_swing, swing_to_gimbal
 from .model import CraneParams, gravity_vector, mass_matrix
+from .reference import reference_trajectory
 from ...rotations import wxyz_to_xyzw
 
 __all__ = ["CraneTruth", "build_model", "set_state", "gravity_in_base", "simulate", "SimResult",
@@ -170,36 +172,6 @@ def set_state(model: mujoco.MjModel, data: mujoco.MjData, q5, qd5=None) -> None:
         data.qvel[[0, 1, 4]] = qd5[:3]
         data.qvel[2] = -qd5[1]  # keep the rope direction fixed in the slewing frame while luffing
     mujoco.mj_forward(model, data)
-
-
-def reference_trajectory(t, q0=(0.0, 0.5, 0.6), amplitude=(0.6, 0.25, 0.15), base_freq=0.08,
-                         seed: int = 0):
-    """Smooth multi-sine joint references for excitation (002 sec. 6.2 used sinusoidal commands).
-
-    Returns ``(q_ref, qd_ref, qdd_ref)``, each (N, 3) [slew rad, luff rad, hoist m]; each joint is a
-    sum of 3 sines with incommensurate frequencies starting at q0 with a smooth 2 s fade-in.
-    """
-    t = np.asarray(t, dtype=float)
-    rng = np.random.default_rng(seed)
-    qr, qdr, qddr = [], [], []
-    ramp_t = 2.0
-    s = np.clip(t / ramp_t, 0, 1)
-    w = s ** 3 * (10 - 15 * s + 6 * s * s)                       # smoothstep fade-in
-    wd = np.where(t < ramp_t, 30 * s * s * (1 - s) ** 2 / ramp_t, 0.0)
-    wdd = np.where(t < ramp_t, 60 * s * (1 - s) * (1 - 2 * s) / ramp_t ** 2, 0.0)
-    for j in range(3):
-        f = base_freq * np.array([1.0, 1.618, 2.414]) * (1 + 0.3 * j) * rng.uniform(0.9, 1.1, 3)
-        ph = rng.uniform(0, 2 * np.pi, 3)
-        a = amplitude[j] / np.array([1.0, 1.8, 3.0])
-        om = 2 * np.pi * f
-        arg = om[None, :] * t[:, None] + ph[None, :]
-        x = (a * (np.sin(arg) - np.sin(ph))).sum(1)
-        xd = (a * om * np.cos(arg)).sum(1)
-        xdd = (-a * om ** 2 * np.sin(arg)).sum(1)
-        qr.append(q0[j] + w * x)
-        qdr.append(wd * x + w * xd)
-        qddr.append(wdd * x + 2 * wd * xd + w * xdd)
-    return np.stack(qr, 1), np.stack(qdr, 1), np.stack(qddr, 1)
 
 
 @dataclass
@@ -401,12 +373,12 @@ def write_bag(path, res: SimResult, description_yaml: str, *, overwrite: bool = 
     with BagWriter(path, overwrite=overwrite) as w:
         w.write_description(description_yaml)
         w.write_clock(res.t)
-        w.write_joint_states("/crane/joint_states", res.t, ("slew", "luff", "hoist"),
+        w.write_joint_states(topics.JOINT_STATES, res.t, ("slew", "luff", "hoist"),
                              position=res.q[:, :3], velocity=res.qd[:, :3], effort=res.effort)
-        w.write_poses("/crane/boom_tip_pose", res.t, res.tip, wxyz_to_xyzw(res.tip_quat))
-        w.write_poses("/crane/payload_pose", res.t, res.payload, wxyz_to_xyzw(res.payload_quat))
-        w.write_joint_states("/crane/ground_truth/swing", res.t, ("theta1", "theta2", "rope_length"),
+        w.write_poses(topics.TIP_POSE, res.t, res.tip, wxyz_to_xyzw(res.tip_quat))
+        w.write_poses(topics.PAYLOAD_POSE, res.t, res.payload, wxyz_to_xyzw(res.payload_quat))
+        w.write_joint_states(topics.SWING_TRUTH, res.t, ("theta1", "theta2", "rope_length"),
                              position=res.q[:, [3, 4, 2]], velocity=res.qd[:, [3, 4, 2]])
-        w.write_joint_trajectory("/crane/reference", res.t, ("slew", "luff", "hoist"), res.q_ref,
+        w.write_joint_trajectory(topics.REFERENCE, res.t, ("slew", "luff", "hoist"), res.q_ref,
                                  res.qd_ref, res.qdd_ref)
-        w.write_float_arrays("/crane/effort_commands", res.t, res.motor)
+        w.write_float_arrays(topics.EFFORT_COMMANDS, res.t, res.motor)

@@ -9,10 +9,10 @@ from __future__ import annotations
 
 from ...registry import Plant, register_plant
 from . import effects as _effects  # noqa: F401  (registers the leg effects)
+from . import topics
 from .dataset import check_bag, dataset
 from .description import parse_section
-
-JOINT_STATE = "sensor_msgs/msg/JointState"
+from .topics import JOINT_STATE
 
 
 def _baseline(description) -> tuple[str, ...]:
@@ -25,29 +25,21 @@ def _candidates(description) -> tuple[str, ...]:
 
 LEG = register_plant(Plant(
     name="leg",
-    topics=(("/leg/joint_states", JOINT_STATE),),
+    topics=((topics.JOINT_STATES, JOINT_STATE),),
     dataset=dataset,
     baseline=_baseline,
     candidates=_candidates,
     channels_doc="body: s (F_in + k (z_0 - z)), the known vertical force on the body (N)",
     section=parse_section,
-    contract_topics={                          # CONTRACT sec. 2, spec 003_leg.md sec. 5
-        "/leg/joint_states": JOINT_STATE,
-        "/leg/contact": JOINT_STATE,
-        "/leg/reference": "trajectory_msgs/msg/JointTrajectory",
-        "/leg/effort_commands": "std_msgs/msg/Float64MultiArray",
-        "/leg/hop_estimate": JOINT_STATE,
-        "/leg/ground_truth/state": JOINT_STATE,
-        "/leg/markers": "visualization_msgs/msg/MarkerArray",
-    },
-    joint_topic="/leg/joint_states",
+    contract_topics=topics.TYPES,                  # CONTRACT sec. 2, spec 003_leg.md sec. 5
+    joint_topic=topics.JOINT_STATES,
     joints=("body", "motor"),
-    checked_topics=("/leg/contact",),
+    checked_topics=(topics.CONTACT,),
     check_bag=check_bag,
     channels=("body",),
-    topic_names=lambda desc: {"/leg/joint_states": ["body", "motor"], "/leg/contact": ["contact"],
+    topic_names=lambda desc: {topics.JOINT_STATES: ["body", "motor"], topics.CONTACT: ["contact"],
                               **{t: ["height", "phase", "apex_height", "grf"] for t in
-                                 ("/leg/hop_estimate", "/leg/ground_truth/state")}},
+                                 (topics.HOP_ESTIMATE, topics.GROUND_TRUTH)}},
     markers=lambda bag, desc: _bag_markers(bag, desc),
 ))
 

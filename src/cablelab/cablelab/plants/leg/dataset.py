@@ -26,6 +26,7 @@ import numpy as np
 from ...conditioning import derivatives, lowpass
 from ...errors import CablelabError
 from ...model import Dataset
+from . import topics
 from .description import leg_of
 from .identify import start_state
 from .strides import phase_runs
@@ -253,7 +254,7 @@ def advance_contact(ds: Dataset, advance_s: float) -> Dataset:
 def check_bag(bag, description, options, series) -> list[str]:
     """Input checks before a fit (:func:`cablelab.bagcheck.check_bag`): say when the phase has
     to come from the height because the bag has no contact switch."""
-    if bag.has("/leg/contact"):
+    if bag.has(topics.CONTACT):
         return []
     return [f"{bag.path}: no /leg/contact in the bag; phase detected from the height "
             "(z < z_td - 0.5 mm, 20 ms dwell)"]
@@ -265,15 +266,15 @@ def dataset(bag, description, options: dict | None = None) -> Dataset:
     rule) and :func:`check_bag` says so."""
     from .estimator import estimate_series
 
-    js = bag.joint_state("/leg/joint_states")
+    js = bag.joint_state(topics.JOINT_STATES)
     if "body" not in js.names:
         raise CablelabError(f"{bag.path}: /leg/joint_states has no joint 'body' (has {js.names})")
     z = js.position[:, js.names.index("body")]
     tau = js.effort[:, js.names.index("motor")] if "motor" in js.names else np.zeros_like(z)
     tau = np.nan_to_num(tau)
     contact = None
-    if bag.has("/leg/contact"):
-        c = bag.joint_state("/leg/contact")
+    if bag.has(topics.CONTACT):
+        c = bag.joint_state(topics.CONTACT)
         contact = np.interp(js.t, c.t, c.position[:, 0]) > 0.5
     if contact is None:       # (said as a warning of the input checks: check_bag below)
         leg = leg_of(description)

@@ -65,3 +65,13 @@ def leg_of(description) -> LegDescription:
     if leg is None:
         raise CablelabError("leg: missing required key (the section of the plant named by 'plant')")
     return leg
+
+
+def load_leg_description(text: str = ""):
+    """The loaded description of ``text`` (YAML file or text), or the package's data/leg.yaml when
+    empty (the nodes' default)."""
+    from pathlib import Path
+
+    from ...description import load_description
+
+    return load_description(text or Path(__file__).parent / "data" / "leg.yaml")

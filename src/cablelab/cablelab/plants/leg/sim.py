@@ -26,11 +26,13 @@ from typing import Callable
 import mujoco
 import numpy as np
 
+from . import topics
 from .hybrid import (FLIGHT, LIFTOFF, STANCE, TOUCHDOWN, LegParams, flight_accel, grf, input_force,
                      stance_accel,
                      liftoff_guard, liftoff_map, spring_force, touchdown_map)
 
-__all__ = ["LegSim", "Trajectory", "Event", "build_model", "simulate", "open_loop", "measure"]
+__all__ = ["LegSim", "Trajectory", "Event", "build_model", "simulate", "open_loop", "measure",
+           "quantise", "motor_angle"]
 
 DT = 1e-3  #: control / sample period of 003 sec. 3.1, s
 
@@ -270,13 +272,27 @@ def simulate(params: LegParams, z0: float, zd0: float, duration: float, torque: 
     return traj
 
 
+def quantise(z, resolution: float, offset: float = 0.0):
+    """Encoder reading of height ``z`` (m): rounded to ``resolution`` (0: exact) about a zero
+    offset ``offset``; scalar or array."""
+    if resolution <= 0:
+        return z
+    return np.round((np.asarray(z) + offset) / resolution) * resolution - offset
+
+
+def motor_angle(z, L: float):
+    """Motor angle theta (rad) at body height ``z`` (m) of the symmetric two-link leg of link
+    length ``L`` (z = 2 L cos theta); scalar or array."""
+    return np.arccos(np.clip(np.asarray(z) / (2.0 * L), -1.0, 1.0))
+
+
 def measure(traj: Trajectory, *, resolution: float = 9e-5, contact_delay: float = 0.0,
             seed: int | None = 0) -> Trajectory:
     """Hardware measurement model (003 sec. 3.1): z quantised to the encoder resolution (with a
     random encoder zero offset when ``seed`` is given), zdot = backward difference of the quantised
     z, contact switch = stance flag delayed by ``contact_delay`` s."""
     off = 0.0 if seed is None else float(np.random.default_rng(seed).uniform(0, resolution))
-    zq = np.round((traj.z + off) / resolution) * resolution - off if resolution > 0 else traj.z.copy()
+    zq = quantise(traj.z, resolution, off) if resolution > 0 else traj.z.copy()
     zdq = np.empty_like(zq)
     zdq[1:] = np.diff(zq) / np.diff(traj.t)
     zdq[0] = zdq[1] if len(zq) > 1 else 0.0
@@ -299,14 +315,14 @@ def write_bag(path, traj: Trajectory, description_yaml: str, *, contact: bool = 
         w.write_description(description_yaml)
         w.write_clock(traj.t)
         n = len(traj.t)
-        theta = np.arccos(np.clip(traj.z_meas / (2 * 0.15), -1, 1))
-        w.write_joint_states("/leg/joint_states", traj.t, ("body", "motor"),
+        theta = motor_angle(traj.z_meas, 0.15)
+        w.write_joint_states(topics.JOINT_STATES, traj.t, ("body", "motor"),
                              position=np.c_[traj.z_meas, theta], velocity=np.c_[traj.zd_meas, np.zeros(n)],
                              effort=np.c_[traj.f_in, traj.tau])
         if contact:
-            w.write_joint_states("/leg/contact", traj.t, ("contact",), position=traj.contact[:, None])
-        w.write_float_arrays("/leg/effort_commands", traj.t, traj.tau[:, None])
-        w.write_joint_states("/leg/ground_truth/state", traj.t, ("height", "phase", "grf"),
+            w.write_joint_states(topics.CONTACT, traj.t, ("contact",), position=traj.contact[:, None])
+        w.write_float_arrays(topics.EFFORT_COMMANDS, traj.t, traj.tau[:, None])
+        w.write_joint_states(topics.GROUND_TRUTH, traj.t, ("height", "phase", "grf"),
                              position=np.c_[traj.z, traj.phase, np.zeros(n)],
                              velocity=np.c_[traj.zd, np.zeros(n), np.zeros(n)],
                              effort=np.c_[np.zeros(n), np.zeros(n), traj.grf])

@@ -15,10 +15,9 @@ from __future__ import annotations
 
 from ...registry import Plant, register_plant
 from . import effects as _effects  # noqa: F401  (registers the effect ids)
-from .dataset import CHANNELS as _CHANNELS, POSE, POSE_TOPIC, SUSPENSION_TOPIC, dataset
+from . import topics
+from .dataset import CHANNELS as _CHANNELS, dataset
 from .description import parse_section
-
-JOINT_STATE = "sensor_msgs/msg/JointState"
 
 __all__ = ["SUSPENDED"]
 
@@ -42,27 +41,16 @@ def candidates(description) -> tuple[str, ...]:
 
 SUSPENDED = register_plant(Plant(
     name="suspended",
-    topics=((POSE_TOPIC, POSE),),
+    topics=((topics.PLATFORM_POSE, topics.POSE),),
     dataset=dataset,
     baseline=baseline,
     candidates=candidates,
     channels_doc="swing_x, swing_y, yaw: modal inertia x angular acceleration (N m)",
     section=parse_section,
-    contract_topics={                          # CONTRACT sec. 2, spec 000_suspended.md sec. 5
-        "/suspended/joint_states": JOINT_STATE,
-        POSE_TOPIC: POSE,
-        "/suspended/imu": "sensor_msgs/msg/Imu",
-        "/suspended/reference": "trajectory_msgs/msg/JointTrajectory",
-        "/suspended/effort_commands": "std_msgs/msg/Float64MultiArray",
-        "/suspended/swing_estimate": JOINT_STATE,
-        "/suspended/ground_truth/swing": JOINT_STATE,
-        "/suspended/ground_truth/virtual_joints": JOINT_STATE,
-        SUSPENSION_TOPIC: POSE,                # optional, docs/contract-additions.md (suspension_motion)
-        "/suspended/markers": "visualization_msgs/msg/MarkerArray",
-    },
+    contract_topics=topics.TYPES,              # CONTRACT sec. 2, spec 000_suspended.md sec. 5
     channels=_CHANNELS,
     topic_names=lambda desc: {t: ["swing_x", "swing_y", "yaw", "r_x", "r_y"] for t in
-                              ("/suspended/swing_estimate", "/suspended/ground_truth/swing")},
+                              (topics.SWING_ESTIMATE, topics.GROUND_TRUTH_SWING)},
     markers=lambda bag, desc: _bag_markers(bag, desc),
 ))
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...rotations import wxyz_to_xyzw
-from .dataset import SUSPENSION_TOPIC
+from . import topics
 from .sim import Run
 from .swing import swing_from_pose
 
@@ -36,10 +36,10 @@ def write_run(path, run: Run, S, description: str, *, every: int = 10, pos_noise
     with BagWriter(path, overwrite=overwrite) as w:
         w.write_description(description)
         w.write_clock(t)
-        w.write_poses("/suspended/platform_pose", t, pos, wxyz_to_xyzw(quat))
+        w.write_poses(topics.PLATFORM_POSE, t, pos, wxyz_to_xyzw(quat))
         if suspension is not None:
             s_meas = S_t + rng.normal(0, pos_noise, S_t.shape) if pos_noise else S_t
-            w.write_poses(SUSPENSION_TOPIC, t, s_meas, np.tile([0.0, 0.0, 0.0, 1.0], (len(t), 1)))
+            w.write_poses(topics.SUSPENSION_POSE, t, s_meas, np.tile([0.0, 0.0, 0.0, 1.0], (len(t), 1)))
         names = ("swing_x", "swing_y", "yaw", "r_x", "r_y")
-        w.write_joint_states("/suspended/ground_truth/swing", t, names,
+        w.write_joint_states(topics.GROUND_TRUTH_SWING, t, names,
                              position=np.stack([sw[k] for k in names], 1))

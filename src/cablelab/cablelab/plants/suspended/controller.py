@@ -11,6 +11,7 @@
 * :func:`sway_offset`: optional sway damping by arm motion, ``delta q2^d = -k_s v_swing``
   (limited to +-0.2 rad; 0 when the swing estimate is older than 0.2 s). The arms' reaction
   then opposes the swing velocity.
+* :class:`ArmLaw`: the three together, the law the controller node runs on each joint state.
 """
 from __future__ import annotations
 
@@ -20,7 +21,7 @@ import numpy as np
 from .mjcf import AXES, _arm_xml
 from .params import VirtualParams
 
-__all__ = ["ArmGravity", "pd_gravity", "fig7_excitation", "sway_offset", "gains", "FIG7"]
+__all__ = ["ArmGravity", "ArmLaw", "pd_gravity", "fig7_excitation", "sway_offset", "gains", "FIG7"]
 
 #: 000 Fig. 7 excitation: frequency (Hz) and amplitudes (deg, three levels) per target mode
 FIG7 = {"x": (0.25, (11.5, 17.0, 20.0)), "y": (0.25, (11.5, 17.0, 20.0)),
@@ -99,3 +100,30 @@ def sway_offset(v_swing: float, k_s: float, age: float, *, limit: float = 0.2, s
     if not np.isfinite(v_swing) or age > stale or k_s == 0.0:
         return 0.0
     return float(np.clip(-k_s * v_swing, -limit, limit))
+
+
+class ArmLaw:
+    """The arm command of one joint state: :func:`pd_gravity` towards the reference plus the
+    built-in :func:`fig7_excitation` (``excitation`` ``none``/``x``/``y``/``z`` at ``level``)
+    and the :func:`sway_offset` on joint 2 of both arms (gain ``sway_damping``, off for a swing
+    estimate older than ``stale`` s), with the arms' gravity under the platform attitude."""
+
+    def __init__(self, p: VirtualParams, excitation: str = "none", level: int = 1,
+                 sway_damping: float = 0.0, stale: float = 0.2):
+        self.p = p
+        self.kp, self.kd, self.limit = gains(p)
+        self.gravity = ArmGravity(p)
+        self.excitation, self.level, self.k_s, self.stale = excitation, level, sway_damping, stale
+
+    def torque(self, t: float, q, qd, q_ref, qd_ref, R=None, v_swing: float = np.nan,
+               swing_age: float = np.inf) -> np.ndarray:
+        """Torques (N m) at time ``t`` (s) for arm state ``q``, ``qd``, reference ``q_ref``,
+        ``qd_ref``, platform attitude ``R`` (3x3, None = level) and the r_y swing rate
+        ``v_swing`` (rad/s) estimated ``swing_age`` s before ``t``."""
+        q_ref, qd_ref = np.array(q_ref, float), np.array(qd_ref, float)
+        if self.excitation in ("x", "y", "z"):
+            qe, qde = fig7_excitation(np.array([t]), self.p, self.excitation, self.level)
+            q_ref, qd_ref = q_ref + qe[0], qd_ref + qde[0]
+        off = sway_offset(v_swing, self.k_s, swing_age, stale=self.stale)
+        q_ref[[1, self.p.n_arm + 1]] += off
+        return pd_gravity(q, qd, q_ref, qd_ref, self.kp, self.kd, self.gravity.torque(q, R), self.limit)

@@ -30,6 +30,7 @@ import numpy as np
 from ...conditioning import Conditioning, condition_motion
 from ...errors import CablelabError
 from ...model import Dataset
+from . import topics
 from .params import VirtualParams
 from .reference import planar_bodies
 from .swing import swing_from_pose
@@ -38,12 +39,10 @@ __all__ = ["dataset", "dataset_from_arrays", "modal_inertias", "radial_mass", "p
            "POSE_TOPIC", "SUSPENSION_TOPIC", "JOINT_STATES", "CUTOFF_HZ"]
 
 CHANNELS = ("swing_x", "swing_y", "yaw", "stretch")
-POSE_TOPIC = "/suspended/platform_pose"
-#: optional: measured pose of the suspension point S (crane hook / drone), a measured input of
-#: ``suspension_motion`` (docs/contract-additions.md)
-SUSPENSION_TOPIC = "/suspended/suspension_pose"
-JOINT_STATES = "/suspended/joint_states"
-POSE = "geometry_msgs/msg/PoseStamped"
+POSE_TOPIC = topics.PLATFORM_POSE
+SUSPENSION_TOPIC = topics.SUSPENSION_POSE
+JOINT_STATES = topics.JOINT_STATES
+POSE = topics.POSE
 #: position low-pass cut-off, Hz: the swing is at 0.5 Hz (LiCAS) / 0.24 Hz (CRANEbot), yaw below
 #: 0.6 Hz; 1 mm of mocap noise differentiated twice needs a low cut-off (cf. crane: 3 Hz)
 CUTOFF_HZ = 2.0

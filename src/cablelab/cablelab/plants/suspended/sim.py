@@ -9,6 +9,8 @@
 * :func:`outputs`: the 000 eq. 4 channels ``r_x, r_y, yaw`` (pose-based, D7) of a run.
 * :func:`platform_imu`: what an IMU on the platform (LiCAS BNO055 on the shoulder structure,
   spec 5) reads: gyro and accelerometer in the platform frame.
+* :class:`LiveSim`: one model stepped period by period with the arm inputs held (the simulator
+  node's physics) and :class:`Reading`, what its sensors read after a period.
 """
 from __future__ import annotations
 
@@ -18,12 +20,12 @@ import mujoco
 import mujoco.rollout
 import numpy as np
 
-from .mjcf import VJ, levelling_ctrl
+from .mjcf import VJ, arm_joint_names, build_truth, build_virtual, levelling_ctrl
 from .params import VirtualParams
-from .swing import swing_from_pose
+from .swing import CHANNELS, swing_from_pose
 
 __all__ = ["initial_state", "simulate", "simulate_paper_levelling", "Run", "outputs",
-           "truth_start", "platform_imu", "STATE_SPEC"]
+           "truth_start", "platform_imu", "STATE_SPEC", "LiveSim", "Reading"]
 
 STATE_SPEC = mujoco.mjtState.mjSTATE_FULLPHYSICS
 
@@ -176,3 +178,89 @@ def platform_imu(model: mujoco.MjModel, data: mujoco.MjData, site: int) -> tuple
     mujoco.mj_rnePostConstraint(model, data)
     mujoco.mj_objectAcceleration(model, data, mujoco.mjtObj.mjOBJ_SITE, site, acc, 1)
     return vel[:3].copy(), acc[3:].copy()
+
+
+@dataclass
+class Reading:
+    """What the sensors of a :class:`LiveSim` read at time ``t`` (s): platform ``pos`` (3,) m
+    (``pos_measured`` with the pose noise), ``quat`` (4,) w x y z, arm joints ``q``, ``qd``,
+    ``effort`` (actuator torque, N m), IMU ``gyro`` rad/s and ``acc`` m/s^2 in the platform frame
+    (None without the IMU), the truth ``swing`` (values of :data:`~.swing.CHANNELS`) and the
+    virtual joints ``J7..J12`` (None for the truth plant)."""
+
+    t: float
+    pos: np.ndarray
+    pos_measured: np.ndarray
+    quat: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    effort: np.ndarray
+    gyro: np.ndarray | None
+    acc: np.ndarray | None
+    swing: list
+    virtual: np.ndarray | None
+
+
+class LiveSim:
+    """The virtual-joint model (``kind="virtual"``) or the four-tendon truth plant
+    (``kind="truth"``) of parameter set ``p``, advanced one period (1/``rate`` s) at a time with
+    the arm inputs held: position servo references, or torques with ``arm_motors``.
+
+    Args:
+        p: parameter set. kind: ``virtual`` or ``truth``. arm_motors: torque motors instead of
+        position servos. start: initial swing about x, y and yaw, rad. rate: periods per
+        second, Hz. pose_noise: standard deviation of the measured position, m. seed: of the noise.
+    """
+
+    def __init__(self, p: VirtualParams, kind: str = "virtual", *, arm_motors: bool = False,
+                 start=(0.0, 0.0, 0.0), rate: float = 100.0, pose_noise: float = 0.0, seed: int = 0):
+        sx, sy, yaw = start
+        if kind == "truth":
+            self.model = build_truth(p, arm_motors=arm_motors)
+            x0 = truth_start(self.model, p, sx, sy, yaw)
+        elif kind == "virtual":
+            self.model = build_virtual(p, arm_motors=arm_motors)
+            q0 = {"J8": sx, "J9": sy, "J7": yaw}
+            if p.level_to_swing:
+                q0.update({"J11": -sx, "J12": -sy})
+            x0 = initial_state(self.model, q0)
+        else:
+            raise ValueError(f"model kind {kind!r}: expected 'virtual' or 'truth'")
+        self.p = p
+        self.data = mujoco.MjData(self.model)
+        mujoco.mj_setState(self.model, self.data, x0, STATE_SPEC)
+        mujoco.mj_forward(self.model, self.data)
+        self.names = list(arm_joint_names(p))
+        self.jq = [self.model.joint(n).qposadr[0] for n in self.names]
+        self.jv = [self.model.joint(n).dofadr[0] for n in self.names]
+        self.vq = [self.model.joint(j).qposadr[0] for j in VJ] if kind == "virtual" else []
+        self.rest = np.array(p.S) - [0, 0, p.L]
+        self.site = self.model.site("platform").id
+        self.steps = max(1, int(round(1.0 / (rate * self.model.opt.timestep))))
+        self.noise = pose_noise
+        self.rng = np.random.default_rng(seed)
+
+    @property
+    def t(self) -> float:
+        return float(self.data.time)
+
+    def hold(self, u) -> None:
+        """Hold the arm inputs ``u`` (references, rad, or torques, N m; one per arm joint)."""
+        self.data.ctrl[:len(self.names)] = u
+
+    def advance(self) -> None:
+        """One period of physics with the inputs held."""
+        for _ in range(self.steps):
+            mujoco.mj_step(self.model, self.data)
+
+    def read(self, imu: bool = True) -> Reading:
+        """The sensors now (``imu``: also the IMU's gyro and accelerometer)."""
+        m, d = self.model, self.data
+        mujoco.mj_forward(m, d)
+        pos, quat = d.sensordata[:3].copy(), d.sensordata[3:7].copy()
+        gyro, acc = platform_imu(m, d, self.site) if imu else (None, None)
+        noisy = pos + (self.rng.normal(0, self.noise, 3) if self.noise > 0 else 0.0)
+        sw = swing_from_pose(pos[None], quat[None], self.p.S, rest_pos=self.rest, rest_yaw=0.0)
+        return Reading(float(d.time), pos, noisy, quat, d.qpos[self.jq].copy(), d.qvel[self.jv].copy(),
+                       d.qfrc_actuator[self.jv].copy(), gyro, acc, [float(sw[k][0]) for k in CHANNELS],
+                       d.qpos[self.vq].copy() if self.vq else None)

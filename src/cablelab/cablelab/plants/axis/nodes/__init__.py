@@ -1,2 +1,2 @@
 """The axis plant's ROS 2 nodes, one module per role (``sim``, ``estimator``, ``controller``), each
-with ``make_node(args)``; run by the node executables (``cable_sim_node --plant axis``, ...)."""
+with ``make_node()``; run by the node executables (``cable_sim_node --plant axis``, ...)."""

@@ -22,6 +22,7 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 from trajectory_msgs.msg import JointTrajectory
 
+from .. import topics
 from ..control import pd_feedforward, sine_reference
 from ....ros import convert
 from ....ros.params import Param
@@ -61,12 +62,12 @@ class AxisController(PlantNode):
         self.inputs.add("reference", timeout=v.reference_timeout, length=1,
                         required=self.source == "topic")
 
-        self.pub_cmd = self.create_publisher(Float64MultiArray, "/axis/effort_command", publisher_qos())
-        self.pub_ref = self.create_publisher(JointTrajectory, "/axis/reference", publisher_qos()) \
+        self.pub_cmd = self.create_publisher(Float64MultiArray, topics.EFFORT_COMMAND, publisher_qos())
+        self.pub_ref = self.create_publisher(JointTrajectory, topics.REFERENCE, publisher_qos()) \
             if self.source == "sine" else None
-        self.create_subscription(JointState, "/axis/joint_states", self.on_state, stream_qos())
+        self.create_subscription(JointState, topics.JOINT_STATES, self.on_state, stream_qos())
         if self.source == "topic":
-            self.create_subscription(JointTrajectory, "/axis/reference", self.on_reference, stream_qos())
+            self.create_subscription(JointTrajectory, topics.REFERENCE, self.on_reference, stream_qos())
         self.listen_for_description()
         self.start_diagnostics()
 
@@ -105,5 +106,5 @@ class AxisController(PlantNode):
         self.pub_cmd.publish(convert.command_msg([u], stamp=t, label="joint"))
 
 
-def make_node(args) -> PlantNode:
+def make_node() -> PlantNode:
     return AxisController()

@@ -18,6 +18,7 @@ import numpy as np
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 
+from .. import topics
 from ..control import gravity_load, regressor
 from ....rls import RecursiveLeastSquares
 from ....ros import convert
@@ -46,8 +47,8 @@ class AxisEstimator(PlantNode):
         self.prev = None  # (t, q, qd, effort)
         self.count = 0
         self.inputs.add("joint_states", timeout=0.5, length=2)
-        self.pub = self.create_publisher(Float64MultiArray, "/axis/parameter_estimate", publisher_qos())
-        self.create_subscription(JointState, "/axis/joint_states", self.on_state, catch_up_qos())
+        self.pub = self.create_publisher(Float64MultiArray, topics.PARAMETER_ESTIMATE, publisher_qos())
+        self.create_subscription(JointState, topics.JOINT_STATES, self.on_state, catch_up_qos())
         self.listen_for_description()
         self.start_diagnostics()
 
@@ -84,5 +85,5 @@ class AxisEstimator(PlantNode):
             self.pub.publish(convert.float_array_msg(self.rls.theta))
 
 
-def make_node(args) -> PlantNode:
+def make_node() -> PlantNode:
     return AxisEstimator()

@@ -23,6 +23,7 @@ import time
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 
+from .. import topics
 from ....description import load_description
 from ..sim import AxisSim, AxisTruth
 from ....ros import convert
@@ -73,11 +74,11 @@ class AxisSimNode(PlantNode):
         self.u = 0.0
         self.inputs.add("effort_command", timeout=v.command_timeout, length=1)
 
-        self.pub_js = self.create_publisher(JointState, "/axis/joint_states", publisher_qos())
-        self.pub_truth = self.create_publisher(JointState, "/axis/ground_truth/joint_states", publisher_qos())
+        self.pub_js = self.create_publisher(JointState, topics.JOINT_STATES, publisher_qos())
+        self.pub_truth = self.create_publisher(JointState, topics.GROUND_TRUTH, publisher_qos())
         self.clock = ClockPublisher(self)
         self.publish_description(self.description)
-        self.create_subscription(Float64MultiArray, "/axis/effort_command", self.on_command, stream_qos())
+        self.create_subscription(Float64MultiArray, topics.EFFORT_COMMAND, self.on_command, stream_qos())
         self.start_diagnostics()
         self.timer = self.create_timer(1.0 / self.rate, self.tick)
         from ..markers import axis_markers
@@ -121,5 +122,5 @@ class AxisSimNode(PlantNode):
         self.pub_truth.publish(convert.joint_state_msg(t, ["joint"], [q], [qd], [self.u]))
 
 
-def make_node(args) -> PlantNode:
+def make_node() -> PlantNode:
     return AxisSimNode()

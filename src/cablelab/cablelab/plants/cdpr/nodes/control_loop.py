@@ -39,6 +39,7 @@ from ....ros.fastspin import take_newest
 from ....ros.qos import publisher_qos, stream_qos
 from ....ros.rawmsg import CommandTemplate, RawTemplate
 from ....rotations import wxyz_to_xyzw
+from .. import topics
 from ..control import PdffConfig
 from ..hardware import SimulatedCdpr
 from ..live import ControllerConfig, LiveController
@@ -92,21 +93,21 @@ class CdprControlLoop(ControlLoopNode):
         self.estimates_rejected = 0
 
         q = publisher_qos()
-        self.pub_js = self.create_publisher(JointState, "/cdpr/joint_states", q)
-        self.pub_ten = self.create_publisher(JointState, "/cdpr/cable_tensions", q)
-        self.pub_ref = self.create_publisher(MultiDOFJointTrajectory, "/cdpr/reference", q)
-        self.pub_cmd = self.create_publisher(Float64MultiArray, "/cdpr/effort_commands", q)
-        self.pub_pose = self.create_publisher(PoseStamped, "/cdpr/platform_pose", q)
+        self.pub_js = self.create_publisher(JointState, topics.JOINT_STATES, q)
+        self.pub_ten = self.create_publisher(JointState, topics.CABLE_TENSIONS, q)
+        self.pub_ref = self.create_publisher(MultiDOFJointTrajectory, topics.REFERENCE, q)
+        self.pub_cmd = self.create_publisher(Float64MultiArray, topics.EFFORT_COMMANDS, q)
+        self.pub_pose = self.create_publisher(PoseStamped, topics.PLATFORM_POSE, q)
         self.pub_clock = self.create_publisher(Clock, "/clock", publisher_qos())
         if self.simulated:
-            self.pub_tpose = self.create_publisher(PoseStamped, "/cdpr/ground_truth/pose", q)
-            self.pub_tpay = self.create_publisher(InertiaStamped, "/cdpr/ground_truth/payload", q)
+            self.pub_tpose = self.create_publisher(PoseStamped, topics.GROUND_TRUTH_POSE, q)
+            self.pub_tpay = self.create_publisher(InertiaStamped, topics.GROUND_TRUTH_PAYLOAD, q)
         self.publish_description(desc)
         self._templates()
         # the estimate waits in a keep-last-1 queue that no executor watches; the loop takes it
         # after a write (take_inputs), never waiting for it
         self.inputs.add("payload_estimate", timeout=self.estimate_timeout, length=1, required=False)
-        self.est_sub = self.create_subscription(InertiaStamped, "/cdpr/payload_estimate", self.on_estimate,
+        self.est_sub = self.create_subscription(InertiaStamped, topics.PAYLOAD_ESTIMATE, self.on_estimate,
                                                 stream_qos(1))
         self.setup_loop(hardware, self.law)
 
@@ -209,5 +210,5 @@ class CdprControlLoop(ControlLoopNode):
         tpl.vector("pose.orientation", "xyzw")[:] = wxyz_to_xyzw(quat_wxyz)
 
 
-def make_node(args) -> CdprControlLoop:
+def make_node() -> CdprControlLoop:
     return CdprControlLoop()

@@ -22,6 +22,7 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 from trajectory_msgs.msg import MultiDOFJointTrajectory
 
+from .. import topics
 from ..control import PdffConfig
 from ..live import ControllerConfig, LiveController
 from ....ros import convert
@@ -91,14 +92,14 @@ class CdprController(PlantNode):
         self.inputs.add("payload_estimate", timeout=self.estimate_timeout, length=1,
                         required=False)
         q = stream_qos(1000)     # deep queue: a busy moment delays samples instead of dropping them
-        self.pub_cmd = self.create_publisher(Float64MultiArray, "/cdpr/effort_commands", publisher_qos())
+        self.pub_cmd = self.create_publisher(Float64MultiArray, topics.EFFORT_COMMANDS, publisher_qos())
         self.keep_first_description = True   # the first valid description configures the law
         self.listen_for_description(v.description)
         # the 1 kHz inputs arrive as bytes, decoded without rclpy message objects (RawReader)
         self.readers = {"state": RawReader(JointState), "reference": RawReader(MultiDOFJointTrajectory)}
-        ref_sub = self.create_subscription(MultiDOFJointTrajectory, "/cdpr/reference", self.on_reference, q, raw=True)
-        est_sub = self.create_subscription(InertiaStamped, "/cdpr/payload_estimate", self.on_estimate, q)
-        self.create_subscription(JointState, "/cdpr/joint_states", self.on_state, q, raw=True)
+        ref_sub = self.create_subscription(MultiDOFJointTrajectory, topics.REFERENCE, self.on_reference, q, raw=True)
+        est_sub = self.create_subscription(InertiaStamped, topics.PAYLOAD_ESTIMATE, self.on_estimate, q)
+        self.create_subscription(JointState, topics.JOINT_STATES, self.on_state, q, raw=True)
         self.pending = None
         self.prepared = None        # LiveController.ReferenceTerms of the next stamp (prepare_next)
         self.prepared_used = 0      # commands whose reference terms were prepared ahead
@@ -273,5 +274,5 @@ class CdprController(PlantNode):
         return level, msg, values
 
 
-def make_node(args) -> PlantNode:
+def make_node() -> PlantNode:
     return CdprController()

@@ -22,6 +22,7 @@ from geometry_msgs.msg import InertiaStamped, PoseStamped
 from sensor_msgs.msg import JointState
 from trajectory_msgs.msg import MultiDOFJointTrajectory
 
+from .. import topics
 from ..live import EstimatorConfig, LiveEstimator
 from ....ros import convert
 from ....rotations import xyzw_to_wxyz
@@ -83,7 +84,7 @@ class CdprPayloadEstimator(PlantNode):
         if self.config.tensions == "motor":
             self.inputs.add("joint_states", timeout=timeout)
         q = stream_qos(1000)     # deep queue: a busy moment delays samples instead of dropping them
-        self.pub = self.create_publisher(InertiaStamped, "/cdpr/payload_estimate", publisher_qos())
+        self.pub = self.create_publisher(InertiaStamped, topics.PAYLOAD_ESTIMATE, publisher_qos())
         self.keep_first_description = True   # the first valid description configures the law
         self.listen_for_description(v.description)
         # batch mode: the inputs wake nobody; a timer takes what queued every poll_period s and
@@ -96,15 +97,15 @@ class CdprPayloadEstimator(PlantNode):
         # the pose first: when both wait in one wake-up, a tension sample meets the pose of its
         # stamp (FastExecutor and rclpy's executor take ready topics in creation order)
         if self.config.pose == "desired":
-            subs = [self.create_subscription(MultiDOFJointTrajectory, "/cdpr/reference", self.on_reference,
+            subs = [self.create_subscription(MultiDOFJointTrajectory, topics.REFERENCE, self.on_reference,
                                              q_pose, raw=True)]
         else:
-            subs = [self.create_subscription(PoseStamped, "/cdpr/platform_pose", self.on_pose, q_pose)]
+            subs = [self.create_subscription(PoseStamped, topics.PLATFORM_POSE, self.on_pose, q_pose)]
         if self.config.tensions == "motor":        # (1 kHz of traffic nobody reads otherwise)
-            subs.append(self.create_subscription(JointState, "/cdpr/joint_states", self.on_joints, q_tension,
+            subs.append(self.create_subscription(JointState, topics.JOINT_STATES, self.on_joints, q_tension,
                                                  raw=True))
         else:
-            subs.append(self.create_subscription(JointState, "/cdpr/cable_tensions", self.on_tensions, q_tension,
+            subs.append(self.create_subscription(JointState, topics.CABLE_TENSIONS, self.on_tensions, q_tension,
                                                  raw=True))
         self.newest = None          # (t, m, com) not published yet (batch mode)
         self.batch_newest = None    # (t, tensions) of the newest input sample of the period (batch mode)
@@ -255,5 +256,5 @@ class CdprPayloadEstimator(PlantNode):
         return level, msg, values
 
 
-def make_node(args) -> PlantNode:
+def make_node() -> PlantNode:
     return CdprPayloadEstimator()

@@ -30,6 +30,7 @@ from trajectory_msgs.msg import MultiDOFJointTrajectory
 
 from ....description import load_description
 from ....errors import CablelabError
+from .. import topics
 from ..trajectory import ReferenceTable, pick_and_place
 from ....ros import convert
 from ....rotations import wxyz_to_xyzw
@@ -43,7 +44,7 @@ from ....ros import rawmsg
 from ....ros.rawmsg import RawTemplate
 from ..geometry import check_pulley_radius
 from ..hardware import WinchBrakes
-from ..sim import CdprSim, CdprTruth, default_description_path
+from ..sim import CdprSim, default_description_path, truth_from_parameters
 
 
 PARAMETERS = merge((
@@ -88,25 +89,6 @@ PARAMETERS = merge((
     markers_rate("/cdpr/markers: cables coloured by tension, platform, exit points"),
     Param("seed", 0, "seed of the noise generator", ge=0),
 ), START_GATE, executor_params(True))
-
-
-def truth_from_parameters(node: str, v, n: int, rate: float) -> CdprTruth:
-    """The simulated CDPR's truth from the validated simulator parameters ``v`` (the specs of
-    :data:`PARAMETERS`) for ``n`` cables at ``rate`` Hz; one-line errors naming ``node`` for what
-    the specs alone cannot check (the bias length against the cable count, the smallest step)."""
-    bias = v.tension_bias
-    if len(bias) not in (1, n):
-        raise CablelabError(f"{node}: parameter tension_bias:={bias}: expected 1 or {n} numbers "
-                            "(one per cable) [N]")
-    if 0 < v.timestep < 1e-5:
-        raise CablelabError(f"{node}: parameter timestep:={v.timestep!r}: expected 0 (auto) or a step "
-                            "of at least 1e-05 [s]")
-    return CdprTruth(
-        pulleys=v.pulleys, payload_mass=v.payload_mass, payload_com=tuple(v.payload_com),
-        winch_coulomb=v.winch_coulomb, winch_viscous=v.winch_viscous,
-        motor_inertia=v.motor_inertia, tension_noise=v.tension_noise,
-        tension_bias=tuple(bias) if any(bias) else None, torque_noise=v.torque_noise,
-        pose_noise=v.pose_noise, timestep=v.timestep or min(0.002, 1.0 / rate), seed=v.seed)
 
 
 class CdprSimNode(PlantNode):
@@ -175,12 +157,12 @@ class CdprSimNode(PlantNode):
         self._wall0 = None          # wall time of sim time 0 (real-time mode)
 
         q, pq = stream_qos(), publisher_qos()
-        self.pub_js = self.create_publisher(JointState, "/cdpr/joint_states", pq)
-        self.pub_ten = self.create_publisher(JointState, "/cdpr/cable_tensions", pq)
-        self.pub_pose = self.create_publisher(PoseStamped, "/cdpr/platform_pose", pq)
-        self.pub_ref = self.create_publisher(MultiDOFJointTrajectory, "/cdpr/reference", pq)
-        self.pub_tpose = self.create_publisher(PoseStamped, "/cdpr/ground_truth/pose", pq)
-        self.pub_tpay = self.create_publisher(InertiaStamped, "/cdpr/ground_truth/payload", pq)
+        self.pub_js = self.create_publisher(JointState, topics.JOINT_STATES, pq)
+        self.pub_ten = self.create_publisher(JointState, topics.CABLE_TENSIONS, pq)
+        self.pub_pose = self.create_publisher(PoseStamped, topics.PLATFORM_POSE, pq)
+        self.pub_ref = self.create_publisher(MultiDOFJointTrajectory, topics.REFERENCE, pq)
+        self.pub_tpose = self.create_publisher(PoseStamped, topics.GROUND_TRUTH_POSE, pq)
+        self.pub_tpay = self.create_publisher(InertiaStamped, topics.GROUND_TRUTH_PAYLOAD, pq)
         self.pub_clock = self.create_publisher(Clock, "/clock", publisher_qos())
         self.publish_description(self.description)
         if not self.real_time and v.rt_priority > 0:
@@ -190,14 +172,14 @@ class CdprSimNode(PlantNode):
         # real time: the commands wait queued until the step that applies them takes the newest
         # (one wake-up per step, the timer's; a keep-last-1 queue, so one take); lock-step: a
         # command wakes the node (it is the trigger)
-        cmd = self.create_subscription(Float64MultiArray, "/cdpr/effort_commands", self.on_command,
+        cmd = self.create_subscription(Float64MultiArray, topics.EFFORT_COMMANDS, self.on_command,
                                        stream_qos(1) if self.real_time else q, raw=True)
         self.polled = [cmd] if self.real_time else []
         for sub in self.polled:
             poll(self, sub)
         self.start_diagnostics()
         self.timer = self.create_timer(1.0 / self.rate if self.real_time else 0.0002, self.tick)
-        start_markers(self, "/cdpr/markers", self._marker_frame, lambda: self.sim.time,
+        start_markers(self, topics.MARKERS, self._marker_frame, lambda: self.sim.time,
                       v.markers_rate)
         self.publish_state()
 
@@ -402,5 +384,5 @@ class CdprSimNode(PlantNode):
         tpl.vector("pose.orientation", "xyzw")[:] = wxyz_to_xyzw(quat_wxyz)
 
 
-def make_node(args) -> PlantNode:
+def make_node() -> PlantNode:
     return CdprSimNode()

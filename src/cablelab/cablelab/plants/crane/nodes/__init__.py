@@ -1,2 +1,2 @@
 """The crane plant's ROS 2 nodes, one module per role (``sim``, ``estimator``, ``controller``), each
-with ``make_node(args)``; run by the node executables (``cable_sim_node --plant crane``, ...)."""
+with ``make_node()``; run by the node executables (``cable_sim_node --plant crane``, ...)."""

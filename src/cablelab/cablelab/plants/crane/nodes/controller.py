@@ -25,14 +25,15 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 from trajectory_msgs.msg import JointTrajectory
 
+from .. import topics
 from ..control import LIVE_GAINS, Gains, control_law, hold_command
 from ..model import JOINTS, CraneParams
+from ..reference import reference_trajectory
 from ....ros import convert
 from ....ros.inputs import WARN
 from ....ros.params import Param
 from ....ros.plant_node import PlantNode
 from ....ros.qos import publisher_qos, stream_qos
-from ..sim import reference_trajectory
 
 
 PARAMETERS = (
@@ -68,7 +69,7 @@ class CraneController(PlantNode):
         if v.reference_bag:
             from ....excite import read_reference
 
-            self.play = read_reference(v.reference_bag, "/crane/reference", JOINTS)
+            self.play = read_reference(v.reference_bag, topics.REFERENCE, JOINTS)
             self.source = "bag"
         self.ref = None
         self.swing = None
@@ -78,13 +79,13 @@ class CraneController(PlantNode):
         self.inputs.add("reference", timeout=v.reference_timeout, length=3,
                         required=self.source == "topic")
         self.inputs.add("swing_estimate", timeout=0.5, length=2, required=False)
-        self.pub_cmd = self.create_publisher(Float64MultiArray, "/crane/effort_commands", publisher_qos())
-        self.pub_ref = self.create_publisher(JointTrajectory, "/crane/reference", publisher_qos()) \
+        self.pub_cmd = self.create_publisher(Float64MultiArray, topics.EFFORT_COMMANDS, publisher_qos())
+        self.pub_ref = self.create_publisher(JointTrajectory, topics.REFERENCE, publisher_qos()) \
             if self.source in ("excitation", "bag") else None
-        self.create_subscription(JointState, "/crane/joint_states", self.on_state, stream_qos())
-        self.create_subscription(JointState, "/crane/swing_estimate", self.on_swing, stream_qos())
+        self.create_subscription(JointState, topics.JOINT_STATES, self.on_state, stream_qos())
+        self.create_subscription(JointState, topics.SWING_ESTIMATE, self.on_swing, stream_qos())
         if self.source == "topic":
-            self.create_subscription(JointTrajectory, "/crane/reference", self.on_reference, stream_qos())
+            self.create_subscription(JointTrajectory, topics.REFERENCE, self.on_reference, stream_qos())
         self.listen_for_description()
         self.start_diagnostics()
 
@@ -156,5 +157,5 @@ class CraneController(PlantNode):
         return self._start
 
 
-def make_node(args) -> PlantNode:
+def make_node() -> PlantNode:
     return CraneController()

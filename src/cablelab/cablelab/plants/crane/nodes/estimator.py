@@ -18,6 +18,7 @@ import numpy as np
 from geometry_msgs.msg import PoseStamped
 from sensor_msgs.msg import JointState
 
+from .. import topics
 from ..swing import SwingTracker
 from ....ros import convert
 from ....ros.inputs import WARN
@@ -52,10 +53,10 @@ class CraneSwingEstimator(PlantNode):
         self.inputs.add("boom_tip_pose", timeout=pose_timeout, length=3)
         self.inputs.add("payload_pose", timeout=pose_timeout, length=3)
         self.inputs.add("slew", timeout=v.slew_timeout, length=1)
-        self.pub = self.create_publisher(JointState, "/crane/swing_estimate", publisher_qos())
-        self.create_subscription(JointState, "/crane/joint_states", self.on_joints, catch_up_qos())
-        self.create_subscription(PoseStamped, "/crane/boom_tip_pose", self.on_tip, catch_up_qos())
-        self.create_subscription(PoseStamped, "/crane/payload_pose", self.on_payload, catch_up_qos())
+        self.pub = self.create_publisher(JointState, topics.SWING_ESTIMATE, publisher_qos())
+        self.create_subscription(JointState, topics.JOINT_STATES, self.on_joints, catch_up_qos())
+        self.create_subscription(PoseStamped, topics.TIP_POSE, self.on_tip, catch_up_qos())
+        self.create_subscription(PoseStamped, topics.PAYLOAD_POSE, self.on_payload, catch_up_qos())
         self.start_diagnostics()
 
     def extend_status(self, level, msg, values):
@@ -122,5 +123,5 @@ class CraneSwingEstimator(PlantNode):
                 self.pub.publish(convert.joint_state_msg(t, NAMES, x, v))
 
 
-def make_node(args) -> PlantNode:
+def make_node() -> PlantNode:
     return CraneSwingEstimator()

@@ -33,6 +33,7 @@ from std_msgs.msg import Float64MultiArray
 
 from ....description import load_description
 from ....errors import CablelabError
+from .. import topics
 from ..control import LIVE_GAINS, hold_command
 from ..model import JOINTS, CraneParams
 from ....ros.markers import start_markers
@@ -101,18 +102,18 @@ class CraneSimNode(PlantNode):
         self.fallbacks = 0
         self.inputs.add("effort_commands", timeout=v.command_timeout, length=3)
 
-        self.pub_js = self.create_publisher(JointState, "/crane/joint_states", publisher_qos())
-        self.pub_tip = self.create_publisher(PoseStamped, "/crane/boom_tip_pose", publisher_qos())
-        self.pub_pay = self.create_publisher(PoseStamped, "/crane/payload_pose", publisher_qos())
-        self.pub_truth = self.create_publisher(JointState, "/crane/ground_truth/swing", publisher_qos())
+        self.pub_js = self.create_publisher(JointState, topics.JOINT_STATES, publisher_qos())
+        self.pub_tip = self.create_publisher(PoseStamped, topics.TIP_POSE, publisher_qos())
+        self.pub_pay = self.create_publisher(PoseStamped, topics.PAYLOAD_POSE, publisher_qos())
+        self.pub_truth = self.create_publisher(JointState, topics.SWING_TRUTH, publisher_qos())
         self.pub_clock = self.create_publisher(Clock, "/clock", publisher_qos())
         self.publish_description(self.description)
-        self.create_subscription(Float64MultiArray, "/crane/effort_commands", self.on_command, stream_qos())
+        self.create_subscription(Float64MultiArray, topics.EFFORT_COMMANDS, self.on_command, stream_qos())
         self.start_diagnostics()
         self.timer = self.create_timer(1.0 / self.rate, self.tick)
         from ..markers import state_markers
 
-        start_markers(self, "/crane/markers", lambda: state_markers(self.description, self.sim.state()[1]),
+        start_markers(self, topics.MARKERS, lambda: state_markers(self.description, self.sim.state()[1]),
                       lambda: self.sim.state()[0], v.markers_rate)
         self.publish_state()
 
@@ -165,5 +166,5 @@ class CraneSimNode(PlantNode):
         self.pub_truth.publish(convert.joint_state_msg(t, SWING, [q[3], q[4], q[2]], [qd[3], qd[4], qd[2]]))
 
 
-def make_node(args) -> PlantNode:
+def make_node() -> PlantNode:
     return CraneSimNode()

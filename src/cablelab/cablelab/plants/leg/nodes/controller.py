@@ -1,0 +1,79 @@
+"""Leg controller node: ``/leg/hop_estimate`` (+ ``/leg/reference`` apex height) ->
+:class:`~..controller.ApexController` -> ``/leg/effort_commands``.
+
+ROS parameters: :data:`PARAMETERS` (``pd_feedforward --plant leg --help``).
+"""
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+from sensor_msgs.msg import JointState
+from std_msgs.msg import Float64MultiArray
+from trajectory_msgs.msg import JointTrajectory
+
+from . import DESCRIPTION
+from .. import topics
+from ..controller import ApexController
+from ..description import leg_of, load_leg_description
+from ....ros import convert
+from ....ros.params import Param
+from ....ros.plant_node import PlantNode
+from ....ros.qos import publisher_qos, stream_qos
+
+PARAMETERS = (
+    DESCRIPTION,
+    Param("h_des", 0.016, "desired apex height above z_td until a /leg/reference arrives", "m",
+          ge=0.0, le=10.0),
+    Param("T", 1.0, "initial stance torque", "N m", ge=0.0, le=1e4),
+    Param("P", 0.30, "stance torque duration", "s", gt=0.0, le=10.0),
+    Param("k_i", 10.0, "integral gain on the apex-height error", "N m/m", ge=0.0, le=1e6),
+    Param("k_ff", 0.5, "feedforward fraction of the model-based Newton step", ge=0.0, le=10.0),
+    Param("T_max", 4.0, "largest stance torque", "N m", gt=0.0, le=1e4),
+    Param("mode", "apex", "apex-height control or a constant open-loop torque",
+          choices=("apex", "open_loop")),
+)
+
+
+class LegControllerNode(PlantNode):
+    def __init__(self):
+        super().__init__("pd_feedforward")
+        v = self.declare_params(PARAMETERS)
+        self.description = load_leg_description(v.description)
+        params = leg_of(self.description).params(self.description.gravity)
+        self.ctl = ApexController(params, params.z_td + v.h_des, T=v.T, P=v.P, k_i=v.k_i, k_ff=v.k_ff,
+                                  T_max=v.T_max, mode=v.mode)
+        self.last_apex = math.nan
+        self.inputs.add("hop_estimate", timeout=0.5)
+        self.inputs.add("reference", timeout=math.inf, length=1, required=False)
+        self.pub = self.create_publisher(Float64MultiArray, topics.EFFORT_COMMANDS, publisher_qos())
+        self.create_subscription(JointState, topics.HOP_ESTIMATE, self.on_estimate, stream_qos())
+        self.create_subscription(JointTrajectory, topics.REFERENCE, self.on_reference, stream_qos())
+        self.start_diagnostics()
+
+    def extend_status(self, level, msg, values):
+        values.update({"T N m": f"{self.ctl.T:.4f}", "h_des m": f"{self.ctl.h_des:.4f}", "mode": self.ctl.mode})
+        return level, msg or "ok", values
+
+    def on_reference(self, msg: JointTrajectory) -> None:
+        _, _, pos, _, _ = convert.joint_trajectory_point(msg)
+        if pos is not None and self.inputs.accept("reference", pos, time.monotonic()):
+            self.ctl.h_des = float(np.asarray(pos).ravel()[0])
+
+    def on_estimate(self, msg: JointState) -> None:
+        t, names, pos, vel, _ = convert.joint_state_arrays(msg)
+        if pos is None or vel is None or "phase" not in names or not self.inputs.accept(
+                "hop_estimate", pos[[names.index("phase")]], time.monotonic()):
+            return  # hold T (stale or NaN estimate)
+        ia = names.index("apex_height")
+        h, ta = float(pos[ia]), float(vel[ia])
+        if math.isfinite(ta) and ta != self.last_apex:
+            self.last_apex = ta
+            self.ctl.on_apex(h)
+        tau = self.ctl.torque(t, int(round(pos[names.index("phase")])))
+        self.pub.publish(convert.command_msg([tau], stamp=t))
+
+
+def make_node() -> PlantNode:
+    return LegControllerNode()

@@ -1,0 +1,73 @@
+"""Leg estimator node: ``/leg/joint_states`` (+ ``/leg/contact`` when present) ->
+:class:`~..estimator.HopEstimator` -> ``/leg/hop_estimate``; /diagnostics reports the phase
+source, chattering flips, switch/height disagreements and dropouts.
+
+ROS parameters: :data:`PARAMETERS` (``payload_estimator --plant leg --help``).
+"""
+from __future__ import annotations
+
+import time
+
+from sensor_msgs.msg import JointState
+
+from . import DESCRIPTION, hop_msg
+from .. import topics
+from ..description import leg_of, load_leg_description
+from ..estimator import HopEstimator
+from ....ros import convert
+from ....ros.params import Param
+from ....ros.plant_node import PlantNode
+from ....ros.qos import publisher_qos, stream_qos
+
+PARAMETERS = (
+    DESCRIPTION,
+    Param("h", 0.5e-3, "height hysteresis of the phase detection", "m", ge=0.0, le=1.0),
+    Param("f_on", 1.0, "ground reaction force above which stance starts without a contact switch",
+          "N", ge=0.0, le=1e5),
+)
+
+
+class LegEstimatorNode(PlantNode):
+    def __init__(self):
+        super().__init__("payload_estimator")
+        v = self.declare_params(PARAMETERS)
+        self.description = load_leg_description(v.description)
+        params = leg_of(self.description).params(self.description.gravity)
+        self.est = HopEstimator(params, h=v.h, f_on=v.f_on)
+        self.contact = None
+        self.inputs.add("joint_states", timeout=0.5)
+        self.inputs.add("contact", timeout=0.5, length=1, required=False)
+        self.pub = self.create_publisher(JointState, topics.HOP_ESTIMATE, publisher_qos())
+        self.create_subscription(JointState, topics.JOINT_STATES, self.on_state, stream_qos())
+        self.create_subscription(JointState, topics.CONTACT, self.on_contact, stream_qos())
+        self.start_diagnostics()
+
+    def extend_status(self, level, msg, values):
+        e = self.est
+        values.update({"phase source": "height (no contact switch)" if self.contact is None else "contact switch",
+                       "chattering flips": str(e.flips), "switch/height disagreements": str(e.disagreements),
+                       "dropouts": str(e.dropouts)})
+        if self.contact is None:
+            msg = "; ".join(x for x in (msg, "no /leg/contact: phase from height") if x)
+            level = max(level, 1)
+        return level, msg or "ok", values
+
+    def on_contact(self, msg: JointState) -> None:
+        _, _, pos, _, _ = convert.joint_state_arrays(msg)
+        if self.inputs.accept("contact", pos, time.monotonic()):
+            self.contact = float(pos[0])
+
+    def on_state(self, msg: JointState) -> None:
+        t, names, pos, _, eff = convert.joint_state_arrays(msg)
+        if pos is None or "body" not in names or not self.inputs.accept("joint_states", pos, time.monotonic()):
+            self.est.dropouts += 1
+            return
+        z = float(pos[names.index("body")])
+        tau = float(eff[names.index("motor")]) if eff is not None and "motor" in names and len(eff) == len(names) else None
+        contact = self.contact if self.inputs.fresh("contact", time.monotonic()) else None
+        e = self.est.step(t, z, contact, tau)
+        self.pub.publish(hop_msg(t, e.z, e.zd, e.phase, e.apex_height, e.apex_time, e.grf))
+
+
+def make_node() -> PlantNode:
+    return LegEstimatorNode()
