@@ -16,7 +16,7 @@ import time
 import numpy as np
 
 from cablelab.bags import open_bag
-from cablelab.plants.suspended.controller import ArmGravity, fig7_excitation, gains, pd_gravity
+from cablelab.plants.suspended.control import ArmGravity, fig7_excitation, gains, pd_gravity
 from cablelab.plants.suspended.params import parameter_set
 from cablelab.rotations import quat_to_matrix, xyzw_to_wxyz
 

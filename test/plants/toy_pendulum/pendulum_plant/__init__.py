@@ -15,12 +15,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cablelab.conditioning import Conditioning, condition_motion
+from cablelab.conditioning import condition_motion
 from cablelab.dataset import Dataset
 from cablelab.fields import check_keys, mapping, number
 from cablelab.effects import register
 from cablelab.effects.base import Effect, Param
 from cablelab.errors import CablelabError
+from cablelab.plant_interface import DatasetOptions
 from cablelab.registry import Plant, register_plant
 
 TOPIC = "/pendulum/joint_states"
@@ -42,13 +43,12 @@ def parse_section(obj) -> PendulumDescription:
                                number(obj, "length", "pendulum", positive=True))
 
 
-def dataset(bag, description, options=None) -> Dataset:
+def dataset(bag, description, options: DatasetOptions) -> Dataset:
     bag.require(TOPIC, JOINT_STATE)
     js = bag.joint_state(TOPIC)
     if js.names != ["hinge"]:
         raise CablelabError(f"{bag.path}: {TOPIC} has joints {js.names}; expected ['hinge']")
-    opts = (options or {}).get("conditioning") or Conditioning()
-    c = condition_motion(js.t, js.position[:, 0], js.effort[:, 0], opts, revolute=True,
+    c = condition_motion(js.t, js.position[:, 0], js.effort[:, 0], options.conditioning, revolute=True,
                          qd=js.velocity[:, 0], source=str(bag.path))
     qd = c["qd"].reshape(-1)
     return Dataset(plant="pendulum", t=c["t"], y=c["effort"].reshape(-1, 1), channels=("hinge",),
@@ -77,8 +77,7 @@ PLANT = register_plant(Plant(
     baseline=lambda desc: ("pendulum_inertia", "pendulum_gravity"),
     candidates=lambda desc: ("joint_viscous_friction", "joint_coulomb_friction",
                              "torque_sensor_offset"),
-    channels_doc="hinge: applied torque (N m)",
-    section=parse_section,
+    parse_section=parse_section,
     contract_topics={TOPIC: JOINT_STATE},
     joint_topic=TOPIC,
     joints=("hinge",),

@@ -1,10 +1,6 @@
-"""The suspended CDPR as a workbench plant, and offline payload estimation from a bag (001).
-
-Geometry, estimation, control and trajectory live in the ``cdpr_*`` modules next to this one;
-this module reads a contract bag into arrays (:func:`load_arrays`), builds the workbench
+"""The CDPR dataset: a contract bag read into arrays (:func:`load_arrays`) and the workbench
 :class:`~cablelab.model.Dataset` (output channels = the cable wrench W t, 6 channels, see
-:mod:`cablelab.plants.cdpr.effects`) and runs the offline estimate of ``cablelab estimate``
-(:func:`estimate_bag`): mass and CoM per sample, vectorised over the whole bag (001 eq. 12-13).
+:mod:`cablelab.plants.cdpr.effects`), and the checks of a bag before a fit.
 
 Bag topics (CONTRACT section 2): ``/cdpr/cable_tensions`` (dynamometers), ``/cdpr/joint_states``
 (motor angles, rates, torques), ``/cdpr/reference`` (desired pose, twist, acceleration; 001's
@@ -19,11 +15,10 @@ import numpy as np
 
 from ...errors import CablelabError
 from ...model import Dataset
+from ...plant_interface import DatasetOptions
 from ...rotations import quat_to_matrix, xyzw_to_wxyz
-from ...registry import Plant, register_plant
-from .description import dump_section, parse_section
-from .estimation import mass_com, mass_com_batch
 from .geometry import cable_geometry, check_pulley_radius, wrench_matrix
+from .options import CdprOptions
 
 JOINT_STATE = "sensor_msgs/msg/JointState"
 TENSIONS = "/cdpr/cable_tensions"
@@ -294,158 +289,23 @@ def remeasure(ds: Dataset, shifted: Dataset) -> Dataset:
     return shifted.replace(y=y, signals=sig)
 
 
-def dataset(bag, description, options: dict | None = None) -> Dataset:
-    """Plant hook of the workbench: the bag's CDPR dataset (options: ``tensions``, ``pose``,
-    ``conditioning.decimate``)."""
-    options = options or {}
-    arr = load_arrays(bag, description, options.get("tensions") or "dynamometer",
-                      options.get("pose") or "desired",
-                      (options.get("derived_velocity") or {}).get(JOINTS, ()))
-    cond = options.get("conditioning")
-    return dataset_from_arrays(arr, description, str(bag.path), getattr(cond, "decimate", 1) or 1)
+def dataset(bag, description, options: DatasetOptions) -> Dataset:
+    """Plant hook of the workbench: the bag's CDPR dataset (the plant options
+    :class:`~.options.CdprOptions` ``tensions`` and ``pose``, and ``conditioning.decimate``)."""
+    own = options.plant_options(CdprOptions)
+    arr = load_arrays(bag, description, own.tensions, own.pose, options.derived_velocity.get(JOINTS, ()))
+    return dataset_from_arrays(arr, description, str(bag.path), options.conditioning.decimate or 1)
 
 
-def baseline(description) -> tuple[str, ...]:
-    """Nominal model: the payload's weight (001 eq. 13) with the wrench matrix of Model II when the
-    description gives a pulley radius, else Model I (point exits)."""
-    c = description.cdpr if description is not None else None
-    if c is not None and c.pulley_radius > 0:
-        return ("cdpr_gravity", "pulley_geometry")
-    return ("cdpr_gravity",)
-
-
-def candidates(description) -> tuple[str, ...]:
-    """Effects a diagnosis tries (the friction and offset ones only matter for the tension source
-    that carries them; an effect without signal is simply not significant)."""
-    return ("pulley_geometry", "platform_inertia", "winch_coulomb_friction",
-            "winch_viscous_friction", "tension_sensor_offset", "time_delay")
-
-
-
-
-# ================================================================================ offline estimate
-
-@dataclass
-class Estimate:
-    """Per-sample payload estimate of a bag (``cablelab estimate``)."""
-
-    t: np.ndarray
-    mass: np.ndarray
-    com: np.ndarray
-    residual: np.ndarray
-    effects: tuple
-    params: dict
-    truth_mass: float | None = None
-    truth_com: np.ndarray | None = None
-
-    def summary(self) -> dict:
-        """JSON of CONTRACT section 5 (cdpr) + the model, parameters and, when the bag has the
-        ground truth, the mass error in %."""
-        ok = np.isfinite(self.mass)
-        if not ok.any():
-            raise CablelabError("no sample gives a finite mass: the cable geometry of the "
-                                "description is degenerate at the recorded poses (e.g. an anchor "
-                                "closer to its pulley than the sheave radius)")
-        m = self.mass[ok]
-        out = {"plant": "cdpr", "samples": int(ok.sum()),
-               "mass": {"mean": float(m.mean()), "std": float(m.std()),
-                        "max_abs_dev": float(np.abs(m - m.mean()).max())},
-               "com": {"x": float(np.mean(self.com[ok, 0])), "y": float(np.mean(self.com[ok, 1]))},
-               "effects": list(self.effects), "params": self.params,
-               "wrench_residual": float(np.sqrt(np.mean(self.residual[ok] ** 2)))}
-        if self.truth_mass:
-            err = 100.0 * (m - self.truth_mass) / self.truth_mass
-            out["truth"] = {"mass": self.truth_mass, "mass_error_percent": float(err.mean()),
-                            "max_error_percent": float(np.abs(err).max())}
-            if self.truth_com is not None:
-                out["truth"]["com"] = {"x": float(self.truth_com[0]), "y": float(self.truth_com[1])}
-        return out
-
-
-def estimate_arrays(arr: CdprArrays, description, effects=(), params: dict | None = None) -> Estimate:
-    """Mass and CoM per sample with the model ``baseline + effects`` (001 eq. 12-13).
-
-    Nuisance parameters the model needs and ``params`` does not give (an unknown sheave radius,
-    winch friction, sensor offsets) are identified first on the same data with the workbench
-    (separable least squares); then the tensions are corrected and eq. 13 is applied per sample,
-    vectorised.
-    """
-    from ...model import Model
-
-    c = description.cdpr
-    effs = tuple(baseline(description)) + tuple(e for e in effects if e not in baseline(description))
-    Model("cdpr", effs)                                         # validates the ids
-    params = dict(params or {})
-    need = []
-    if "pulley_geometry" in effs and "r_p" not in params:
-        if c.pulley_radius > 0:
-            params["r_p"] = c.pulley_radius
-        else:
-            need.append("r_p")
-    fr = [e for e in effs if e in ("winch_coulomb_friction", "winch_viscous_friction", "tension_sensor_offset")]
-    if need or fr:
-        from ...fit import identify
-
-        ds = dataset_from_arrays(arr, description)
-        fixed = {"r_p": params["r_p"]} if "r_p" in params and "pulley_geometry" in effs else {}
-        # W_I-based friction/offset columns: good to first order in r_p
-        ident = identify(Model("cdpr", effs, fixed), ds)
-        params.update({k: v for k, v in ident.params.items() if k not in ("m", "mx", "my", "m_a")})
-    n = arr.tensions.shape[1]
-    t = arr.tensions.copy()
-    names = [f"winch_{i}" for i in range(1, n + 1)]
-    if "winch_coulomb_friction" in effs or "winch_viscous_friction" in effs:
-        fc = np.array([params.get(f"Fc[{w}]", 0.0) for w in names])
-        fv = np.array([params.get(f"Fv[{w}]", 0.0) for w in names])
-        s = np.sign(arr.motor_velocity)
-        t = t - arr.scale * (fc * s + fv * arr.motor_velocity) if arr.source == "motor" else t
-    if "tension_sensor_offset" in effs:
-        t = t - np.array([params.get(f"b[{w}]", 0.0) for w in names])
-    r = params.get("r_p", 0.0) if "pulley_geometry" in effs else 0.0
-    check_pulley_radius(c.exit_points, c.anchor_points, arr.position, arr.R, r, c.swivel_axes,
-                        "r_p (pulley_geometry)" if r != c.pulley_radius else "cdpr.pulley_radius")
-    if arr.R is None and "platform_inertia" not in effs:      # level and static: fast kernel
-        est = mass_com_batch(c.exit_points, c.anchor_points, arr.position, t, r,
-                             description.gravity, c.swivel_axes)
-    else:
-        geom = cable_geometry(c.exit_points, c.anchor_points, arr.position, arr.R, r, c.swivel_axes)
-        est = mass_com(geom, t, description.gravity,
-                       arr.acc if "platform_inertia" in effs else None, arr.R)
-    return Estimate(arr.t, est.mass, est.com, est.residual, effs,
-                    {k: float(v) for k, v in params.items()}, arr.truth_mass, arr.truth_com)
-
-
-def estimate_bag(bag_path, description=None, *, tensions: str = "dynamometer", effects=(),
-                 pose: str = "desired", out=None, derived_velocity: dict | None = None) -> Estimate:
-    """``cablelab estimate`` for a CDPR bag; ``out`` also writes ``/cdpr/payload_estimate``
-    (InertiaStamped: m, com = (x_G, y_G, NaN), frame ``platform``) stamped like the tensions."""
-    from ...bags import open_bag
-
-    bag = bag_path if hasattr(bag_path, "joint_state") else open_bag(bag_path)   # path or open Bag
-    desc = description if description is not None else bag.description
-    if desc is None:
-        raise CablelabError(f"{bag_path}: no /plant_description in the bag; give --description FILE")
-    arr = load_arrays(bag, desc, tensions, pose, (derived_velocity or {}).get(JOINTS, ()))
-    est = estimate_arrays(arr, desc, effects)
-    if out is not None:
-        from ...bags import BagWriter
-        from ...description import dump_description
-
-        with BagWriter(out, overwrite=True) as w:
-            w.write_description(desc.yaml_text or dump_description(desc), float(est.t[0]))
-            com = np.column_stack([est.com, np.full(len(est.t), np.nan)])
-            w.write_inertia(ESTIMATE, est.t, est.mass, com)
-    return est
-
-
-def check_bag(bag, desc, options, series) -> list[str]:
+def check_bag(bag, desc, options: DatasetOptions, series) -> list[str]:
     """Before a fit: one winch and one cable per described cable, no cable that pushes, tensions
     that are not all zero, and a geometry that can hold the platform (:func:`check_geometry`)."""
     from ...bagcheck import check_names, negative_tension_warnings
 
     warnings = []
     n = len(desc.cdpr.cables) if desc.cdpr is not None else None
-    source = options.get("tensions") or "dynamometer"
+    own = options.plant_options(CdprOptions)
+    source = own.tensions
     for topic, prefix, noun in ((JOINTS, "winch", "winches"), (TENSIONS, "cable", "cables")):
         s = series.get(topic)
         if s is None or n is None:
@@ -457,7 +317,7 @@ def check_bag(bag, desc, options, series) -> list[str]:
         if (topic == TENSIONS) == (source in ("dynamometer", "both")):
             _refuse_zero_load(bag, topic, s.effort, "tension" if topic == TENSIONS else "motor torque")
     if desc.cdpr is not None:
-        pose = series.get(REFERENCE) if (options.get("pose") or "desired") == "desired" else None
+        pose = series.get(REFERENCE) if own.pose == "desired" else None
         pose = pose if pose is not None else series.get(POSE)
         check_geometry(bag, desc.cdpr, None if pose is None else pose.position)
     return warnings
@@ -519,50 +379,3 @@ def check_geometry(bag, c, positions=None) -> None:
             f"{np.round(P[k], 3).tolist()} span fewer than {need} dimensions (singular wrench "
             f"matrix: all cables in one line or plane); the forces cannot be resolved, check the "
             f"exit and anchor points")
-
-
-CDPR = register_plant(Plant(
-    name="cdpr",
-    topics=((JOINTS, JOINT_STATE),),
-    dataset=dataset,
-    baseline=baseline,
-    candidates=candidates,
-    remeasure=remeasure,
-    channels_doc="cable wrench W t at the desired pose: Fx, Fy, Fz (N), Mx, My, Mz (N m) about "
-                 "the platform origin, world axes",
-    section=parse_section,
-    dump_section=dump_section,
-    contract_topics={
-        JOINTS: JOINT_STATE,
-        "/cdpr/cable_tensions": JOINT_STATE,
-        "/cdpr/platform_pose": "geometry_msgs/msg/PoseStamped",
-        "/cdpr/reference": "trajectory_msgs/msg/MultiDOFJointTrajectory",
-        "/cdpr/effort_commands": "std_msgs/msg/Float64MultiArray",
-        "/cdpr/payload_estimate": "geometry_msgs/msg/InertiaStamped",
-        "/cdpr/ground_truth/pose": "geometry_msgs/msg/PoseStamped",
-        "/cdpr/ground_truth/payload": "geometry_msgs/msg/InertiaStamped",
-    },
-    joint_topic=JOINTS,
-    joints=tuple(f"winch_{i}" for i in range(1, 9)),
-    capabilities=frozenset({"winch_actuators"}),
-    estimate=estimate_bag,
-    checked_topics=(TENSIONS, "/cdpr/reference", POSE),
-    check_bag=check_bag,
-    channels=CHANNELS,
-    topic_names=lambda desc: _topic_names(desc),
-    markers=lambda bag, desc: _bag_markers(bag, desc),
-    options=("tensions", "pose"),
-))
-
-
-def _bag_markers(bag, desc):
-    from .markers import bag_markers
-
-    return bag_markers(bag, desc)
-
-
-def _topic_names(desc) -> dict:
-    """Element names of the CDPR JointState topics (CONTRACT sec. 2) for ``desc``'s cables."""
-    n = len(desc.cdpr.cables) if desc is not None and desc.cdpr is not None else 8
-    return {JOINTS: [f"winch_{i}" for i in range(1, n + 1)],
-            TENSIONS: [f"cable_{i}" for i in range(1, n + 1)]}

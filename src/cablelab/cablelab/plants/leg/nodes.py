@@ -28,7 +28,7 @@ from ...ros.clock import ClockPublisher
 from ...ros.params import Param
 from ...ros.plant_node import PlantNode
 from ...ros.qos import publisher_qos, stream_qos
-from .controller import ApexController
+from .control import ApexController
 from .description import leg_of
 from .estimator import HopEstimator
 from .hybrid import STANCE

@@ -347,7 +347,7 @@ def _controller_class():
 
     from ...ros import convert
     from ...ros.qos import catch_up_qos, publisher_qos, stream_qos
-    from .controller import ArmGravity, fig7_excitation, gains, pd_gravity, sway_offset
+    from .control import ArmGravity, fig7_excitation, gains, pd_gravity, sway_offset
     from .mjcf import arm_joint_names
 
     class SuspendedController(PlantNode):
