@@ -186,7 +186,7 @@ def plain(obj: Any) -> Any:
     """``obj`` with numpy arrays, dataclasses and tuples turned into YAML-ready lists/mappings
     (``None`` fields of dataclasses dropped)."""
     if isinstance(obj, np.ndarray):
-        return [float(x) for x in obj]
+        return np.asarray(obj, dtype=float).tolist()      # any shape (e.g. two 3-vectors)
     if dataclasses.is_dataclass(obj):
         return {k: plain(getattr(obj, k)) for k in (f.name for f in dataclasses.fields(obj))
                 if getattr(obj, k) is not None}
