@@ -3,7 +3,8 @@
 
 Geometry, estimation, control and trajectory live in the modules next to this one
 (:mod:`.geometry`, :mod:`.estimation`, :mod:`.control`, :mod:`.trajectory`); :mod:`.dataset` reads
-a bag into the workbench dataset and :mod:`.estimate` runs the offline estimate (``cablelab estimate``).
+a bag into the workbench dataset, :mod:`.estimate` runs the offline estimate (``cablelab
+estimate``), :mod:`.options` holds the plant's own options (``--tensions``, ``--pose``).
 """
 from __future__ import annotations
 
