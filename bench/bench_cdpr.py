@@ -358,7 +358,8 @@ def closed_loop_1khz(bench: Bench, launch, seconds: float, params: dict) -> None
 
 def paper_tables(bench: Bench) -> None:
     """001 Tables I-II and Fig. 15 from offline closed-loop runs (MP, MP+M1, MP+M2)."""
-    from cablelab.plants.cdpr.plant import estimate_arrays, CdprArrays
+    from cablelab.plants.cdpr.estimate import estimate_arrays
+    from cablelab.plants.cdpr.dataset import CdprArrays
     from cablelab.plants.cdpr.sim import CdprTruth, default_description, simulate, without_pulley_radius
 
     desc = default_description()

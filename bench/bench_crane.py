@@ -79,11 +79,12 @@ def main() -> int:
     from cablelab.description import load_description
     from cablelab.diagnose import rank_candidates
     from cablelab.model import Model
+    from cablelab.plants.crane import dataset as CD
     from cablelab.plants.crane import plant as C
 
     desc = load_description(os.path.join(os.path.dirname(C.__file__), "data", "crane.yaml"))
     r = simulate(CraneTruth(params=p, base_tilt=(-0.058, 0.0)), 60.0, decimate=10)
-    ds = C.dataset_from_arrays(r.t, r.q[:, :3], r.effort, r.t, r.tip, r.payload, desc)
+    ds = CD.dataset_from_arrays(r.t, r.q[:, :3], r.effort, r.t, r.tip, r.payload, desc)
     t_diag = bench.time(lambda: rank_candidates(Model("crane", C.baseline(desc), {"l_c": 0.3}), ds,
                                                 C.candidates(desc)), repeat=1)
     bench.row(case="diagnose (5 candidates x 5 folds)", samples=ds.n, seconds=t_diag,

@@ -20,7 +20,8 @@ from cablelab.plants.leg.estimator import HopEstimator  # noqa: E402
 from cablelab.plants.leg.hybrid import LegParams  # noqa: E402
 from cablelab.plants.leg.identify import identify, record_from_trajectory, stride_segments  # noqa: E402
 from cablelab.plants.leg.reference import sampled_trajectory  # noqa: E402
-from cablelab.plants.leg.sim import build_model, open_loop, simulate  # noqa: E402
+from cablelab.plants.leg.mjcf import build_mjcf  # noqa: E402
+from cablelab.plants.leg.sim import DT, open_loop, simulate  # noqa: E402
 
 
 def main() -> int:
@@ -35,7 +36,7 @@ def main() -> int:
     # ---- hybrid simulation vs a bare mj_step loop (same model, 1 kHz, no phase logic)
     import mujoco
 
-    m = build_model(p)
+    m = build_mjcf(p, DT)
     d = mujoco.MjData(m)
     n = int(dur / 1e-3)
 

@@ -19,7 +19,7 @@
 
 Every bag carries both tension measurements (dynamometers and motor torques), and every case is
 diagnosed with ``--tensions both``: the six wrench channels from the dynamometers plus the
-per-winch torque balance ``(R/r) tau_i - d_i`` (``cablelab.plants.cdpr.plant.torque_balance``),
+per-winch torque balance ``(R/r) tau_i - d_i`` (``cablelab.plants.cdpr.dataset.torque_balance``),
 where each dynamometer offset and each winch's friction has a channel of its own (with the wrench
 alone the offsets' two-dimensional internal-force component is invisible at each pose).
 

@@ -1,6 +1,6 @@
 """Randomized boom-crane diagnosis cases (bench_diagnosis.py), generated WITHOUT the fitting code.
 
-* truth: the MuJoCo crane of :mod:`cablelab.plants.crane.sim` (``build_model``: slew, luff, gimbal
+* truth: the MuJoCo crane of :mod:`cablelab.plants.crane.sim` (``build_mjcf``: slew, luff, gimbal
   swing joints and the hoist, built from the plant description; 002 ch. 3). The crane's fitting
   code never runs MuJoCo for the diagnosis: its regressor is the sympy-generated Lagrangian of 002
   eq. 4.1-4.2, so the two are separate implementations of the same mechanics. Added to it here:
@@ -162,14 +162,15 @@ def simulate(case: PlantCase) -> dict:
     signals: ``t``, ``q`` (N, 3) encoder readings, ``qd`` (N, 3) or NaN, ``effort`` (N, 3), ``tip``,
     ``payload`` (N, 3) motion capture and their quaternions x, y, z, w, plus the true motor efforts."""
     from cablelab.plants.crane.model import CraneParams
-    from cablelab.plants.crane.sim import CraneTruth, build_model, set_state
+    from cablelab.plants.crane.mjcf import build_mjcf
+    from cablelab.plants.crane.sim import CraneTruth, set_state
 
     rng = np.random.default_rng(case.seed + 7919)
     tr = case.truth
     ref = reference(case, rng)
     params = CraneParams(**{k: tr[k] for k in ("boom_length", "payload_mass", "boom_mass", "counterbalance_mass",
                                                "counterbalance_distance", "slew_inertia", "luff_inertia")})
-    model = build_model(CraneTruth(params=params, base_tilt=tuple(tr["tilt"]), viscous=tuple(tr["viscous"]),
+    model = build_mjcf(CraneTruth(params=params, base_tilt=tuple(tr["tilt"]), viscous=tuple(tr["viscous"]),
                                    effort_limit=(1e3, 1e3, 1e3)))
     data = mujoco.MjData(model)
     dt = model.opt.timestep

@@ -25,7 +25,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from harness import Bench  # noqa: E402
 
 from cablelab.bags import open_bag  # noqa: E402
-from cablelab.plants.suspended.controller import fig7_excitation  # noqa: E402
+from cablelab.plants.suspended.control import fig7_excitation  # noqa: E402
 from cablelab.plants.suspended.params import parameter_set  # noqa: E402
 from cablelab.ros.launch import Launcher  # noqa: E402
 

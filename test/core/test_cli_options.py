@@ -51,3 +51,25 @@ def test_every_bag_verb_has_the_flags_its_messages_advise(cli, verb):
         if flag == "--description" and verb in ("replay", "info"):
             continue
         assert flag in text, (verb, flag)
+
+
+@pytest.mark.parametrize("verb, flags", [("estimate", ("--tensions", "--pose")),
+                                         ("compare", ("--tensions",)), ("diagnose", ("--tensions",)),
+                                         ("identify", ("--tensions",)), ("report", ("--tensions",)),
+                                         ("excite", ("--tensions",))])
+def test_help_lists_the_options_plants_add(cli, verb, flags):
+    """The plants' own options (declared in their packages, added when the verb parses) are in
+    the verb's --help, with the plant they belong to and their choices."""
+    text = cli(verb, "--help").out
+    assert "plant options" in text
+    for flag in flags:
+        assert flag in text, (verb, flag)
+    assert "cdpr only" in text and "dynamometer,motor,both" in text
+    if "--pose" not in flags:
+        assert "--pose" not in text                # the CDPR offers --pose to estimate only
+
+
+def test_a_plant_option_value_outside_its_choices_is_a_usage_error(cli):
+    res = cli("estimate", EMPS, "--pose", "sideways")
+    assert res.code == 2 and len(res.err_lines) == 1
+    assert "--pose" in res.err and "sideways" in res.err

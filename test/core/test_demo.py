@@ -8,7 +8,8 @@ from scipy.optimize import root
 
 from cablelab.description import load_description
 from cablelab.plants.crane.model import CraneParams
-from cablelab.plants.crane.sim import CraneTruth, build_model, gravity_in_base, set_state
+from cablelab.plants.crane.mjcf import build_mjcf
+from cablelab.plants.crane.sim import CraneTruth, gravity_in_base, set_state
 from cablelab import demo
 from cablelab.plants.crane import demo as demo_crane
 
@@ -24,7 +25,7 @@ def params():
 def slew_torque_at_rest(truth: CraneTruth, alpha: float, beta: float, d: float = 0.6) -> float:
     """Slew torque (N m) that holds the MuJoCo crane at rest with the payload hanging in its
     equilibrium (zero generalised force on both swing joints, found numerically)."""
-    model = build_model(truth)
+    model = build_mjcf(truth)
     data = mujoco.MjData(model)
 
     def state(sw):

@@ -102,7 +102,7 @@ def _arrays(n=4000, fs=1000.0, seed=0):
 def _diag_arrays(t, q, eff):
     from cablelab.description import load_description
     from cablelab.plants import get_plant
-    from cablelab.plants.axis.plant import dataset_from_arrays
+    from cablelab.plants.axis.dataset import dataset_from_arrays
 
     desc = load_description(PRISMATIC)
     plant = get_plant("axis")

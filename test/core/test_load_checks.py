@@ -48,12 +48,13 @@ def test_gap_is_masked_not_interpolated(cli, tmp_path, full_fit):
     assert abs(out["samples"] - (n_full - lost.sum())) <= 25   # (zero-speed cut at the borders)
     # control: the same data interpolated across the gap (no mask) is measurably wrong
     from cablelab.bags import open_bag
+    from cablelab.plant_interface import DatasetOptions
     from cablelab.plants import get_plant
     from cablelab.workbench import build_model, compare
 
     b = open_bag(bag)
     plant = get_plant("axis")
-    ds = plant.dataset(b, b.description, {})
+    ds = plant.dataset(b, b.description, DatasetOptions())
     M_interp = compare(ds, build_model(plant, b.description))["params"]["M"]["value"]
     assert abs(M_interp - M_full) > 5 * abs(M - M_full)
     # text output: the warning line is printed too

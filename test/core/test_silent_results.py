@@ -272,7 +272,7 @@ def test_crane_contradictions_are_errors(cli, tmp_path, edit, topic, needle, ver
 
 def test_crane_luff_in_degrees_without_tip_pose():
     from cablelab.errors import CablelabError
-    from cablelab.plants.crane.plant import check_measurements
+    from cablelab.plants.crane.dataset import check_measurements
 
     class S:  # a joint-state series
         names = ["slew", "luff", "hoist"]
@@ -435,7 +435,8 @@ def test_free_run_fit_starts_from_the_models_own_parameters(tmp_path):
     (Fc is not in the model); a non-physical inverse-model start names what is wrong."""
     from cablelab.description import load_description
     from cablelab.errors import CablelabError
-    from cablelab.plants.axis.plant import dataset_from_arrays, fit_free_run
+    from cablelab.plants.axis.dataset import dataset_from_arrays
+    from cablelab.plants.axis.freerun import fit_free_run
     from cablelab.plants.axis.sim import AxisTruth
     from cablelab.plants.axis.truth import simulate_axis
 
@@ -457,7 +458,7 @@ def test_crane_degrees_flagged_iff_degrees(seed, degrees, boom, with_tip):
     the boom of marker noise) or without one: refused exactly when the angles are in degrees."""
     from cablelab.errors import CablelabError
     from cablelab.plants.crane.kinematics import boom_tip
-    from cablelab.plants.crane.plant import check_measurements
+    from cablelab.plants.crane.dataset import check_measurements
 
     rng = np.random.default_rng(seed)
     t = np.linspace(0, 20, 400)

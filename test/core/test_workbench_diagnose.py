@@ -94,7 +94,8 @@ def test_whiteness_band_and_cross_correlation_lag():
 
 
 def test_simulation_fit_recovers_axis_parameters_with_both_objectives():
-    from cablelab.plants.axis.plant import dataset_from_arrays, fit_free_run
+    from cablelab.plants.axis.dataset import dataset_from_arrays
+    from cablelab.plants.axis.freerun import fit_free_run
     from cablelab.plants.axis.sim import AxisTruth
     from cablelab.plants.axis.truth import simulate_axis
 
@@ -120,7 +121,7 @@ def test_typed_diagnosis_is_the_ranking_once_reshaped():
     from cablelab.diagnose import rank_candidates
     from cablelab.diagnose.result import ROW_KEYS, Diagnosis
     from cablelab.model import Model
-    from cablelab.plants.axis.plant import dataset_from_arrays
+    from cablelab.plants.axis.dataset import dataset_from_arrays
     from cablelab.workbench import diagnose
 
     rng = np.random.default_rng(1)

@@ -76,7 +76,7 @@ def test_bounded_least_squares_keeps_physical_sign():
 
 
 def _axis_data(t, q, f, **kw):
-    from cablelab.plants.axis.plant import dataset_from_arrays
+    from cablelab.plants.axis.dataset import dataset_from_arrays
 
     return dataset_from_arrays(t, q, f, PRISMATIC, kw.get("options"))
 

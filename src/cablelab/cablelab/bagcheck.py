@@ -29,7 +29,7 @@ class BagCheck:
             measured velocities that contradict their positions).
         derived_velocity: topic -> joint names whose measured velocity contradicts the
             derivative of their position (:func:`velocity_checks`): the plants' datasets derive
-            those velocities from the positions instead (``options["derived_velocity"]``).
+            those velocities from the positions instead (``DatasetOptions.derived_velocity``).
     """
 
     reports: dict = field(default_factory=dict)
@@ -61,7 +61,7 @@ def _stamps_and_values(bag, topic: str, msgtype: str):
     return None
 
 
-def check_bag(bag, plant, desc, options: dict | None = None, limits: Limits = Limits()) -> BagCheck:
+def check_bag(bag, plant, desc, options=None, limits: Limits = Limits()) -> BagCheck:
     """Check the topics ``plant`` reads from ``bag`` against ``desc``.
 
     Raises:
@@ -69,7 +69,9 @@ def check_bag(bag, plant, desc, options: dict | None = None, limits: Limits = Li
             joint or cable names that do not match the description (one line naming the bag,
             topic and both counts).
     """
-    options = options or {}
+    from .plant_interface import DatasetOptions
+
+    options = DatasetOptions.build(plant, options)   # a DatasetOptions, or a mapping of its fields
     out = BagCheck()
     if getattr(desc, plant.name, "absent") is None:     # e.g. "axis: null" parses to no section
         raise CablelabError(f"{bag.path}: plant description for plant {plant.name} has no '{plant.name}' "

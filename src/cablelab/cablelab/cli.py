@@ -40,6 +40,18 @@ class OneLineParser(argparse.ArgumentParser):
     def error(self, message):
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
+    def defer(self, add) -> None:
+        """Call ``add(self)`` just before this parser parses: options that cost an import to know
+        (the plants' own, :func:`cablelab.commands._workbench_args.add_plant_options`) are only
+        looked up for the verb being run (its ``--help`` included), not for every verb."""
+        self._deferred = [*getattr(self, "_deferred", ()), add]
+
+    def parse_known_args(self, args=None, namespace=None):
+        deferred, self._deferred = getattr(self, "_deferred", ()), []
+        for add in deferred:
+            add(self)
+        return super().parse_known_args(args, namespace)
+
 
 def build_parser() -> argparse.ArgumentParser:
     parser = OneLineParser(

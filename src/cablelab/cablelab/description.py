@@ -17,6 +17,7 @@ import numpy as np
 import yaml
 
 from .errors import CablelabError
+from .fields import check_keys, fail, mapping, number
 
 #: keys of the description's top level besides the plant sections
 COMMON_KEYS = ("plant", "name", "gravity")
@@ -58,15 +59,6 @@ class Description:
     def to_yaml(self) -> str:
         """The description as YAML (the original text when it was loaded from text)."""
         return self.yaml_text or dump_description(self)
-
-
-# ----------------------------------------------------------------------------- validation helpers
-# (the public validators are cablelab.fields; these names stay for plants written against them)
-from .fields import check_keys as _check_keys  # noqa: E402
-from .fields import fail as _fail  # noqa: E402
-from .fields import mapping as _mapping  # noqa: E402
-from .fields import number as _number  # noqa: E402
-from .fields import vector as _vector  # noqa: E402
 
 
 # ----------------------------------------------------------------------------- YAML 1.2 reading
@@ -123,30 +115,29 @@ def read_yaml(text: str):
 def parse_description(data: Any, source: str = "description") -> Description:
     """Validate an already-parsed YAML mapping; ``source`` prefixes nothing, it is for messages.
 
-    Each plant section is parsed by its plant's ``section`` function (found through
+    Each plant section is parsed by its plant's ``parse_section`` (found through
     :mod:`cablelab.registry`); the section of the plant named by ``plant`` is required."""
     from .registry import available_plants, get_plant
 
-    data = _mapping(data, source)
+    data = mapping(data, source)
     plants = tuple(available_plants())
-    _check_keys(data, "", ("plant",), COMMON_KEYS[1:] + plants)
+    check_keys(data, "", ("plant",), COMMON_KEYS[1:] + plants)
     plant = data["plant"]
     if plant not in plants:
-        raise _fail("plant", f"unknown plant {plant!r} (expected one of {', '.join(plants)})")
+        raise fail("plant", f"unknown plant {plant!r} (expected one of {', '.join(plants)})")
     name = data.get("name", "")
     if name is None:
         name = ""
     if not isinstance(name, str):
-        raise _fail("name", f"expected text, got {name!r}")
-    gravity = _number(data, "gravity", "", nonneg=True, default=9.81)
-    parser = get_plant(plant).section
-    if parser is not None and data.get(plant) is None:
-        raise _fail(plant, "missing required key (the section of the plant named by 'plant')")
+        raise fail("name", f"expected text, got {name!r}")
+    gravity = number(data, "gravity", "", nonneg=True, default=9.81)
+    get_plant(plant)
+    if data.get(plant) is None:
+        raise fail(plant, "missing required key (the section of the plant named by 'plant')")
     sections: dict[str, Any] = {}
     for key in plants:
         if key in data and data[key] is not None:
-            parse = get_plant(key).section
-            sections[key] = parse(data[key]) if parse is not None else _mapping(data[key], key)
+            sections[key] = get_plant(key).parse_section(data[key])
     return Description(plant=plant, name=name, gravity=gravity, sections=sections)
 
 
@@ -195,7 +186,7 @@ def plain(obj: Any) -> Any:
     """``obj`` with numpy arrays, dataclasses and tuples turned into YAML-ready lists/mappings
     (``None`` fields of dataclasses dropped)."""
     if isinstance(obj, np.ndarray):
-        return [float(x) for x in obj]
+        return np.asarray(obj, dtype=float).tolist()      # any shape (e.g. two 3-vectors)
     if dataclasses.is_dataclass(obj):
         return {k: plain(getattr(obj, k)) for k in (f.name for f in dataclasses.fields(obj))
                 if getattr(obj, k) is not None}

@@ -215,14 +215,17 @@ class ResidualMonitor:
             conditioning border away from its end: the detection delay's floor).
         hold: seconds outside the band before an alarm. band_sigma: band = band_sigma x the
             residual RMS (calibration). calibrate: seconds of stream the calibration fits on.
-        options: plant options (``tensions`` ...), as the command line's.
+        options: plant options by name (``tensions`` ...), as the command line's; those the plant
+            does not have are left out (the monitor node offers the CDPR's for every plant).
     """
 
     def __init__(self, plant_name: str, desc, model: MonitorModel, *, window: float = 3.0,
                  hold: float = 0.5, band_sigma: float = 4.0, calibrate: float = 10.0,
                  error_factor: float = 3.0, options: dict | None = None):
-        from .conditioning import Conditioning
+        import dataclasses
+
         from .model import Model
+        from .plant_interface import DatasetOptions
         from .registry import get_plant
 
         self.plant = get_plant(plant_name)
@@ -232,7 +235,9 @@ class ResidualMonitor:
         self.band_by_channel = model.band
         self.window, self.hold, self.band_sigma = float(window), float(hold), float(band_sigma)
         self.calibrate_s, self.error_factor = float(calibrate), float(error_factor)
-        self.options = {"conditioning": Conditioning(), **dict(options or {})}
+        own = {f.name for f in dataclasses.fields(self.plant.options_type)} if self.plant.options_type else set()
+        self.options = DatasetOptions.build(self.plant, {k: v for k, v in dict(options or {}).items()
+                                                         if k in own})
         self.topics = self.input_topics(self.plant)
         self.stream = StreamWindow(self.topics, max(self.window, self.calibrate_s if self.params is None else 0.0),
                                    required=[t for t, _ in self.plant.topics])
@@ -259,7 +264,7 @@ class ResidualMonitor:
         return self.stream.add(topic, data)
 
     def _dataset(self):
-        return self.plant.dataset(self.stream.bag(), self.desc, dict(self.options))
+        return self.plant.dataset(self.stream.bag(), self.desc, self.options)
 
     def _calibrate(self) -> None:
         from .fit import identify

@@ -6,106 +6,38 @@ another distribution is announced by an entry point in the group ``cablelab.plan
 (``myplant = mypackage.myplant``). Importing the package registers its :class:`Plant` with
 :func:`register_plant` (and its effects with :func:`cablelab.effects.register`). No module of the
 core names a plant: the description loader, the topic sets, the recorder, the importer, the
-workbench and the node executables all ask this registry (see docs/architecture.md).
+workbench and the node executables all ask this registry (see docs/architecture.md). What a plant
+must offer is :class:`~cablelab.plant_interface.PlantInterface`, checked at registration.
 """
 from __future__ import annotations
 
 import importlib
 import importlib.util
 import pkgutil
-from dataclasses import dataclass, field
-from typing import Callable, Mapping
 
 from .errors import CablelabError
+from .plant_interface import Plant, PlantInterface, missing_members
 
 #: entry-point group under which other distributions announce plant packages
 ENTRY_POINT_GROUP = "cablelab.plants"
 #: the package holding cablelab's own plants (one subpackage each)
 BUILTIN_PACKAGE = "cablelab.plants"
 
-_REGISTRY: dict[str, "Plant"] = {}
+_REGISTRY: dict[str, PlantInterface] = {}
 
 
-@dataclass(frozen=True)
-class Plant:
-    """A plant as seen by the workbench, the description loader, the recorder and the nodes.
+def register_plant(plant: PlantInterface) -> PlantInterface:
+    """Register a plant (at import of its package). Returns it.
 
-    Args:
-        name: plant id (``axis``, ``crane``, ``cdpr``, ...) = ``description.plant`` = the name
-            of its description section.
-        topics: ``(topic, type)`` pairs a bag must hold for the workbench (checked first).
-        dataset: ``fn(bag, description, options) -> Dataset``: conditioned signals, output
-            channels, actuator map and velocities, regimes. ``options`` is a dict of plant options
-            from the command line (``{"conditioning": Conditioning, "tensions": "dynamometer"}``).
-        baseline: ``fn(description) -> tuple of effect ids`` of the nominal model.
-        candidates: ``fn(description) -> tuple of effect ids`` that diagnose may try (the model's
-            own effects are skipped).
-        channels_doc: one line describing the output channels (for docs and reports).
-        simulate: optional free-run comparison ``fn(ds, params) -> dict`` shown by ``compare``.
-        simulation_fit: optional simulation-based fit ``fn(ds, start_params, *, objective,
-            progress=False) -> SimulationFit`` (``identify --simulation nmse|pearson``).
-        section: ``fn(mapping) -> dataclass``: parses and validates the plant's section of the
-            description YAML (CONTRACT section 3), one-line errors naming the key path.
-        dump_section: optional ``fn(dataclass) -> mapping`` (default: the dataclass fields).
-        contract_topics: every topic (name -> type) a recording of the plant holds (CONTRACT
-            section 2 plus documented additions), without /clock and /plant_description.
-        joint_topic: the JointState topic ``cablelab import`` writes, with ``joints`` its names.
-        joints: joint names on ``joint_topic`` (None when they depend on the description).
-        capabilities: what the plant's datasets offer to generic effects, e.g.
-            ``"joint_actuators"`` (per-joint actuator velocities and efforts: joint friction and
-            the like), ``"winch_actuators"`` (CDPR winch motors).
-        estimate: optional ``fn(bag, desc, **options) -> Estimate`` for ``cablelab estimate``
-            (an object with ``summary() -> dict``, or a dict).
-        checked_topics: topics besides ``topics`` whose time base is checked when present.
-        check_bag: optional ``fn(bag, desc, options, series) -> list of warnings`` run before
-            every fit (:func:`cablelab.bagcheck.check_bag`; ``series``: topic -> decoded series):
-            names against the description (one-line errors), physically impossible values.
-        options: the plant-specific command-line options it reads, by ``argparse`` dest
-            (``("tensions", "pose")`` for the CDPR); a verb refuses such an option given for a
-            bag of another plant (one line naming the option and the plants it belongs to).
-        package: the Python package of the plant (filled in by :func:`get_plant`).
-        remeasure: optional ``fn(ds, shifted) -> Dataset`` used by ``time_delay``
-            (:mod:`cablelab.effects.delay`) when the output channels are raw measurements mapped
-            through a motion-dependent matrix (CDPR: wrench = W(pose) x measured tensions):
-            ``shifted`` has every motion signal at ``t - tau``; the hook puts the raw
-            measurement back unshifted and re-forms ``y`` and the signals computed from it
-            with the map of the time the measurement belongs to. None: nothing to re-form.
-        channels: the output channel names of the plant's datasets (``Dataset.channels`` with the
-            default options), for layouts (:mod:`cablelab.layouts`).
-        topic_names: optional ``fn(description or None) -> {topic: element names}`` of the
-            plant's JointState topics whose names the contract fixes (None: the default machine).
-        markers: optional ``fn(bag, description) -> (t, frames) | None``: the machine in 3D along
-            a recording for the overlay bag (:mod:`cablelab.markers`; ``frames`` one list of
-            marker dicts per time), None when the bag lacks what it needs.
+    Raises:
+        CablelabError: ``plant`` does not satisfy :class:`~cablelab.plant_interface.PlantInterface`
+            (one line naming what it lacks).
     """
-
-    name: str
-    topics: tuple[tuple[str, str], ...]
-    dataset: Callable
-    baseline: Callable
-    candidates: Callable
-    channels_doc: str = ""
-    simulate: Callable | None = None
-    simulation_fit: Callable | None = None
-    section: Callable | None = None
-    dump_section: Callable | None = None
-    contract_topics: Mapping[str, str] = field(default_factory=dict)
-    joint_topic: str = ""
-    joints: tuple[str, ...] | None = None
-    capabilities: frozenset = frozenset()
-    estimate: Callable | None = None
-    checked_topics: tuple[str, ...] = ()
-    check_bag: Callable | None = None
-    package: str = ""
-    remeasure: Callable | None = None
-    markers: Callable | None = None
-    channels: tuple[str, ...] = ()
-    topic_names: Callable | None = None
-    options: tuple[str, ...] = ()
-
-
-def register_plant(plant: Plant) -> Plant:
-    """Register a plant (at import of its package). Returns it, for module-level use."""
+    missing = missing_members(plant)
+    if missing:
+        name = getattr(plant, "name", None)
+        raise CablelabError(f"plant {name!r} does not satisfy the plant interface "
+                            f"(cablelab.plant_interface.PlantInterface): it lacks {', '.join(missing)}")
     _REGISTRY[plant.name] = plant
     return plant
 
@@ -155,7 +87,7 @@ def available_plants() -> list[str]:
     return sorted(plant_packages())
 
 
-def get_plant(name: str) -> Plant:
+def get_plant(name: str) -> PlantInterface:
     """The registered plant ``name``, importing its package on first use.
 
     Raises:
@@ -170,10 +102,14 @@ def get_plant(name: str) -> Plant:
         if name not in _REGISTRY:
             raise CablelabError(f"plant package {package} registers no plant {name!r}")
     if not _REGISTRY[name].package:
-        from dataclasses import replace
+        import dataclasses
 
-        package = _discovered().get(name) or _REGISTRY[name].dataset.__module__.rsplit(".", 1)[0]
-        _REGISTRY[name] = replace(_REGISTRY[name], package=package)
+        plant = _REGISTRY[name]
+        package = _discovered().get(name) or plant.dataset.__module__.rsplit(".", 1)[0]
+        if dataclasses.is_dataclass(plant):
+            _REGISTRY[name] = dataclasses.replace(plant, package=package)
+        else:
+            plant.package = package
     return _REGISTRY[name]
 
 
@@ -183,5 +119,5 @@ def plant_module(name: str, module: str):
     return importlib.import_module(f"{plant.package}.{module}")
 
 
-__all__ = ["ENTRY_POINT_GROUP", "Plant", "available_plants", "get_plant", "plant_module",
+__all__ = ["ENTRY_POINT_GROUP", "Plant", "PlantInterface", "available_plants", "get_plant", "plant_module",
            "plant_packages", "register_plant"]

@@ -7,7 +7,8 @@ description file) into (plant, description, dataset), :func:`build_model` a plan
 """
 from __future__ import annotations
 
-from typing import Sequence
+import dataclasses
+from typing import Mapping, Sequence
 
 import numpy as np
 
@@ -19,11 +20,16 @@ from .errors import CablelabError
 from .fit import identify as _identify
 from .fit.threads import blas_single
 from .model import Dataset, Model
+from .plant_interface import DatasetOptions
 
 
-def load(bag_path, description_path=None, options: dict | None = None):
+def load(bag_path, description_path=None, options: DatasetOptions | Mapping | None = None):
     """Open a bag, read its description (or the given file), check the plant's topics and build
     the plant's dataset (:func:`load_checked` without its check report).
+
+    ``options``: a :class:`~cablelab.plant_interface.DatasetOptions`, or a mapping of its fields
+    and the plant's own options (``{"conditioning": ..., "tensions": "motor"}``,
+    :meth:`DatasetOptions.build`); None: the defaults.
 
     Returns:
         ``(plant, description, dataset)``.
@@ -34,7 +40,7 @@ def load(bag_path, description_path=None, options: dict | None = None):
     return plant, desc, ds
 
 
-def load_checked(bag_path, description_path=None, options: dict | None = None, *,
+def load_checked(bag_path, description_path=None, options: DatasetOptions | Mapping | None = None, *,
                  recover: bool = False, before_dataset=None, limits=None):
     """:func:`load` with the input checks of :mod:`cablelab.bagcheck`: time base of every topic
     the plant reads (gaps, clock jumps, stamps out of order, NaN samples), description vs bag
@@ -74,8 +80,9 @@ def load_checked(bag_path, description_path=None, options: dict | None = None, *
         bag.require(topic, msgtype)
     from .timebase import Limits
 
+    options = DatasetOptions.build(plant, options)
     check = check_bag(bag, plant, desc, options, limits or Limits())
-    ds = plant.dataset(bag, desc, {**(options or {}), "derived_velocity": check.derived_velocity})
+    ds = plant.dataset(bag, desc, dataclasses.replace(options, derived_velocity=check.derived_velocity))
     check.warnings.extend(ds.signals.get("load_warnings") or ())   # e.g. too slow for its motion
     # drives that stop: every plant with friction-bearing actuators (joint or winch drives)
     # leaves its zero-speed zone out of the fits (cablelab.velocity; a plant may have applied it
@@ -86,8 +93,7 @@ def load_checked(bag_path, description_path=None, options: dict | None = None, *
     if drives and "zero_speed_zone" not in ds.signals:
         ds = exclude_zero_speed(ds)
     if check.gaps:
-        cond = (options or {}).get("conditioning")
-        border = getattr(cond, "border", 50)
+        border = options.conditioning.border
         period = min(r.period for r in check.reports.values() if np.isfinite(r.period))
         keep = check.mask(ds.t, border * period)
         ds.valid = np.asarray(ds.valid, dtype=bool) & keep

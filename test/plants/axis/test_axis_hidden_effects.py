@@ -10,7 +10,7 @@ from cablelab.description import load_description
 from cablelab.diagnose import greedy, rank_candidates
 from cablelab.model import Model
 from cablelab.plants import get_plant
-from cablelab.plants.axis.plant import dataset_from_arrays
+from cablelab.plants.axis.dataset import dataset_from_arrays
 from cablelab.plants.axis.sim import AxisTruth
 from cablelab.plants.axis.truth import simulate_axis
 

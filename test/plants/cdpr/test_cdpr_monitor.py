@@ -58,6 +58,8 @@ def test_monitor_on_the_reference_run_fits_and_matches_the_batch_prediction():
     from cablelab.bags import open_bag
     from cablelab.conditioning import Conditioning
     from cablelab.model import Model
+    from cablelab.plant_interface import DatasetOptions
+    from cablelab.plants.cdpr.options import CdprOptions
     from cablelab.monitor import MonitorModel, ResidualMonitor
     from cablelab.registry import get_plant
 
@@ -72,7 +74,7 @@ def test_monitor_on_the_reference_run_fits_and_matches_the_batch_prediction():
     assert mon.params["m"] == pytest.approx(488.0, rel=0.02)
     # batch oracle: the workbench's dataset of the whole recording with the same parameters
     plant = get_plant("cdpr")
-    ds = plant.dataset(bag, bag.description, {"conditioning": Conditioning(), "tensions": "dynamometer"})
+    ds = plant.dataset(bag, bag.description, DatasetOptions(Conditioning(), plant=CdprOptions("dynamometer")))
     y_hat, valid = Model("cdpr", tuple(plant.baseline(bag.description))).predict(ds, mon.params)
     pred = np.concatenate([s.prediction for s in out])
     j = np.searchsorted(ds.t, t)

@@ -49,7 +49,7 @@ def run_json(capsys, *argv):
 
 def rms_error_percent(capsys, bag, *args):
     """Per-sample mass error of the estimate vs the truth in the bag: (mean %, rms %)."""
-    from cablelab.plants.cdpr.plant import estimate_bag
+    from cablelab.plants.cdpr.estimate import estimate_bag
     eff = args[args.index("--effects") + 1].split(",") if "--effects" in args else ()
     ten = args[args.index("--tensions") + 1] if "--tensions" in args else "dynamometer"
     est = estimate_bag(bag, tensions=ten, effects=[e for e in eff if e])

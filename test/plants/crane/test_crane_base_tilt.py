@@ -14,7 +14,8 @@ from cablelab.plants.crane import kinematics as kin
 from cablelab.plants.crane import plant as C
 from cablelab.plants.crane.effects import BASE_TILT, tilt_masses
 from cablelab.plants.crane.model import CraneParams, gravity_vector
-from cablelab.plants.crane.sim import CraneTruth, build_model, gravity_in_base, set_state
+from cablelab.plants.crane.mjcf import build_mjcf
+from cablelab.plants.crane.sim import CraneTruth, gravity_in_base, set_state
 
 DESC = load_description(C.__file__.replace("plant.py", "data/crane.yaml"))
 P = CraneParams.from_description(DESC)
@@ -69,7 +70,7 @@ def test_mujoco_tilted_crane_at_rest_matches_the_angles(tilt, alpha, beta):
     exactly (the vertical gravity gives no slew torque); luff torque = vertical-gravity model +
     effect up to the second-order change of the vertical gravity."""
     truth = CraneTruth(params=P, base_tilt=tilt)
-    model = build_model(truth)
+    model = build_mjcf(truth)
     data = mujoco.MjData(model)
     d = 0.6
 

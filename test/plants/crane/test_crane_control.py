@@ -5,7 +5,8 @@ import mujoco
 
 from cablelab.plants.crane.control import Gains, control_law, hold_command
 from cablelab.plants.crane.model import CraneParams
-from cablelab.plants.crane.sim import CraneTruth, build_model, contract_to_qpos, simulate
+from cablelab.plants.crane.mjcf import build_mjcf
+from cablelab.plants.crane.sim import CraneTruth, contract_to_qpos, simulate
 
 P = CraneParams()
 
@@ -13,7 +14,7 @@ P = CraneParams()
 def test_feedforward_equals_mujoco_inverse_dynamics_at_zero_velocity():
     """With q = q_ref, qd = qd_ref = 0 the law is G_a(q) + M_aa(q) qdd_ref: MuJoCo's mj_inverse for
     that acceleration with the swing held (swing accelerations 0) gives the same actuated efforts."""
-    model = build_model(CraneTruth(params=P))
+    model = build_mjcf(CraneTruth(params=P))
     data = mujoco.MjData(model)
     rng = np.random.default_rng(5)
     for _ in range(20):
@@ -34,7 +35,7 @@ def test_feedforward_equals_mujoco_inverse_dynamics_at_zero_velocity():
 def test_hold_command_holds_the_crane_still():
     q = np.array([[0.3, 0.6, 0.8]])
     u = hold_command(q, np.zeros((1, 3)), P)
-    model = build_model(CraneTruth(params=P))
+    model = build_mjcf(CraneTruth(params=P))
     data = mujoco.MjData(model)
     data.qpos[:] = contract_to_qpos([0.3, 0.6, 0.8, 0.0, 0.0])[0]
     data.ctrl[:] = u[0]

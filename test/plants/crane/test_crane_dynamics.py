@@ -6,7 +6,8 @@ import mujoco
 
 from cablelab.plants.crane import symbolic as crane_symbolic
 from cablelab.plants.crane.model import CraneParams, inverse_dynamics, mass_matrix, gravity_vector, regressor
-from cablelab.plants.crane.sim import CraneTruth, build_model, simulate
+from cablelab.plants.crane.mjcf import build_mjcf
+from cablelab.plants.crane.sim import CraneTruth, simulate
 
 PARAMS = CraneParams(boom_length=1.2, payload_mass=0.7, boom_mass=1.3, counterbalance_mass=2.1,
                      counterbalance_distance=0.35, slew_inertia=0.08, luff_inertia=0.03, gravity=9.81)
@@ -72,7 +73,7 @@ def _mujoco_to_contract_map():
 
 def test_mujoco_inverse_dynamics_equals_symbolic_eom():
     """mj_inverse of the MuJoCo crane == Y(q, qd, qdd) pi from 002's energies, over random states."""
-    model = build_model(CraneTruth(params=PARAMS))
+    model = build_mjcf(CraneTruth(params=PARAMS))
     data = mujoco.MjData(model)
     h, J, Jdv = _mujoco_to_contract_map()
     rng = np.random.default_rng(7)
@@ -101,7 +102,7 @@ def test_regressor_reproduces_simulated_torques_exactly():
     """On a closed-loop MuJoCo run, Y pi == measured motor efforts and 0 on the swing rows."""
     truth = CraneTruth(params=PARAMS)
     res = simulate(truth, 4.0, decimate=20)
-    model = build_model(truth)
+    model = build_mjcf(truth)
     data = mujoco.MjData(model)
     h, J, Jdv = _mujoco_to_contract_map()
     q, qd, qdd, tau = [], [], [], []

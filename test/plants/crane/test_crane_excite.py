@@ -16,7 +16,7 @@ from cablelab.cli import main
 from cablelab.diagnose.identifiability import correlations
 from cablelab.excite import get_exciter, read_reference
 from cablelab.fit import identify
-from cablelab.plants.crane.plant import REFERENCE
+from cablelab.plants.crane.topics import REFERENCE
 from cablelab.plants.crane.sim import CraneTruth, simulate, write_bag
 from cablelab.workbench import build_model, load
 

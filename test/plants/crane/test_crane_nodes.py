@@ -78,7 +78,7 @@ def test_adapters_survive_nan_wrong_length_stale(ros_context):
 
 def test_crane_nodes_over_dds(launcher, tmp_path):
     from cablelab.bags import open_bag
-    from cablelab.plants.crane import plant as C
+    from cablelab.plants.crane import estimate as C
 
     bag_dir = tmp_path / "run"
     launcher.start("recorder", [sys.executable, "-m", "cablelab.cli", "record", "--plant", "crane",

@@ -8,6 +8,7 @@ from cablelab.description import load_description
 from cablelab.diagnose import rank_candidates
 from cablelab.fit import identify
 from cablelab.model import Model
+from cablelab.plants.crane import dataset as CD
 from cablelab.plants.crane import plant as C
 from cablelab.plants.crane.model import CraneParams
 from cablelab.plants.crane.sim import CraneTruth, gravity_in_base, reference_trajectory, simulate
@@ -23,7 +24,7 @@ KNOWN_LC = {"l_c": DESC.crane.counterbalance.distance}
 def _dataset(truth, desc, seed, duration=50.0):
     r = simulate(truth, duration, decimate=10, seed=seed,
                  reference=partial(reference_trajectory, base_freq=0.08, seed=seed))
-    return C.dataset_from_arrays(r.t, r.q[:, :3], r.effort, r.t, r.tip, r.payload, desc)
+    return CD.dataset_from_arrays(r.t, r.q[:, :3], r.effort, r.t, r.tip, r.payload, desc)
 
 
 def _hold(t):

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from cablelab.plants.leg.controller import ApexController, next_apex
+from cablelab.plants.leg.control import ApexController, next_apex
 from cablelab.plants.leg.estimator import HopEstimator, estimate_series
 from cablelab.plants.leg.hybrid import STANCE, LegParams, flight_apex, grf
 from cablelab.plants.leg.sim import LegSim, open_loop, simulate

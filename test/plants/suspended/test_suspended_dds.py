@@ -17,7 +17,7 @@ import numpy as np
 
 from cablelab.bags import open_bag
 from cablelab.bags.reader import recorder_lost
-from cablelab.plants.suspended.controller import ArmGravity, fig7_excitation, gains, pd_gravity
+from cablelab.plants.suspended.control import ArmGravity, fig7_excitation, gains, pd_gravity
 from cablelab.plants.suspended.params import parameter_set
 from cablelab.rotations import quat_to_matrix, xyzw_to_wxyz
 

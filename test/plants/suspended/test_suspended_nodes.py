@@ -145,7 +145,7 @@ def test_controller_node_law_sway_offset_and_bad_input(ros_context):
     from sensor_msgs.msg import JointState
     from std_msgs.msg import Float64MultiArray
 
-    from cablelab.plants.suspended.controller import ArmGravity, gains, pd_gravity, sway_offset
+    from cablelab.plants.suspended.control import ArmGravity, gains, pd_gravity, sway_offset
     from cablelab.plants.suspended.params import parameter_set
     from cablelab.ros import convert
     from cablelab.ros.qos import catch_up_qos, publisher_qos

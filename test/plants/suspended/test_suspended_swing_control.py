@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from scipy.ndimage import maximum_filter1d
 
-from cablelab.plants.suspended.controller import (ArmGravity, fig7_excitation, gains, pd_gravity,
+from cablelab.plants.suspended.control import (ArmGravity, fig7_excitation, gains, pd_gravity,
                                                     sway_offset)
 from cablelab.plants.suspended.mjcf import build_truth, build_virtual
 from cablelab.plants.suspended.params import parameter_set

@@ -42,35 +42,62 @@ def add_overwrite(p) -> None:
     p.add_argument("--overwrite", action="store_true", help="replace an existing output")
 
 
-def add_tensions(p) -> None:
-    p.add_argument("--tensions", choices=("dynamometer", "motor", "both"), default=None,
-                   help="CDPR only: cable tensions from the dynamometers (default), from the motor "
-                        "torques, or both (dynamometer wrench + per-winch torque balance against "
-                        "the motor torques)")
+def plant_cli_options(verb: str | None = None) -> dict:
+    """The command-line options plants declare (:func:`cablelab.plant_interface.option` fields of
+    their ``options_type``): flag -> ``(dest, CliOption, owners)``, ``owners`` the plants that
+    declare it; only those ``verb`` offers (None: every verb's)."""
+    from ..errors import CablelabError
+    from ..plant_interface import cli_options
+    from ..registry import available_plants, get_plant
+
+    found: dict = {}
+    for name in available_plants():
+        try:
+            plant = get_plant(name)
+        except CablelabError:
+            continue
+        for dest, spec in cli_options(plant.options_type):
+            if verb is None or verb in spec.verbs:
+                found.setdefault(spec.flag, (dest, spec, []))[2].append(name)
+    return found
 
 
-#: options that only some plants read: dest -> option as typed (see Plant.options)
-PLANT_OPTIONS = {"tensions": "--tensions", "pose": "--pose"}
+def add_plant_options(p, verb: str) -> None:
+    """The options the plants add to ``verb`` (e.g. the CDPR's ``--tensions``), each once, its
+    help naming the plants it belongs to; not given = None (the plant's default applies).
+
+    Knowing them imports every plant, so a parser that can defer (:class:`cablelab.cli.OneLineParser`)
+    adds them only when it parses: the other verbs do not pay for the import."""
+    def add(parser) -> None:
+        group = parser.add_argument_group("plant options")
+        for flag, (dest, spec, owners) in sorted(plant_cli_options(verb).items()):
+            kw = {"choices": spec.choices} if spec.choices else {"metavar": "VALUE"}
+            group.add_argument(flag, dest=dest, default=None,
+                               help=f"{' / '.join(owners)} only: {spec.help}", **kw)
+
+    if hasattr(p, "defer"):
+        p.defer(add)
+    else:
+        add(p)
+
+
+def plant_option_values(args) -> dict:
+    """dest -> value of every plant option given on the command line (for
+    :meth:`~cablelab.plant_interface.DatasetOptions.build`)."""
+    return {dest: getattr(args, dest) for dest, _, _ in plant_cli_options().values()
+            if getattr(args, dest, None) is not None}
 
 
 def check_plant_options(args, plant) -> None:
     """A plant-specific option given for a bag of another plant is an error (it would be
     silently ignored): one line naming the option and the plants it belongs to."""
     from ..errors import CablelabError
-    from ..registry import available_plants, get_plant
 
-    for dest, flag in PLANT_OPTIONS.items():
-        if getattr(args, dest, None) is None or dest in plant.options:
+    for flag, (dest, _, owners) in plant_cli_options().items():
+        if getattr(args, dest, None) is None or plant.name in owners:
             continue
-        owners = []
-        for name in available_plants():
-            try:
-                if dest in get_plant(name).options:
-                    owners.append(name)
-            except CablelabError:
-                continue
         raise CablelabError(f"{flag} {getattr(args, dest)}: an option of plant "
-                            f"{' / '.join(owners) or 'none'} only, and {args.bag} holds plant "
+                            f"{' / '.join(owners)} only, and {args.bag} holds plant "
                             f"{plant.name} (leave {flag} out)")
 
 
@@ -78,7 +105,9 @@ def add_json(p) -> None:
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
 
 
-def add_common(p, *, effects_required: bool = False) -> None:
+def add_common(p, verb: str, *, effects_required: bool = False) -> None:
+    """The options of the workbench verbs (compare, diagnose, identify, report), with the plant
+    options ``verb`` offers."""
     add_bag(p)
     p.add_argument("--effects", metavar="A,B", default="", required=effects_required,
                    help="effects added to the plant's nominal model (ids: docs/interface.md section 3)")
@@ -86,7 +115,7 @@ def add_common(p, *, effects_required: bool = False) -> None:
                    help="replace the plant's nominal effects ('none' = empty model)")
     p.add_argument("--fix", metavar="NAME=VALUE", action="append", default=[],
                    help="known parameter moved to the left-hand side (repeatable)")
-    add_tensions(p)
+    add_plant_options(p, verb)
     add_strict(p)
     p.add_argument("--cutoff", type=number(gt=0, unit="Hz"), metavar="HZ", default=None,
                    help="zero-phase Butterworth cut-off for positions (default fs/10)")
@@ -194,7 +223,7 @@ def load_from_args(args, *, check_out: bool = False):
 
         check_target(args.out, overwrite=args.overwrite, inputs=[args.bag, args.description])
 
-    options = {"conditioning": conditioning_from_args(args), "tensions": args.tensions}
+    options = {"conditioning": conditioning_from_args(args), **plant_option_values(args)}
     plant, desc, ds, check = load_checked(args.bag, args.description, options,
                                           recover=getattr(args, "recover", False),
                                           before_dataset=lambda p: check_plant_options(args, p),

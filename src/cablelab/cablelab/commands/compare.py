@@ -9,7 +9,7 @@ HELP = "compare the model (nominal effects + --effects, fitted) with the measure
 
 
 def add_arguments(p) -> None:
-    add_common(p)
+    add_common(p, "compare")
     p.add_argument("--segments", type=number(ge=1, le=1000, integer=True), default=5,
                    help="number of worst segments to list")
     add_overlay_out(p)

@@ -10,7 +10,7 @@ HELP = "rank the missing physical effects by held-out error (blocked k-fold), --
 
 
 def add_arguments(p) -> None:
-    add_common(p)
+    add_common(p, "diagnose")
     add_folds(p)
     p.add_argument("--candidates", metavar="A,B", default=None,
                    help="effects to try (default: every effect applicable to the plant)")

@@ -1,7 +1,8 @@
-"""``cablelab estimate BAG [--tensions {dynamometer,motor}] [--effects a,b] [--out BAG2] --json``.
+"""``cablelab estimate BAG [plant options] [--effects a,b] [--out BAG2] --json``.
 
 Dispatches on the plant of the bag's description to its registered ``estimate(bag,
-description, tensions=..., effects=..., pose=..., out=...)``, which returns a dict or an object
+description, effects=..., out=..., derived_velocity=..., <the plant's own options>)`` (CDPR:
+``tensions=..., pose=...``), which returns a dict or an object
 with ``summary() -> dict`` (CONTRACT section 5: cdpr ``{"plant", "samples", "mass": {"mean",
 "std", "max_abs_dev"}, "com": {"x", "y"}}``; crane: swing-angle statistics).
 """
@@ -10,20 +11,18 @@ from __future__ import annotations
 import inspect
 
 from ..errors import CablelabError
-from ._workbench_args import (add_bag, add_json, add_overwrite, add_tensions, check_plant_options,
-                              dump_json, limits_from_args, with_warnings)
+from ._workbench_args import (add_bag, add_json, add_overwrite, add_plant_options, check_plant_options,
+                              dump_json, limits_from_args, plant_option_values, with_warnings)
 
 HELP = "estimate the payload (CDPR mass and CoM) or the swing (crane) per sample from a bag"
 
 
 def add_arguments(p) -> None:
     add_bag(p)
-    add_tensions(p)
+    add_plant_options(p, "estimate")
     p.add_argument("--effects", metavar="A,B", default="",
                    help="effects added to the plant's nominal model (e.g. pulley_geometry, "
                         "platform_inertia, winch_coulomb_friction)")
-    p.add_argument("--pose", choices=("desired", "measured"), default=None,
-                   help="CDPR only: pose for the wrench matrix (default desired, as 001)")
     p.add_argument("--out", metavar="BAG2", help="also write the per-sample estimates as a bag")
     add_overwrite(p)
     add_json(p)
@@ -46,11 +45,13 @@ def _without_gaps(res, check):
 
 def run(args) -> int:
     import contextlib
+    import dataclasses
 
     from ..atomic import atomic_output, check_target
     from ..bagcheck import check_bag
     from ..bags import open_bag
     from ..model import parse_effect_list
+    from ..plant_interface import DatasetOptions
     from ..registry import available_plants, get_plant
     from ..workbench import load_bag_description
 
@@ -60,16 +61,17 @@ def run(args) -> int:
     desc = load_bag_description(args.bag, args.description, bag)
     plant = get_plant(desc.plant)
     check_plant_options(args, plant)
-    args.check = check_bag(bag, plant, desc, {"tensions": args.tensions, "pose": args.pose},
-                           limits_from_args(args))
+    options = DatasetOptions.build(plant, plant_option_values(args))
+    args.check = check_bag(bag, plant, desc, options, limits_from_args(args))
     args.warnings = args.check.warnings
     fn = plant.estimate
     if fn is None:
         able = [p for p in available_plants() if get_plant(p).estimate is not None]
         raise CablelabError(f"plant {desc.plant}: no estimator (cablelab estimate supports "
                             f"{', '.join(able)})")
-    kwargs = {"tensions": args.tensions or "dynamometer", "effects": parse_effect_list(args.effects),
-              "pose": args.pose or "desired", "out": None, "derived_velocity": args.check.derived_velocity}
+    own = dataclasses.asdict(options.plant) if options.plant is not None else {}
+    kwargs = {**own, "effects": parse_effect_list(args.effects), "out": None,
+              "derived_velocity": args.check.derived_velocity}
     accepted = inspect.signature(fn).parameters
     if not any(p.kind == p.VAR_KEYWORD for p in accepted.values()):
         kwargs = {k: v for k, v in kwargs.items() if k in accepted}

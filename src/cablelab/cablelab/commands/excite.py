@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import math
 
-from ._workbench_args import add_overwrite, add_recover, add_tensions, dump_json
+from ._workbench_args import (add_overwrite, add_plant_options, add_recover, check_plant_options, dump_json,
+                              plant_option_values)
 from .numeric import number
 
 HELP = "design a reference trajectory (within the machine's limits) that separates named parameters"
@@ -23,7 +24,7 @@ def add_arguments(p) -> None:
     p.add_argument("--description", metavar="FILE",
                    help="plant description YAML (default: /plant_description in the bag)")
     add_recover(p)
-    add_tensions(p)
+    add_plant_options(p, "excite")
     p.add_argument("--params", metavar="A,B", required=True,
                    help="parameters to separate, as the fit names them (e.g. 'OF[hoist],m')")
     p.add_argument("--duration", type=number(ge=5, le=3600, unit="s"), default=60.0, metavar="S",
@@ -49,8 +50,9 @@ def run(args) -> int:
     check_target(args.out, overwrite=args.overwrite, inputs=inputs, option="-o")
     before = None
     if args.bag is not None:
-        plant, desc, before, _ = load_checked(args.bag, args.description, {"tensions": args.tensions},
-                                              recover=args.recover)
+        plant, desc, before, _ = load_checked(args.bag, args.description, plant_option_values(args),
+                                              recover=args.recover,
+                                              before_dataset=lambda p: check_plant_options(args, p))
     else:
         desc = load_bag_description(None, args.description)
     params = parse_effect_list(args.params)

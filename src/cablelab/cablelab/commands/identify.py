@@ -8,7 +8,7 @@ HELP = "identify the parameters of the nominal model + --effects, with standard 
 
 
 def add_arguments(p) -> None:
-    add_common(p)
+    add_common(p, "identify")
     add_folds(p)
     p.add_argument("--simulation", choices=("nmse", "pearson"), default=None,
                    help="refine by a simulation-based (free-run) fit with this objective "

@@ -14,7 +14,7 @@ HELP = "write DIR/index.html with plots: waterfall, ranking, parameters, overlay
 
 
 def add_arguments(p) -> None:
-    add_common(p)
+    add_common(p, "report")
     add_folds(p)
     p.add_argument("-o", "--out", required=True, metavar="DIR", help="output directory")
     add_overwrite(p)

@@ -2,22 +2,22 @@
 output channel the effects' regressors explain (``tau``, N m)."""
 from __future__ import annotations
 
-from cablelab.conditioning import Conditioning, condition_motion
+from cablelab.conditioning import condition_motion
 from cablelab.dataset import Dataset
 from cablelab.errors import CablelabError
+from cablelab.plant_interface import DatasetOptions
 
 from . import topics
 from .mjcf import JOINT
 
 
-def dataset(bag, description, options=None) -> Dataset:
-    """The dataset of a recording (``options``: the command line's plant options)."""
+def dataset(bag, description, options: DatasetOptions) -> Dataset:
+    """The dataset of a recording (``options``: conditioning and the plant's own options)."""
     bag.require(topics.JOINT_STATES, topics.JOINT_STATE)
     js = bag.joint_state(topics.JOINT_STATES)
     if js.names != [JOINT]:
         raise CablelabError(f"{bag.path}: {topics.JOINT_STATES} has joints {js.names}; expected [{JOINT!r}]")
-    opts = (options or {}).get("conditioning") or Conditioning()
-    c = condition_motion(js.t, js.position[:, 0], js.effort[:, 0], opts, revolute=True,
+    c = condition_motion(js.t, js.position[:, 0], js.effort[:, 0], options.conditioning, revolute=True,
                          qd=js.velocity[:, 0], source=str(bag.path))
     qd = c["qd"].reshape(-1)
     return Dataset(plant="pendulum", t=c["t"], y=c["effort"].reshape(-1, 1), channels=(JOINT,),

@@ -1,7 +1,8 @@
 """The axis plant: importing the package registers it (:mod:`cablelab.registry`) and its effects.
 
 Docs: README.md in this folder."""
-from . import effects, plant  # noqa: F401  (registration at import)
-from .plant import AXIS
+from ...registry import register_plant
+from . import effects  # noqa: F401  (registers the axis effects)
+from .plant import PLANT
 
-PLANT = AXIS
+register_plant(PLANT)

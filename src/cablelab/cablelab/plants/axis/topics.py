@@ -9,7 +9,6 @@ REFERENCE = "/axis/reference"                  # joint reference: position, velo
 EFFORT_COMMAND = "/axis/effort_command"        # drive command (addition)
 PARAMETER_ESTIMATE = "/axis/parameter_estimate"    # live [M, Fv, Fc, offset] (addition)
 GROUND_TRUTH = "/axis/ground_truth/joint_states"   # effort = true applied force (addition)
-
 MARKERS = "/axis/markers"                      # the machine in 3D for Foxglove (addition)
 
 #: topic -> message type of every axis topic a recording holds

@@ -92,7 +92,7 @@ def cdpr_page(out: Path, bag: Path, pd_bag: Path | None, rows: list, report_inde
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from .plant import estimate_bag
+    from .estimate import estimate_bag
 
     rep = out / "report"
     rep.mkdir(parents=True, exist_ok=True)
@@ -158,7 +158,7 @@ def cdpr_runs(out: Path, a) -> tuple[Path, Path | None]:
 def cdpr_analysis(out: Path, a, runs: tuple) -> PartResult:
     """Steps 2-3 for CAROCA on the runs of :func:`cdpr_runs`; the table rows, bags, reports."""
     pdff, pd = runs
-    from .plant import estimate_bag
+    from .estimate import estimate_bag
 
     t0 = time.monotonic()
     log("estimating (cablelab estimate) ...")

@@ -11,7 +11,7 @@ wrench matrix W at the desired (or measured) pose. The model explains it as (001
 
 The friction and offset terms act on the cables, so they reach the wrench through the model's
 wrench matrix: W_II(r_p) = W_I + r_p S (below) with pulleys. Their columns use the described sheave
-radius (:func:`cablelab.plants.cdpr.plant.model_wrench_matrix`, exact when the model's r_p is the described one); when r_p is
+radius (:func:`cablelab.plants.cdpr.dataset.model_wrench_matrix`, exact when the model's r_p is the described one); when r_p is
 fitted (pulleys not described) the second-order term (r_p - r_desc) S b is left out.
 
 With ``--tensions both`` (dynamometers and motor torques in the bag) the dataset adds one
@@ -82,8 +82,8 @@ def _pulley(ds: Dataset) -> np.ndarray:
 
 def _tension_offset(ds: Dataset) -> np.ndarray:
     # wrench channels: W b; torque-balance channels ((R/r) tau_i - d_i, --tensions both): -b_i
-    # while winch i moves (the channel is zeroed at rest, see plants.cdpr.plant.balance_mask)
-    from .plant import model_wrench_matrix
+    # while winch i moves (the channel is zeroed at rest, see plants.cdpr.dataset.balance_mask)
+    from .dataset import model_wrench_matrix
 
     W = model_wrench_matrix(ds.require_signal("W"), ds.require_signal("pulley_S"), ds.description)
     mask = ds.signals.get("balance_mask")

@@ -14,11 +14,9 @@ EFFORT_COMMANDS = "/cdpr/effort_commands"      # winch torques
 PAYLOAD_ESTIMATE = "/cdpr/payload_estimate"    # live payload mass and centre of mass
 GROUND_TRUTH_POSE = "/cdpr/ground_truth/pose"
 GROUND_TRUTH_PAYLOAD = "/cdpr/ground_truth/payload"
-#: topic -> message type of every CDPR topic a recording holds
-MARKERS = "/cdpr/markers"                      # the machine in 3D for Foxglove (addition)
-
 MARKERS = "/cdpr/markers"                      # 3D view of the simulator (visualization_msgs)
 
+#: topic -> message type of every CDPR topic a recording holds
 TYPES = {
     JOINT_STATES: JOINT_STATE,
     CABLE_TENSIONS: JOINT_STATE,

@@ -1,7 +1,12 @@
-"""The crane plant: importing the package registers it (:mod:`cablelab.registry`) and its effects.
+"""The crane plant: importing the package registers it (:mod:`cablelab.registry`), its effects and
+its experiment design.
 
 Docs: README.md in this folder."""
-from . import effects, plant  # noqa: F401  (registration at import)
-from .plant import CRANE
+from ...excite import register_exciter
+from ...registry import register_plant
+from . import effects  # noqa: F401  (registers the crane effects)
+from .excite import EXCITER
+from .plant import PLANT
 
-PLANT = CRANE
+register_plant(PLANT)
+register_exciter(PLANT.name, EXCITER)

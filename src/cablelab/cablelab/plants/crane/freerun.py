@@ -77,7 +77,8 @@ def free_run(ds: Dataset, params, horizon_s: float = FREE_RUN_HORIZON_S) -> np.n
     import mujoco
     import mujoco.rollout
 
-    from .sim import build_model, qpos_to_contract
+    from .mjcf import build_mjcf
+    from .sim import qpos_to_contract
 
     sets = [params] if isinstance(params, dict) else list(params)
     dt = ds.dt
@@ -90,7 +91,7 @@ def free_run(ds: Dataset, params, horizon_s: float = FREE_RUN_HORIZON_S) -> np.n
     for ps in sets:
         truth = truth_from_params(ps, ds.description)
         truth = truth.__class__(**{**truth.__dict__, "timestep": dt / steps})
-        model = build_model(truth)
+        model = build_mjcf(truth)
         data = mujoco.MjData(model)
         spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
         x0 = np.zeros((n_win, mujoco.mj_stateSize(model, spec)))

@@ -25,11 +25,12 @@ import numpy as np
 
 from . import topics
 from .kinematics import gimbal_rates_to_swing, gimbal_to_swing, swing_to_gimbal
+from .mjcf import build_mjcf, gravity_in_base
 from .model import CraneParams, gravity_vector, mass_matrix
 from .reference import reference_trajectory
 from ...rotations import wxyz_to_xyzw
 
-__all__ = ["CraneTruth", "build_model", "set_state", "gravity_in_base", "simulate", "SimResult",
+__all__ = ["CraneTruth", "set_state", "gravity_in_base", "simulate", "SimResult",
            "reference_trajectory", "QPOS", "contract_acceleration", "truth_accelerations",
            "contract_to_qpos", "qpos_to_contract", "DEFAULT_KP", "DEFAULT_KD", "CraneSim",
            "write_bag"]
@@ -66,82 +67,6 @@ class CraneTruth:
     timestep: float = 0.001
     effort_limit: tuple = (50.0, 80.0, 100.0)
     rope_range: tuple = (0.05, 5.0)
-
-
-def gravity_in_base(truth: CraneTruth) -> np.ndarray:
-    """(3,) gravity vector in the (tilted) crane base frame, m/s^2: R(tilt)^T [0, 0, -g]."""
-    ex, ey = (float(v) for v in truth.base_tilt)
-    cx, sx, cy, sy = np.cos(ex), np.sin(ex), np.cos(ey), np.sin(ey)
-    rx = np.array([[1, 0, 0], [0, cx, -sx], [0, sx, cx]])
-    ry = np.array([[cy, 0, sy], [0, 1, 0], [-sy, 0, cy]])
-    return (ry @ rx).T @ np.array([0.0, 0.0, -truth.params.gravity])
-
-
-def _f(x) -> str:
-    return " ".join(repr(float(v)) for v in np.atleast_1d(x))
-
-
-def model_xml(truth: CraneTruth, kp=(0.0, 0.0, 0.0), kd=(0.0, 0.0, 0.0)) -> str:
-    """MJCF text of the crane (see module docstring)."""
-    p = truth.params
-    lb, lc = p.boom_length, p.counterbalance_distance
-    b = truth.viscous
-    c = truth.coulomb
-    # boom point masses m_b at l_b/2 and m_c at -l_c as one inertial (about its centre, I_xx = 0)
-    mb, mc = p.boom_mass, p.counterbalance_mass
-    mtot = mb + mc
-    xc = (mb * lb / 2 - mc * lc) / mtot
-    jb = mb * (lb / 2 - xc) ** 2 + mc * (lc + xc) ** 2
-    tiny = 1e-12 * max(jb, 1.0)  # MuJoCo needs inertia > mjMINVAL; 1e-12 relative is far below the tests
-    ptiny = 1e-12 * p.payload_mass
-    boom_inertial = (f'<inertial pos="{xc!r} 0 0" mass="{mtot!r}" '
-                     f'diaginertia="{tiny!r} {jb + tiny!r} {jb + tiny!r}"/>')
-    acts = "\n".join(
-        f'<general name="{j}" joint="{j}" gainprm="1" biasprm="0 {-float(kp[i])!r} {-float(kd[i])!r}" '
-        f'biastype="affine" ctrlrange="{-float(lim)!r} {float(lim)!r}"/>'
-        for i, (j, lim) in enumerate(zip(("slew", "luff", "hoist"), truth.effort_limit)))
-    return f"""<mujoco model="crane">
-  <compiler angle="radian" autolimits="true" boundmass="0" boundinertia="0"/>
-  <option timestep="{truth.timestep!r}" gravity="{_f(gravity_in_base(truth))}" integrator="RK4"/>
-  <worldbody>
-    <body name="turret">
-      <joint name="slew" type="hinge" axis="0 0 1" damping="{b[0]!r}" frictionloss="{c[0]!r}"/>
-      <inertial pos="0 0 0" mass="1" diaginertia="{p.slew_inertia / 2!r} {p.slew_inertia / 2!r} {p.slew_inertia!r}"/>
-      <body name="boom">
-        <joint name="luff" type="hinge" axis="0 -1 0" armature="{p.luff_inertia!r}"
-               damping="{b[1]!r}" frictionloss="{c[1]!r}"/>
-        {boom_inertial}
-        <site name="tip" pos="{lb!r} 0 0"/>
-        <body name="payload" pos="{lb!r} 0 0">
-          <joint name="swing_y" type="hinge" axis="0 -1 0"/>
-          <joint name="swing_x" type="hinge" axis="1 0 0"/>
-          <joint name="hoist" type="slide" axis="0 0 -1" damping="{b[2]!r}" frictionloss="{c[2]!r}"
-                 range="{float(truth.rope_range[0])!r} {float(truth.rope_range[1])!r}"/>
-          <inertial pos="0 0 0" mass="{p.payload_mass!r}" diaginertia="{ptiny!r} {ptiny!r} {ptiny!r}"/>
-          <site name="payload"/>
-        </body>
-      </body>
-    </body>
-  </worldbody>
-  <actuator>
-{acts}
-  </actuator>
-  <sensor>
-    <jointpos joint="slew"/><jointpos joint="luff"/><jointpos joint="hoist"/>
-    <jointvel joint="slew"/><jointvel joint="luff"/><jointvel joint="hoist"/>
-    <actuatorfrc actuator="slew"/><actuatorfrc actuator="luff"/><actuatorfrc actuator="hoist"/>
-    <jointpos joint="swing_y"/><jointpos joint="swing_x"/>
-    <jointvel joint="swing_y"/><jointvel joint="swing_x"/>
-    <framepos objtype="site" objname="tip"/><framequat objtype="body" objname="boom"/>
-    <framepos objtype="site" objname="payload"/><framequat objtype="body" objname="payload"/>
-  </sensor>
-</mujoco>
-"""
-
-
-def build_model(truth: CraneTruth, kp=(0.0, 0.0, 0.0), kd=(0.0, 0.0, 0.0)) -> mujoco.MjModel:
-    """Compiled MuJoCo model of the crane (actuators: motors, or PD servos with gains kp, kd)."""
-    return mujoco.MjModel.from_xml_string(model_xml(truth, kp, kd))
 
 
 def contract_to_qpos(q5) -> np.ndarray:
@@ -238,7 +163,7 @@ def simulate(truth: CraneTruth, duration: float, *, decimate: int = 10, seed: in
     u0 = kp * q_ref + kd * qd_ref
     if feedforward:
         u0 = u0 + G + np.einsum("nij,nj->ni", M, qdd_ref)
-    model = build_model(truth)
+    model = build_mjcf(truth)
     data = mujoco.MjData(model)
     set_state(model, data, [q_ref[0, 0], q_ref[0, 1], q_ref[0, 2], 0.0, 0.0])
     idx = np.array([0, 1, 4])
@@ -294,7 +219,7 @@ def contract_acceleration(qpos, qvel, qacc, step: float = 1e-6) -> np.ndarray:
 def truth_accelerations(truth: CraneTruth, res: SimResult) -> np.ndarray:
     """(N, 5) exact contract accelerations of a :class:`SimResult` (MuJoCo forward dynamics at
     each recorded state with the recorded motor efforts; ground truth for tests and benchmarks)."""
-    model = build_model(truth)
+    model = build_mjcf(truth)
     data = mujoco.MjData(model)
     qacc = np.empty_like(res.qvel)
     for k in range(res.qpos.shape[0]):  # MuJoCo has no batched mj_forward; ground truth only
@@ -313,7 +238,7 @@ class CraneSim:
 
     def __init__(self, truth: CraneTruth, q0=(0.0, 0.5, 0.6), seed: int = 0):
         self.truth = truth
-        self.model = build_model(truth)
+        self.model = build_mjcf(truth)
         self.data = mujoco.MjData(self.model)
         self.rng = np.random.default_rng(seed)
         set_state(self.model, self.data, [q0[0], q0[1], q0[2], 0.0, 0.0])

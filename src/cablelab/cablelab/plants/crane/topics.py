@@ -12,11 +12,9 @@ SWING_ESTIMATE = "/crane/swing_estimate"       # theta1, theta2, rope_length
 SWING_TRUTH = "/crane/ground_truth/swing"      # simulation truth, the names of SWING_ESTIMATE
 REFERENCE = "/crane/reference"                 # joint references
 EFFORT_COMMANDS = "/crane/effort_commands"     # slew, luff torque, hoist force
-#: topic -> message type of every crane topic a recording holds
-MARKERS = "/crane/markers"                     # the machine in 3D for Foxglove (addition)
-
 MARKERS = "/crane/markers"                     # 3D view of the simulator (visualization_msgs)
 
+#: topic -> message type of every crane topic a recording holds
 TYPES = {
     JOINT_STATES: JOINT_STATE,
     TIP_POSE: POSE,

@@ -26,6 +26,7 @@ import numpy as np
 from ...conditioning import derivatives, lowpass
 from ...errors import CablelabError
 from ...model import Dataset
+from ...plant_interface import DatasetOptions
 from . import topics
 from .description import leg_of
 from .identify import start_state
@@ -71,7 +72,7 @@ def _event_steps(t, z, contact, adv: float, vcache: dict) -> dict[str, np.ndarra
 @dataclass(eq=False)
 class LegRecords:
     """The raw 1 kHz records a leg dataset was built from: ``(t, z, contact, tau)`` per record, the
-    description and the options. A dataset keeps it in ``signals["raw"]`` (one object, not a time
+    description and the velocity filter's cut-off. A dataset keeps it in ``signals["raw"]`` (one object, not a time
     series: subsets and the time-delay shift leave it alone) beside ``signals["row"]`` (int, each
     sample's row in the full dataset), so a transform that moves the phase (effect
     ``contact_delay``) rebuilds every phase-dependent signal on the whole records (the filters need
@@ -80,8 +81,8 @@ class LegRecords:
 
     records: tuple
     description: object
-    options: dict
     source: str = "data"
+    cutoff_hz: float = CUTOFF_HZ
     _base: list = field(default_factory=list, repr=False)
     _cache: dict = field(default_factory=dict, repr=False)
 
@@ -92,7 +93,7 @@ class LegRecords:
         """Per record the parts that do not depend on the phase (computed once)."""
         if not self._base:
             p = leg_of(self.description).params(self.description.gravity)
-            cut = float(self.options.get("cutoff_hz", CUTOFF_HZ))
+            cut = float(self.cutoff_hz)
             for t, z, contact, tau in self.records:
                 fs = 1.0 / float(np.median(np.diff(t)))
                 _, zd, zdd = derivatives(z, fs, cut, ORDER)
@@ -127,7 +128,7 @@ class LegRecords:
         if adv in self._cache:
             return self._cache[adv]
         g = self.description.gravity
-        cut = float(self.options.get("cutoff_hz", CUTOFF_HZ))
+        cut = float(self.cutoff_hz)
         parts = []
         for (t, z, contact, tau), b in zip(self.records, self._bases()):
             fs, n = b["fs"], len(t)
@@ -192,13 +193,12 @@ def _time_to_edge(s: np.ndarray, fs: float) -> np.ndarray:
 RECORD_GAP_S = 1.0
 
 
-def dataset_from_records(records, description, options: dict | None = None,
+def dataset_from_records(records, description, options: DatasetOptions | None = None,
                          source: str = "data") -> Dataset:
     """Leg dataset from one or more raw 1 kHz records ``(t, z, contact, tau)`` (s, m, 0/1, N m).
     Each record is filtered on its own (``EDGE`` samples at its ends invalid) and the records are
     concatenated, later ones moved on the time axis to start ``RECORD_GAP_S`` after the previous
-    one ends."""
-    options = options or {}
+    one ends. ``options`` are unused: the leg filters with its own cut-off (:data:`CUTOFF_HZ`)."""
     recs = []
     for t, z, contact, tau in records:
         if contact is None:
@@ -210,7 +210,7 @@ def dataset_from_records(records, description, options: dict | None = None,
     if max(rates) - min(rates) > 1e-6 * max(rates):
         raise CablelabError(f"{source}: leg records at different sample rates "
                             f"({min(rates):g} and {max(rates):g} Hz); resample them to one rate")
-    raw = LegRecords(tuple(recs), description, dict(options), source)
+    raw = LegRecords(tuple(recs), description, source)
     built = raw.build(0.0)
     times, valid, t_next = [], [], None
     for t, *_ in recs:
@@ -230,7 +230,7 @@ def dataset_from_records(records, description, options: dict | None = None,
                    inputs={"velocity": zd}, description=description, source=source)
 
 
-def dataset_from_arrays(t, z, contact, tau, description, options: dict | None = None,
+def dataset_from_arrays(t, z, contact, tau, description, options: DatasetOptions | None = None,
                         source: str = "data") -> Dataset:
     """Leg dataset from raw 1 kHz arrays: t (s), z (m), contact (0/1), tau (N m)."""
     if contact is None:
@@ -260,7 +260,7 @@ def check_bag(bag, description, options, series) -> list[str]:
             "(z < z_td - 0.5 mm, 20 ms dwell)"]
 
 
-def dataset(bag, description, options: dict | None = None) -> Dataset:
+def dataset(bag, description, options: DatasetOptions) -> Dataset:
     """Leg dataset from a bag's ``/leg/joint_states`` (joint ``body`` height, ``motor`` torque) and
     ``/leg/contact``. Without the contact topic the phase comes from the height (live estimator
     rule) and :func:`check_bag` says so."""

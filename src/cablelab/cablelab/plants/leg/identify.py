@@ -31,7 +31,8 @@ from ...errors import CablelabError
 from ...fit.simulation import fit_simulation
 from ...model import Param
 from .hybrid import STANCE, LegParams, input_force
-from .sim import DT, LegSim, build_model
+from .mjcf import build_mjcf
+from .sim import DT, LegSim
 from .strides import phase_runs, segments, strides
 
 #: velocity filter of 003 sec. 3.3
@@ -204,7 +205,7 @@ def _phase_model(p: LegParams, phase: int, dt: float) -> mujoco.MjModel:
     """Phase model for batch rollouts: the slide-joint body with the phase's passive elements
     (spec sec. 4 variant (b)): stance ``jnt_stiffness = k``, ``qpos_spring = z_0``, damping d_s;
     flight stiffness 0, damping d_f. ctrl = F_in (+ F_0 in stance)."""
-    m = build_model(p, dt)
+    m = build_mjcf(p, dt)
     m.jnt_stiffness[0] = p.k if phase == STANCE else 0.0
     m.qpos_spring[0] = p.spring_rest
     m.dof_damping[0] = p.d_s if phase == STANCE else p.d_f

@@ -30,29 +30,11 @@ from . import topics
 from .hybrid import (FLIGHT, LIFTOFF, STANCE, TOUCHDOWN, LegParams, flight_accel, grf, input_force,
                      stance_accel,
                      liftoff_guard, liftoff_map, spring_force, touchdown_map)
+from .mjcf import build_mjcf
 
-__all__ = ["LegSim", "Trajectory", "Event", "build_model", "simulate", "open_loop", "measure",
-           "quantise", "motor_angle"]
+__all__ = ["LegSim", "Trajectory", "Event", "simulate", "open_loop", "measure", "quantise", "motor_angle"]
 
 DT = 1e-3  #: control / sample period of 003 sec. 3.1, s
-
-
-def build_model(p: LegParams, dt: float = DT) -> mujoco.MjModel:
-    """The MuJoCo model: body on a vertical slide joint, one force motor, Euler at ``dt``."""
-    xml = f"""
-<mujoco model="leg">
-  <option timestep="{float(dt)!r}" gravity="0 0 {-float(p.g)!r}" integrator="Euler"/>
-  <worldbody>
-    <body name="body">
-      <joint name="hop" type="slide" axis="0 0 1" limited="false"/>
-      <inertial pos="0 0 0" mass="{float(p.m)!r}" diaginertia="1e-6 1e-6 1e-6"/>
-    </body>
-  </worldbody>
-  <actuator>
-    <motor name="motor" joint="hop" gear="1" ctrllimited="false"/>
-  </actuator>
-</mujoco>"""
-    return mujoco.MjModel.from_xml_string(xml)
 
 
 @dataclass(frozen=True)
@@ -79,7 +61,7 @@ class LegSim:
                  dt: float = DT):
         self.p = params
         self.dt = dt
-        self.model = build_model(params, dt)
+        self.model = build_mjcf(params, dt)
         self.data = mujoco.MjData(self.model)
         self._q, self._v = self.data.qpos, self.data.qvel  # cached views (hot loop)
         self.reset(z, zd, phase)

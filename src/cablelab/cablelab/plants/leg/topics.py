@@ -10,7 +10,6 @@ REFERENCE = "/leg/reference"                # desired apex height
 EFFORT_COMMANDS = "/leg/effort_commands"    # motor torque
 HOP_ESTIMATE = "/leg/hop_estimate"          # height, phase, apex_height, grf
 GROUND_TRUTH = "/leg/ground_truth/state"    # simulation truth, the names of HOP_ESTIMATE
-
 MARKERS = "/leg/markers"                       # the machine in 3D for Foxglove (addition)
 
 #: topic -> message type of every leg topic a recording holds

@@ -27,9 +27,10 @@ import dataclasses
 
 import numpy as np
 
-from ...conditioning import Conditioning, condition_motion
+from ...conditioning import condition_motion
 from ...errors import CablelabError
 from ...model import Dataset
+from ...plant_interface import DatasetOptions
 from . import topics
 from .params import VirtualParams
 from .reference import planar_bodies
@@ -85,15 +86,14 @@ def platform_tilt(quat_wxyz) -> np.ndarray:
     return np.column_stack([np.arctan2(-zb[:, 1], zb[:, 2]), np.arcsin(np.clip(zb[:, 0], -1.0, 1.0))])
 
 
-def dataset_from_arrays(t, pos, quat_wxyz, desc_section, description=None, options: dict | None = None,
+def dataset_from_arrays(t, pos, quat_wxyz, desc_section, description=None, options: DatasetOptions | None = None,
                         *, source: str = "data", suspension=None) -> Dataset:
     """Dataset from platform poses ``pos`` (N, 3) m and ``quat_wxyz`` (N, 4) at stamps ``t`` (N,).
 
     ``suspension``: measured position of the suspension point S at the same stamps (N, 3) m, or
     None (S fixed at the description's ``S``). When given, the swing angles are taken about the
     moving S and its acceleration is the signal ``a_S`` of ``suspension_motion``."""
-    options = options or {}
-    opts = options.get("conditioning") or Conditioning()
+    opts = (options or DatasetOptions()).conditioning
     if opts.cutoff_hz is None:
         opts = dataclasses.replace(opts, cutoff_hz=CUTOFF_HZ)
     p = desc_section.params()
@@ -121,7 +121,7 @@ def dataset_from_arrays(t, pos, quat_wxyz, desc_section, description=None, optio
     y[:, 3] = M_r * (qdd[:, 3] - lk * udot2) - M_r * g * (np.cos(q[:, 0]) * np.cos(q[:, 1]) - 1.0)
     # a channel the record does not excite carries only differentiated noise: its output is
     # zeroed (the columns keep the measured motion, so every parameter stays fitted, to ~0)
-    excited = np.abs(q - q.mean(axis=0)).max(axis=0) > np.asarray(options.get("min_amplitude", MIN_AMPLITUDE))
+    excited = np.abs(q - q.mean(axis=0)).max(axis=0) > MIN_AMPLITUDE
     y[:, ~excited] = 0.0
     return Dataset(
         plant="suspended", t=c["t"], y=y, channels=CHANNELS, units=("N m", "N m", "N m", "N"),
@@ -149,7 +149,7 @@ def section_of(description):
     return sec
 
 
-def dataset(bag, description, options: dict | None = None) -> Dataset:
+def dataset(bag, description, options: DatasetOptions) -> Dataset:
     """Workbench dataset of a ``suspended`` bag (``/suspended/platform_pose``)."""
     bag.require(POSE_TOPIC, POSE)
     ps = bag.pose(POSE_TOPIC)

@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from .baselines import BASELINES, fit_baseline
-from .controller import fig7_excitation
+from .control import fig7_excitation
 from .identify import Experiment, identify, validate
 from .mjcf import build_truth, build_virtual
 from .params import parameter_set

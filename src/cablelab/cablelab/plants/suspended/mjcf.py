@@ -266,7 +266,7 @@ def truth_xml(p: VirtualParams, *, platform_mass: float = 0.7, cable_separation:
     spring-damper (default k_c = 2e5 N/m, c_c = 2e3 N s/m).
 
     Args:
-        arm_motors: arms driven by torque motors (ctrl = N m, for :mod:`.controller`) instead of
+        arm_motors: arms driven by torque motors (ctrl = N m, for :mod:`.control`) instead of
             the repo position servos.
     """
     if p.variant == "cranebot":

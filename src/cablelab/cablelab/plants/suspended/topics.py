@@ -16,7 +16,6 @@ GROUND_TRUTH_VIRTUAL = "/suspended/ground_truth/virtual_joints"
 #: optional: measured pose of the suspension point S (crane hook / drone), a measured input of
 #: ``suspension_motion`` (docs/contract-additions.md)
 SUSPENSION_POSE = "/suspended/suspension_pose"
-
 MARKERS = "/suspended/markers"                 # the machine in 3D for Foxglove (addition)
 
 #: topic -> message type of every suspended topic a recording holds

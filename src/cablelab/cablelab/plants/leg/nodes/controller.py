@@ -15,7 +15,7 @@ from trajectory_msgs.msg import JointTrajectory
 
 from . import DESCRIPTION
 from .. import topics
-from ..controller import ApexController
+from ..control import ApexController
 from ..description import leg_of, load_leg_description
 from ....ros import convert
 from ....ros.params import Param

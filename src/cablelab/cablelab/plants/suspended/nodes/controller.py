@@ -20,7 +20,7 @@ from trajectory_msgs.msg import JointTrajectory
 
 from . import VARIANT, arm_reference
 from .. import topics
-from ..controller import ArmLaw
+from ..control import ArmLaw
 from ..mjcf import arm_joint_names
 from ..params import parameter_set
 from ....ros import convert
