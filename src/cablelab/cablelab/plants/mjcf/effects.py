@@ -1,0 +1,122 @@
+"""Effects of the ``mjcf`` plant (CONTRACT section 4). Their columns come from the MuJoCo model
+through the dataset (:mod:`.dataset`, :mod:`.inverse`), none is an equation written for one
+machine. The generic joint friction, sensor offset and time delay apply through the
+``joint_actuators`` capability (one actuator per joint of the model).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ...effects import register
+from ...effects.base import Physical
+from ...errors import CablelabError
+from ...model import KNOWN_OUTPUT, Dataset, Effect, Param
+
+
+def _payload(ds: Dataset) -> np.ndarray:
+    cols = ds.signals.get("payload_columns")
+    if cols is None:
+        raise CablelabError("effect payload_mass: the description names no mjcf.payload_body")
+    return cols
+
+
+def _payload_physical(ds: Dataset):
+    c0 = np.asarray(ds.signals.get("payload_com0", np.zeros(3)), float)
+
+    def com(k):
+        name = "mc" + "xyz"[k]
+        return lambda p: c0[k] + p[name] / p["m"] if p["m"] else float("nan")
+
+    return (Physical("m", "kg", lambda p: p["m"], "payload mass added to payload_body"),
+            *(Physical("com_" + "xyz"[k], "m", com(k), "payload centre of mass, payload_body frame")
+              for k in range(3)))
+
+
+PAYLOAD_MASS = register(Effect(
+    id="payload_mass",
+    plants=("mjcf",),
+    params=(Param("m", "kg", 0.0, -np.inf, np.inf, "mass added to payload_body"),
+            Param("mcx", "kg m", 0.0, -np.inf, np.inf, "its first moment about the body's centre of mass, x"),
+            Param("mcy", "kg m", 0.0, -np.inf, np.inf, "its first moment about the body's centre of mass, y"),
+            Param("mcz", "kg m", 0.0, -np.inf, np.inf, "its first moment about the body's centre of mass, z")),
+    explanation="an unknown payload on payload_body: the arm carries more mass than its model",
+    signature="residual follows the gravity and inertia load of the payload body",
+    reference="CONTRACT sec. 4 (mjcf); columns: mj_inverse differences in the body's standard "
+              "inertial parameters",
+    regressor=_payload,
+    physical=_payload_physical,
+))
+
+
+def _per_joint(signal: str):
+    return lambda ds: ds.actuator_block(ds.require_signal(signal))
+
+
+JOINT_ARMATURE = register(Effect(
+    id="joint_armature",
+    plants=("mjcf",),
+    params=(Param("armature", "{inertia}", 0.0, -np.inf, np.inf,
+                  "reflected rotor inertia beyond the model's (MuJoCo armature)"),),
+    explanation="the rotor's reflected inertia adds armature x qdd at its joint",
+    signature="residual follows each joint's own acceleration",
+    reference="CONTRACT sec. 4 (mjcf); MuJoCo joint armature",
+    regressor=_per_joint("qdd"),
+    per_actuator=True,
+))
+
+
+def _spring(ds: Dataset) -> np.ndarray:
+    q = ds.require_signal("q")
+    return np.concatenate([ds.actuator_block(q), ds.actuator_block(-np.ones_like(q))], axis=2)
+
+
+def _spring_physical(ds: Dataset):
+    out = []
+    for i, j in enumerate(ds.actuators):
+        s = f"[{j}]" if len(ds.actuators) > 1 else ""
+        eu, pu = ds.act_units[i] if i < len(ds.act_units) else ("N m", "rad")
+        out.append(Physical("k" + s, f"{eu}/{pu}", lambda p, s=s: p["k" + s], "joint spring stiffness"))
+        out.append(Physical("q0" + s, pu, lambda p, s=s: p["kq0" + s] / p["k" + s] if p["k" + s]
+                            else float("nan"), "joint spring rest position"))
+    return tuple(out)
+
+
+JOINT_SPRING = register(Effect(
+    id="joint_spring",
+    plants=("mjcf",),
+    params=(Param("k", "{effort}/{position}", 0.0, -np.inf, np.inf, "joint stiffness"),
+            Param("kq0", "{effort}", 0.0, -np.inf, np.inf, "stiffness x rest position")),
+    explanation="a spring at the joint (gravity compensator, cable chain, harmonic drive) "
+                "pulls it towards a rest position",
+    signature="residual follows the joint position",
+    reference="CONTRACT sec. 4 (mjcf); MuJoCo joint stiffness / springref",
+    regressor=_spring,
+    per_actuator=True,
+    physical=_spring_physical,
+))
+
+
+def _gain(ds: Dataset) -> np.ndarray:
+    return ds.actuator_block(ds.require_signal(KNOWN_OUTPUT))
+
+
+def _gain_physical(ds: Dataset):
+    out = []
+    for j in ds.actuators:
+        s = f"[{j}]" if len(ds.actuators) > 1 else ""
+        out.append(Physical("gain" + s, "1", lambda p, s=s: 1.0 + p["dgain" + s],
+                            "measured effort / applied generalised force"))
+    return tuple(out)
+
+
+ACTUATOR_GAIN = register(Effect(
+    id="actuator_gain",
+    plants=("mjcf",),
+    params=(Param("dgain", "1", 0.0, -np.inf, np.inf, "gain - 1 of the measured effort"),),
+    explanation="the measured effort is the applied force times a gain (torque-constant error)",
+    signature="residual is proportional to the model's own joint force",
+    reference="CONTRACT sec. 4 (mjcf)",
+    regressor=_gain,
+    per_actuator=True,
+    physical=_gain_physical,
+))

@@ -1,0 +1,58 @@
+"""The ``mjcf`` plant: any machine described by a MuJoCo model (MJCF or URDF) and a bag of it.
+
+The nominal model is MuJoCo's inverse dynamics of the given model (:mod:`.dataset`); the
+candidates are the effects of :mod:`.effects` plus the generic joint friction, sensor offset and
+time delay on the model's joints.
+"""
+from __future__ import annotations
+
+from ...registry import Plant
+from .dataset import dataset
+from .description import dump_section, parse_section
+from .topics import TOPICS, contract_topics, topic
+
+
+def baseline(description) -> tuple[str, ...]:
+    """Nominal model: the given MuJoCo model's own inverse dynamics, no added effect."""
+    return ()
+
+
+def candidates(description) -> tuple[str, ...]:
+    """Effects a diagnosis tries: the mjcf effects (``payload_mass`` when the description names
+    a ``payload_body``) and the generic joint ones."""
+    sec = getattr(description, "mjcf", None) if description is not None else None
+    cands = ("joint_viscous_friction", "joint_coulomb_friction", "joint_armature", "joint_spring",
+             "actuator_gain", "torque_sensor_offset", "time_delay")
+    if sec is not None and sec.payload_body:
+        cands = ("payload_mass",) + cands
+    return cands
+
+
+def _topic_names(desc) -> dict:
+    sec = getattr(desc, "mjcf", None) if desc is not None else None
+    if sec is None:
+        return {}
+    from .mjcf import dof_joints
+
+    joints = dof_joints(sec.compiled())
+    out = {topic(sec, "joint_states"): joints, topic(sec, "ground_truth_joint_states"): joints}
+    if sec.tendons:
+        out[topic(sec, "cable_tensions")] = list(sec.tendons)
+    return out
+
+
+PLANT = Plant(
+    name="mjcf",
+    topics=(),                      # the joint-state topic depends on the description (remapping)
+    dataset=dataset,
+    baseline=baseline,
+    candidates=candidates,
+    channels_doc="one generalised force per hinge/slide joint of the model (N m or N)",
+    section=parse_section,
+    dump_section=dump_section,
+    contract_topics=contract_topics(),
+    joint_topic=TOPICS["joint_states"][0],
+    joints=None,
+    capabilities=frozenset({"joint_actuators"}),
+    topic_names=_topic_names,
+)

@@ -1,0 +1,170 @@
+"""Forward simulation of an ``mjcf`` machine (ROS-free): the truth a bag is recorded from.
+
+This is deliberately a separate path from the workbench's inverse dynamics: the truth model is
+the user's model *changed through MuJoCo's own model editor* (:class:`mujoco.MjSpec`: a payload
+body added, joint damping, Coulomb friction (``frictionloss``) or armature set, a wrong torque
+constant on the effort sensor), stepped forward by ``mj_step`` under a PD tracking controller,
+and recorded with encoder quantisation and effort noise. The explicit Euler integrator (with
+implicit damping disabled) makes the recorded positions' second difference the acceleration
+MuJoCo computed, so the record is the machine's motion and nothing of the workbench's code.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .mjcf import dof_joints, names
+
+
+@dataclass(frozen=True)
+class Hidden:
+    """What the truth has and the user's model lacks.
+
+    Args:
+        payload: ``(body, mass kg, (x, y, z) m in the body frame)`` added as a point-mass child
+            body, or None.
+        damping, frictionloss, armature: per joint name: viscous friction (N m s/rad), Coulomb
+            friction (N m), reflected inertia (kg m^2).
+        gain: per joint: the effort sensor reads gain x the applied force.
+        stiffness: per joint ``(k, q0)``: a spring pulling the joint towards q0.
+    """
+
+    payload: tuple | None = None
+    damping: dict = field(default_factory=dict)
+    frictionloss: dict = field(default_factory=dict)
+    armature: dict = field(default_factory=dict)
+    gain: dict = field(default_factory=dict)
+    stiffness: dict = field(default_factory=dict)
+
+
+def _set(joint, attr: str, value: float) -> None:
+    """Set a joint attribute that is a number or (newer MuJoCo) a coefficient vector whose
+    first entry is the linear coefficient."""
+    old = getattr(joint, attr)
+    if np.ndim(old):
+        new = np.zeros_like(old)
+        new[0] = value
+        setattr(joint, attr, new)
+    else:
+        setattr(joint, attr, float(value))
+
+
+def truth_model(xml: str, hidden: Hidden = Hidden(), timestep: float | None = None):
+    """The truth :class:`mujoco.MjModel`: ``xml`` edited with MjSpec to hold ``hidden``."""
+    import mujoco
+
+    spec = mujoco.MjSpec.from_string(xml)
+    spec.option.integrator = mujoco.mjtIntegrator.mjINT_EULER
+    spec.option.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_EULERDAMP)
+    if timestep:
+        spec.option.timestep = float(timestep)
+    if hidden.payload is not None:
+        body, mass, pos = hidden.payload
+        b = spec.body(body).add_body(name="hidden_payload", pos=list(pos))
+        b.ipos = [0.0, 0.0, 0.0]
+        b.mass = float(mass)
+        b.inertia = [1e-9, 1e-9, 1e-9]
+        b.explicitinertial = True
+    for attr in ("damping", "frictionloss", "armature"):
+        for j, v in getattr(hidden, attr).items():
+            _set(spec.joint(j), attr, v)
+    for j, (k, q0) in hidden.stiffness.items():
+        _set(spec.joint(j), "stiffness", k)
+        spec.joint(j).springref = float(q0)
+    return spec.compile()
+
+
+def excitation(duration: float, dt: float, n: int, seed: int = 0, amplitude: float = 0.8,
+               band_hz: tuple[float, float] = (0.15, 1.2), harmonics: int = 5):
+    """Multisine reference per joint: positions, velocities, accelerations (T, n)."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(int(round(duration / dt))) * dt
+    f = rng.uniform(*band_hz, size=(harmonics, n))
+    ph = rng.uniform(0, 2 * np.pi, size=(harmonics, n))
+    a = amplitude / harmonics / (1 + f)
+    w = 2 * np.pi * f
+    arg = w[None] * t[:, None, None] + ph[None]
+    q = np.sum(a * (np.sin(arg) - np.sin(ph)), axis=1)
+    qd = np.sum(a * w * np.cos(arg), axis=1)
+    qdd = np.sum(-a * w**2 * np.sin(arg), axis=1)
+    return t, q, qd, qdd
+
+
+def simulate(model, duration: float = 12.0, seed: int = 0, kp: float = 400.0, kd: float = 40.0,
+             amplitude: float = 0.8):
+    """Run the truth model under PD + bias feedback tracking a multisine (one sample per step).
+
+    Returns:
+        ``t (T,), q (T, nv), qd (T, nv), effort (T, nv)``: the state each step starts from and
+        the generalised actuator force applied during it (``qfrc_actuator``).
+    """
+    import mujoco
+
+    d = mujoco.MjData(model)
+    dt = model.opt.timestep
+    t, qr, qdr, _ = excitation(duration, dt, model.nv, seed, amplitude)
+    T = len(t)
+    q = np.empty((T, model.nv))
+    qd = np.empty((T, model.nv))
+    eff = np.empty((T, model.nv))
+    mass = np.array([model.dof_M0[i] if hasattr(model, "dof_M0") else 1.0 for i in range(model.nv)])
+    kp_v = kp * np.maximum(mass, 0.05)
+    kd_v = kd * np.maximum(mass, 0.05)
+    # actuator i drives the joint of its transmission: ctrl = generalised force / gear
+    act_dof = model.jnt_dofadr[model.actuator_trnid[:, 0]]
+    gear = model.actuator_gear[:, 0]
+    for k in range(T):
+        mujoco.mj_step1(model, d)
+        tau = kp_v * (qr[k] - d.qpos) + kd_v * (qdr[k] - d.qvel) + d.qfrc_bias
+        d.ctrl[:] = tau[act_dof] / gear
+        q[k], qd[k] = d.qpos, d.qvel
+        mujoco.mj_step2(model, d)
+        eff[k] = d.qfrc_actuator
+    return t, q, qd, eff
+
+
+def record(model, hidden: Hidden = Hidden(), *, duration: float = 12.0, seed: int = 0,
+           encoder_bits: int = 18, effort_noise: float = 0.02, effort_quantum: float = 1e-3):
+    """A simulated record as a sensor sees it: positions quantised to ``2 pi / 2^bits``, efforts
+    times the hidden gain plus white noise (N m) and quantised."""
+    t, q, qd, eff = simulate(model, duration, seed)
+    rng = np.random.default_rng(seed + 1)
+    quantum = 2 * np.pi / 2**encoder_bits
+    q_meas = np.round(q / quantum) * quantum
+    joints = dof_joints(model)
+    gain = np.array([hidden.gain.get(j, 1.0) for j in joints])
+    e = eff * gain + rng.normal(0.0, effort_noise, eff.shape)
+    e = np.round(e / effort_quantum) * effort_quantum
+    return t, q_meas, e, joints
+
+
+def description_yaml(xml: str, **section) -> str:
+    """A description (YAML text) of an mjcf machine with the model inline."""
+    from ...description import dump_description, load_description
+
+    import yaml
+
+    text = yaml.safe_dump({"plant": "mjcf", "gravity": 9.81, "mjcf": {"model": xml, **section}},
+                          sort_keys=False)
+    return dump_description(load_description(text))
+
+
+def write_bag(path, xml: str, hidden: Hidden = Hidden(), *, duration: float = 12.0, seed: int = 0,
+              overwrite: bool = True, **section) -> str:
+    """Simulate the truth (``xml`` + ``hidden``) and write a contract bag of it: the description
+    (the user's model, without the hidden effect), ``/mjcf/joint_states`` and the truth."""
+    from ...bags import BagWriter
+
+    model = truth_model(xml, hidden)
+    t, q, e, joints = record(model, hidden, duration=duration, seed=seed)
+    desc = description_yaml(xml, **section)
+    t0 = 1000.0
+    with BagWriter(path, overwrite=overwrite) as w:
+        w.write_description(desc, t=t0)
+        w.write_joint_states("/mjcf/joint_states", t0 + t, joints, position=q, effort=e)
+    return str(path)
+
+
+__all__ = ["Hidden", "description_yaml", "excitation", "record", "simulate", "truth_model",
+           "write_bag", "names"]
