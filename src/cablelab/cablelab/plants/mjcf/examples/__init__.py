@@ -1,0 +1,11 @@
+"""Example machines of the ``mjcf`` plant, shipped as MJCF files (README.md of the plant)."""
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+#: a three-joint arm (base yaw, shoulder, elbow) carrying an unknown payload on ``tool``
+ARM3 = HERE / "arm3.xml"
+
+
+def text(path: Path) -> str:
+    """The model text of an example."""
+    return Path(path).read_text(encoding="utf-8")
