@@ -2,7 +2,8 @@
 a separate simulator configuration, MuJoCo forward simulation (``mj_step``, explicit Euler) of the
 user's model edited with MjSpec to hold the hidden effect (a payload body, joint damping,
 armature, a torque-constant error), PD-tracked, with 18-bit encoders and effort noise. The analysed
-model is the user's model as given; the oracle is the truth's parameters."""
+model is the user's model as given; the oracle is the truth's parameters (Coulomb friction is
+MuJoCo's ``frictionloss``, a soft constraint, not the sign function the effect fits)."""
 import json
 
 import numpy as np
@@ -26,6 +27,13 @@ CASES = {
     "armature": (Hidden(armature={"base_yaw": 0.05, "shoulder": 0.08, "elbow": 0.03}),
                  "joint_armature", {"armature[base_yaw]": 0.05, "armature[shoulder]": 0.08,
                                     "armature[elbow]": 0.03}, 0.10),
+    "coulomb": (Hidden(frictionloss={"base_yaw": 0.3, "shoulder": 0.6, "elbow": 0.25}),
+                "joint_coulomb_friction", {"Fc[base_yaw]": 0.3, "Fc[shoulder]": 0.6,
+                                           "Fc[elbow]": 0.25}, 0.10),
+    "gain": (Hidden(gain={"base_yaw": 1.08, "shoulder": 0.9, "elbow": 1.1}), "actuator_gain",
+             {"gain[base_yaw]": 1.08, "gain[shoulder]": 0.9, "gain[elbow]": 1.1}, 0.10),
+    "spring": (Hidden(stiffness={"shoulder": (6.0, -0.3), "elbow": (3.0, 0.4)}), "joint_spring",
+               {"k[shoulder]": 6.0, "k[elbow]": 3.0, "q0[shoulder]": -0.3, "q0[elbow]": 0.4}, 0.10),
 }
 
 

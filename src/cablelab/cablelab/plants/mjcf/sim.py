@@ -71,7 +71,9 @@ def truth_model(xml: str, hidden: Hidden = Hidden(), timestep: float | None = No
             _set(spec.joint(j), attr, v)
     for j, (k, q0) in hidden.stiffness.items():
         _set(spec.joint(j), "stiffness", k)
-        spec.joint(j).springref = float(q0)
+        hinge = spec.joint(j).type == mujoco.mjtJoint.mjJNT_HINGE
+        # MJCF angles are in degrees unless the model's compiler says radians
+        spec.joint(j).springref = float(np.degrees(q0) if hinge and spec.compiler.degree else q0)
     return spec.compile()
 
 
