@@ -70,10 +70,13 @@ def test_payload_centre_of_mass_is_recovered(bags):
     assert p["com_x"] == pytest.approx(0.04, abs=0.005) and abs(p["com_y"]) < 0.005, p
 
 
-def test_control_bag_calls_nothing_significant(bags):
-    d = _diagnose(bags["control"])
-    assert not [r["effect"] for r in d.ranking if r["significant"]], d.ranking
-    assert d.error < 0.02                       # the nominal model explains the record
+def test_control_bag_calls_nothing_significant(bags, capsys):
+    """Through the command line: the nominal model alone (no effect) is a model to diagnose."""
+    assert main(["diagnose", bags["control"], "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["plant"] == "mjcf" and out["baseline"]["effects"] == []
+    assert not [r["effect"] for r in out["ranking"] if r["significant"]], out["ranking"]
+    assert out["baseline"]["error"] < 0.02       # the nominal model explains the record
 
 
 def test_identify_cli_on_an_mjcf_bag(bags, capsys):
