@@ -87,3 +87,19 @@ def test_identify_cli_on_an_mjcf_bag(bags, capsys):
     m = out["params"]["m"]["value"] if "params" in out and "m" in out["params"] else None
     assert m is not None, flat[:400]
     assert m == pytest.approx(1.5, rel=0.05)
+
+
+def test_link_inertia_base_parameters_of_a_heavier_forearm(tmp_path, capsys):
+    """The forearm 0.6 kg heavier at its centre of mass (0.17 m from the elbow): MuJoCo's columns
+    give the base parameters of the classical lumping, dh_x = 0.6 x 0.17 and dI_yy = 0.6 x 0.17^2
+    about the elbow; the mass itself moves to the upper arm's first moment and inertia at the
+    elbow (0.4 m): dh_x = 0.6 x 0.4, dI_yy = 0.6 x 0.4^2."""
+    bag = write_bag(tmp_path / "link", ARM_XML, Hidden(link_mass={"fore": 0.6}), seed=3)
+    assert main(["identify", bag, "--effects", "link_inertia", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    p = {k: v["value"] for k, v in out["params"].items()}
+    assert out["fit"]["cv_nrmse"] < 0.01
+    assert p["dhx[fore]"] == pytest.approx(0.6 * 0.17, rel=0.05)
+    assert p["dIyy[fore]"] == pytest.approx(0.6 * 0.17**2, rel=0.10)
+    assert p["dhx[upper]"] == pytest.approx(0.6 * 0.4, rel=0.05)
+    assert p["dIyy[upper]"] == pytest.approx(0.6 * 0.4**2, rel=0.10)

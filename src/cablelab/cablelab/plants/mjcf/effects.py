@@ -120,3 +120,64 @@ ACTUATOR_GAIN = register(Effect(
     per_actuator=True,
     physical=_gain_physical,
 ))
+
+
+# ----------------------------------------------------------------------------- link inertia
+#: ``Dataset.signals`` keys of the link-inertia columns (computed on first use) and body names
+LINK_COLUMNS, LINK_BODIES = "link_inertia_columns", "link_bodies"
+
+
+def _moving_bodies(model) -> list[int]:
+    """Bodies that move with some joint (not welded to the world), in tree order."""
+    return [b for b in range(1, model.nbody) if model.body_weldid[b] != 0]
+
+
+def _link_columns(ds: Dataset) -> np.ndarray:
+    """(N, C, 10 n_bodies) columns of every moving body's standard inertial parameters
+    (:func:`.inverse.inertial_columns`), computed once per dataset from its q, qd, qdd."""
+    if LINK_COLUMNS not in ds.signals:
+        from .description import section_of
+        from .inverse import inertial_columns, inverse_dynamics
+
+        model = section_of(ds.description).compiled(ds.gravity)
+        q, qd, qdd = (ds.require_signal(k) for k in ("q", "qd", "qdd"))
+        base = inverse_dynamics(model, q, qd, qdd)
+        ds.signals[LINK_COLUMNS] = np.concatenate(
+            [inertial_columns(model, b, q, qd, qdd, base=base) for b in _moving_bodies(model)], axis=2)
+    return ds.signals[LINK_COLUMNS]
+
+
+def _link_names(ds: Dataset) -> list[str]:
+    if LINK_BODIES not in ds.signals:
+        from .description import section_of
+        from .mjcf import names
+
+        model = section_of(ds.description).compiled()
+        body = names(model, "body")
+        ds.signals[LINK_BODIES] = [body[b] for b in _moving_bodies(model)]
+    return ds.signals[LINK_BODIES]
+
+
+class LinkInertiaEffect(Effect):
+    """``link_inertia``: its parameters are the ten standard parameters of each moving body of
+    the model (the names depend on the model, so :meth:`columns` expands them per body)."""
+
+    def columns(self, ds: Dataset) -> list[Param]:
+        from .inverse import STANDARD_PARAMS
+
+        units = {"m": "kg", "h": "kg m", "I": "kg m^2"}
+        return [Param(f"d{p}[{b}]", units[p[0]], 0.0, -np.inf, np.inf,
+                      f"change of {b}'s standard inertial parameter {p}")
+                for b in _link_names(ds) for p in STANDARD_PARAMS]
+
+
+LINK_INERTIA = register(LinkInertiaEffect(
+    id="link_inertia",
+    plants=("mjcf",),
+    params=(),
+    explanation="the links' masses, centres of mass and inertias differ from the model",
+    signature="residual follows the rigid-body dynamics (gravity and inertia loads) of the links",
+    reference="CONTRACT sec. 4 (mjcf); standard inertial parameters, base parameters by the held "
+              "(unidentifiable) directions of the fit",
+    regressor=_link_columns,
+))

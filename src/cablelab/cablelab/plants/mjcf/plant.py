@@ -19,7 +19,9 @@ def baseline(description) -> tuple[str, ...]:
 
 def candidates(description) -> tuple[str, ...]:
     """Effects a diagnosis tries: the mjcf effects (``payload_mass`` when the description names
-    a ``payload_body``) and the generic joint ones."""
+    a ``payload_body``) and the generic joint ones. ``link_inertia`` is not among them: it holds
+    every rigid-body change (a payload is a change of its body's inertia) and would tie with the
+    more specific effects; fit it with ``identify --effects link_inertia``."""
     sec = getattr(description, "mjcf", None) if description is not None else None
     cands = ("joint_viscous_friction", "joint_coulomb_friction", "joint_armature", "joint_spring",
              "actuator_gain", "torque_sensor_offset", "time_delay")

@@ -28,6 +28,7 @@ class Hidden:
             friction (N m), reflected inertia (kg m^2).
         gain: per joint: the effort sensor reads gain x the applied force.
         stiffness: per joint ``(k, q0)``: a spring pulling the joint towards q0.
+        link_mass: per body: mass added at its centre of mass (kg; its inertia unchanged).
     """
 
     payload: tuple | None = None
@@ -36,6 +37,7 @@ class Hidden:
     armature: dict = field(default_factory=dict)
     gain: dict = field(default_factory=dict)
     stiffness: dict = field(default_factory=dict)
+    link_mass: dict = field(default_factory=dict)
 
 
 def _set(joint, attr: str, value: float) -> None:
@@ -66,6 +68,8 @@ def truth_model(xml: str, hidden: Hidden = Hidden(), timestep: float | None = No
         b.mass = float(mass)
         b.inertia = [1e-9, 1e-9, 1e-9]
         b.explicitinertial = True
+    for b, dm in hidden.link_mass.items():
+        spec.body(b).mass = spec.body(b).mass + float(dm)
     for attr in ("damping", "frictionloss", "armature"):
         for j, v in getattr(hidden, attr).items():
             _set(spec.joint(j), attr, v)
