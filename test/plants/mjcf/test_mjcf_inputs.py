@@ -1,0 +1,93 @@
+"""A user's own model and topics: URDF on a remapped ``/joint_states``, measured tendon tensions
+through the tendon Jacobian (sign: a tension pulls its tendon shorter)."""
+import numpy as np
+import yaml
+
+from cablelab import workbench
+from cablelab.bags import BagWriter
+from cablelab.model import KNOWN_OUTPUT
+from cablelab.plants.mjcf.sim import Hidden, record, truth_model
+
+URDF = """<robot name="double">
+  <link name="base"/>
+  <link name="l1"><inertial><origin xyz="0.25 0 0"/><mass value="1.5"/>
+    <inertia ixx="0.002" iyy="0.03" izz="0.03" ixy="0" ixz="0" iyz="0"/></inertial>
+    <visual><geometry><mesh filename="package://double/meshes/l1.stl"/></geometry></visual></link>
+  <link name="l2"><inertial><origin xyz="0.2 0 0"/><mass value="0.8"/>
+    <inertia ixx="0.001" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="j1" type="continuous"><parent link="base"/><child link="l1"/><axis xyz="0 1 0"/></joint>
+  <joint name="j2" type="continuous"><parent link="l1"/><child link="l2"/>
+    <origin xyz="0.5 0 0"/><axis xyz="0 1 0"/></joint>
+</robot>"""
+
+# the same machine as MJCF with motors, for the truth simulator (MuJoCo's URDF import has none)
+URDF_MJCF = """<mujoco><compiler angle="radian"/><option timestep="0.002"/>
+  <worldbody><body name="l1"><joint name="j1" axis="0 1 0"/>
+    <inertial pos="0.25 0 0" mass="1.5" diaginertia="0.002 0.03 0.03"/>
+    <body name="l2" pos="0.5 0 0"><joint name="j2" axis="0 1 0"/>
+      <inertial pos="0.2 0 0" mass="0.8" diaginertia="0.001 0.01 0.01"/></body></body></worldbody>
+  <actuator><motor joint="j1"/><motor joint="j2"/></actuator></mujoco>"""
+
+
+def _write(path, desc: dict, topic: str, t, names, q, eff, extra=None):
+    with BagWriter(path) as w:
+        w.write_description(yaml.safe_dump(desc, sort_keys=False))
+        w.write_joint_states(topic, t, names, q, None, eff)
+        for args in extra or ():
+            w.write_joint_states(*args)
+    return str(path)
+
+
+def test_urdf_on_a_remapped_joint_states_topic(tmp_path):
+    t, q, e, joints = record(truth_model(URDF_MJCF), duration=8.0, seed=5)
+    desc = {"plant": "mjcf", "mjcf": {"model": URDF, "topics": {"joint_states": "/joint_states"}}}
+    bag = _write(tmp_path / "urdf", desc, "/joint_states", t, joints, q, e)
+    plant, d, ds = workbench.load(bag)
+    assert ds.channels == ("j1", "j2")
+    assert not any("l1.stl" in w for w in ds.signals["load_warnings"])   # URDF visuals: ignored
+    nrmse = workbench.compare(ds, workbench.build_model(plant, d))["channels"]
+    assert all(m["nrmse"] < 0.02 for m in nrmse.values()), nrmse
+
+
+TENDON_MJCF = """<mujoco><compiler angle="radian"/><option timestep="0.002"/>
+  <worldbody><site name="anchor" pos="0.3 0 0.6"/>
+    <body name="arm"><joint name="hinge" axis="0 1 0"/>
+      <inertial pos="0.3 0 0" mass="2" diaginertia="0.01 0.06 0.06"/>
+      <site name="tip" pos="0.6 0 0"/></body></worldbody>
+  <tendon><spatial name="cable"><site site="anchor"/><site site="tip"/></spatial></tendon>
+  <actuator><motor joint="hinge"/></actuator></mujoco>"""
+
+
+def test_measured_tendon_tension_enters_through_the_tendon_jacobian(tmp_path):
+    """Truth: a cable pulls the arm with a known tension (applied as a tendon force in the
+    simulation); the joint motor supplies the rest. With the tension measured, the channel
+    ``effort - ten_J^T T`` equals MuJoCo's inverse dynamics of the arm without the cable."""
+    import mujoco
+
+    spec = mujoco.MjSpec.from_string(TENDON_MJCF)
+    act = spec.add_actuator(name="winch", target="cable")
+    act.trntype = mujoco.mjtTrn.mjTRN_TENDON
+    truth = spec.compile()
+    truth.opt.integrator = mujoco.mjtIntegrator.mjINT_EULER
+    d = mujoco.MjData(truth)
+    n = 3000
+    tt = np.arange(n) * truth.opt.timestep
+    tension = 20.0 + 5.0 * np.sin(2.0 * tt)
+    q, eff = np.empty(n), np.empty(n)
+    ref = 0.4 * np.sin(1.3 * tt) - 0.2
+    for k in range(n):
+        mujoco.mj_step1(truth, d)
+        d.ctrl[1] = -tension[k]                 # a pulling (shortening) tendon force
+        d.ctrl[0] = 300 * (ref[k] - d.qpos[0]) - 30 * d.qvel[0] + d.qfrc_bias[0]
+        q[k] = d.qpos[0]
+        mujoco.mj_step2(truth, d)
+        eff[k] = d.actuator_force[0]            # the joint motor alone
+    desc = {"plant": "mjcf", "mjcf": {"model": TENDON_MJCF, "tendons": ["cable"]}}
+    bag = _write(tmp_path / "tendon", desc, "/mjcf/joint_states", tt, ["hinge"], q[:, None],
+                 eff[:, None], [("/mjcf/cable_tensions", tt, ["cable"], None, None, tension[:, None])])
+    plant, dd, ds = workbench.load(bag)
+    resid = ds.y[ds.valid, 0] - ds.signals[KNOWN_OUTPUT][ds.valid, 0]
+    assert np.sqrt(np.mean(resid**2)) < 0.01 * np.sqrt(np.mean(ds.y[ds.valid, 0] ** 2))
+    # without the tension the channel would be off by the cable's torque (tens of N m)
+    moment = np.abs(ds.signals["ten_J"][ds.valid, 0, 0] * ds.signals["tension"][ds.valid, 0])
+    assert moment.mean() > 1.0
