@@ -91,3 +91,26 @@ def test_measured_tendon_tension_enters_through_the_tendon_jacobian(tmp_path):
     # without the tension the channel would be off by the cable's torque (tens of N m)
     moment = np.abs(ds.signals["ten_J"][ds.valid, 0, 0] * ds.signals["tension"][ds.valid, 0])
     assert moment.mean() > 1.0
+
+
+def test_csv_import_onto_the_models_joints(tmp_path, capsys):
+    """``cablelab import --plant mjcf``: CSV columns onto the joints the description's model has;
+    the bag carries the model inline (model_file read), and the nominal model fits it."""
+    from cablelab.cli import main
+    from cablelab.plants.mjcf.examples import ARM3
+
+    t, q, e, joints = record(truth_model(ARM3.read_text()), duration=6.0, seed=4)
+    csv = tmp_path / "arm.csv"
+    np.savetxt(csv, np.column_stack([t, q, e]), delimiter=",", comments="",
+               header="t,q0,q1,q2,e0,e1,e2")
+    desc = tmp_path / "arm.yaml"
+    desc.write_text(yaml.safe_dump({"plant": "mjcf", "mjcf": {"model_file": str(ARM3)}}))
+    spec = ",".join(["time=t"] + [f"position.{j}=q{k}" for k, j in enumerate(joints)]
+                    + [f"effort.{j}=e{k}" for k, j in enumerate(joints)])
+    assert main(["import", str(csv), "--plant", "mjcf", "--description", str(desc), "--map", spec,
+                 "-o", str(tmp_path / "bag")]) == 0
+    capsys.readouterr()
+    plant, d, ds = workbench.load(str(tmp_path / "bag"))
+    assert d.mjcf.model == ARM3.read_text() and ds.channels == tuple(joints)
+    nrmse = workbench.compare(ds, workbench.build_model(plant, d))["channels"]
+    assert all(m["nrmse"] < 0.02 for m in nrmse.values()), nrmse
