@@ -172,5 +172,47 @@ def write_bag(path, xml: str, hidden: Hidden = Hidden(), *, duration: float = 12
     return str(path)
 
 
-__all__ = ["Hidden", "description_yaml", "excitation", "record", "simulate", "truth_model",
+__all__ = ["Hidden", "MjcfSim", "description_yaml", "excitation", "record", "simulate", "truth_model",
            "write_bag", "names"]
+
+
+class MjcfSim:
+    """A running simulation of an ``mjcf:`` section's model at its own timestep:
+    ``advance(ctrl, duration)`` holds the actuator controls for whole physics steps.
+
+    Args:
+        section: the parsed ``mjcf:`` section; gravity: g along -z, m/s^2.
+    """
+
+    def __init__(self, section, gravity: float = 9.81):
+        import mujoco
+
+        self.model = section.compiled(gravity)
+        self.data = mujoco.MjData(self.model)
+        self.joints = dof_joints(self.model)
+        self.tendons = list(section.tendons)
+        tn = names(self.model, "tendon")
+        self._tendon_ids = [tn.index(x) for x in self.tendons]
+        self._mujoco = mujoco
+        mujoco.mj_forward(self.model, self.data)
+
+    @property
+    def t(self) -> float:
+        return float(self.data.time)
+
+    def advance(self, ctrl, duration: float) -> None:
+        """Hold ``ctrl`` (nu,) for ``duration`` s (at least one step)."""
+        self.data.ctrl[:] = np.asarray(ctrl, float)
+        n = max(1, int(round(duration / self.model.opt.timestep)))
+        self._mujoco.mj_step(self.model, self.data, nstep=n)
+
+    def state(self):
+        """``(t, q (nv,), qd (nv,), effort (nv,) = qfrc_actuator, tension (n_tendons,))``: the
+        tension of a measured tendon is the pull of the actuators on it (N, >= 0 when pulling)."""
+        m, d = self.model, self.data
+        tension = np.zeros(len(self._tendon_ids))
+        for k, tid in enumerate(self._tendon_ids):
+            on = (m.actuator_trntype == 3) & (m.actuator_trnid[:, 0] == tid)   # mjTRN_TENDON
+            tension[k] = -float(np.sum(d.actuator_force[on] * m.actuator_gear[on, 0]))
+        return (float(d.time), np.array(d.qpos[: m.nv]), np.array(d.qvel), np.array(d.qfrc_actuator),
+                tension)
