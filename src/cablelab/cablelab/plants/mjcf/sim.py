@@ -133,7 +133,8 @@ def simulate(model, duration: float = 12.0, seed: int = 0, kp: float = 400.0, kd
 def record(model, hidden: Hidden = Hidden(), *, duration: float = 12.0, seed: int = 0,
            encoder_bits: int = 18, effort_noise: float = 0.02, effort_quantum: float = 1e-3):
     """A simulated record as a sensor sees it: positions quantised to ``2 pi / 2^bits``, efforts
-    times the hidden gain plus white noise (N m) and quantised."""
+    times the hidden gain plus white noise (N m) and quantised; NaN for a joint no actuator
+    drives."""
     t, q, qd, eff = simulate(model, duration, seed)
     rng = np.random.default_rng(seed + 1)
     quantum = 2 * np.pi / 2**encoder_bits
@@ -142,6 +143,9 @@ def record(model, hidden: Hidden = Hidden(), *, duration: float = 12.0, seed: in
     gain = np.array([hidden.gain.get(j, 1.0) for j in joints])
     e = eff * gain + rng.normal(0.0, effort_noise, eff.shape)
     e = np.round(e / effort_quantum) * effort_quantum
+    driven = np.zeros(model.nv, bool)
+    driven[model.jnt_dofadr[model.actuator_trnid[:, 0]]] = True
+    e[:, ~driven] = np.nan                 # a joint without actuator has no effort sensor
     return t, q_meas, e, joints
 
 

@@ -4,6 +4,8 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 #: a three-joint arm (base yaw, shoulder, elbow) carrying an unknown payload on ``tool``
 ARM3 = HERE / "arm3.xml"
+#: an overhead crane: driven trolley and hoist, a payload swinging freely on the rope
+GANTRY = HERE / "gantry.xml"
 
 
 def text(path: Path) -> str:
