@@ -113,3 +113,10 @@ def test_bag_whose_joints_are_not_in_the_model_is_one_line_error(tmp_path, capsy
     assert main(["compare", str(path)]) == 2
     err = capsys.readouterr().err.strip()
     assert "\n" not in err and "'wrist'" in err and "not in the model" in err, err
+
+
+def test_example_joints_are_the_shipped_arms():
+    from cablelab.plants.mjcf.mjcf import dof_joints
+    from cablelab.plants.mjcf.plant import EXAMPLE_JOINTS
+
+    assert tuple(dof_joints(load_description(_desc(model=ARM_XML)).mjcf.compiled())) == EXAMPLE_JOINTS

@@ -30,10 +30,16 @@ def candidates(description) -> tuple[str, ...]:
     return cands
 
 
+#: the joints of the machine without a description: the shipped example arm
+#: (``examples/arm3.xml``, what ``cable_sim_node --plant mjcf`` runs by default; default layouts)
+EXAMPLE_JOINTS = ("base_yaw", "shoulder", "elbow")
+
+
 def _topic_names(desc) -> dict:
     sec = getattr(desc, "mjcf", None) if desc is not None else None
     if sec is None:
-        return {}
+        return {topic(None, "joint_states"): list(EXAMPLE_JOINTS),
+                topic(None, "ground_truth_joint_states"): list(EXAMPLE_JOINTS)}
     from .mjcf import dof_joints
 
     joints = dof_joints(sec.compiled())
@@ -57,4 +63,5 @@ PLANT = Plant(
     joints=None,
     capabilities=frozenset({"joint_actuators"}),
     topic_names=_topic_names,
+    channels=EXAMPLE_JOINTS,
 )

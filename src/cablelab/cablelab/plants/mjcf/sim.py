@@ -97,13 +97,28 @@ def excitation(duration: float, dt: float, n: int, seed: int = 0, amplitude: flo
     return t, q, qd, qdd
 
 
+def actuator_moments(model, data) -> np.ndarray:
+    """(nu, nv) dense actuator moment matrix (generalised force per unit actuator force)."""
+    import mujoco
+
+    out = np.zeros((model.nu, model.nv))
+    mujoco.mju_sparse2dense(out, data.actuator_moment, data.moment_rownnz, data.moment_rowadr,
+                            data.moment_colind)
+    return out
+
+
 def simulate(model, duration: float = 12.0, seed: int = 0, kp: float = 400.0, kd: float = 40.0,
-             amplitude: float = 0.8):
+             amplitude: float = 0.8, pretension: float = 30.0):
     """Run the truth model under PD + bias feedback tracking a multisine (one sample per step).
 
+    The wanted generalised force is spread over the actuators by least squares around a
+    pretension of ``pretension`` N on every tendon actuator (cables must pull), exactly on the
+    joints an actuator drives (joint actuators: the force itself).
+
     Returns:
-        ``t (T,), q (T, nv), qd (T, nv), effort (T, nv)``: the state each step starts from and
-        the generalised actuator force applied during it (``qfrc_actuator``).
+        ``t (T,), q (T, nv), qd (T, nv), effort (T, nv), act (T, nu)``: the state each step
+        starts from, the generalised actuator force applied during it (``qfrc_actuator``) and
+        the actuator forces.
     """
     import mujoco
 
@@ -114,28 +129,40 @@ def simulate(model, duration: float = 12.0, seed: int = 0, kp: float = 400.0, kd
     q = np.empty((T, model.nv))
     qd = np.empty((T, model.nv))
     eff = np.empty((T, model.nv))
-    mass = np.array([model.dof_M0[i] if hasattr(model, "dof_M0") else 1.0 for i in range(model.nv)])
-    kp_v = kp * np.maximum(mass, 0.05)
-    kd_v = kd * np.maximum(mass, 0.05)
-    # actuator i drives the joint of its transmission: ctrl = generalised force / gear
-    act_dof = model.jnt_dofadr[model.actuator_trnid[:, 0]]
-    gear = model.actuator_gear[:, 0]
+    act = np.empty((T, model.nu))
+    mujoco.mj_forward(model, d)
+    mass = np.maximum(np.array(model.dof_M0), 0.05)
+    kp_v, kd_v = kp * mass, kd * mass
+    tendon = model.actuator_trntype == int(mujoco.mjtTrn.mjTRN_TENDON)
+    c0 = np.where(tendon, -pretension / np.maximum(np.abs(model.actuator_gear[:, 0]), 1e-12), 0.0)
     for k in range(T):
         mujoco.mj_step1(model, d)
-        tau = kp_v * (qr[k] - d.qpos) + kd_v * (qdr[k] - d.qvel) + d.qfrc_bias
-        d.ctrl[:] = tau[act_dof] / gear
-        q[k], qd[k] = d.qpos, d.qvel
+        tau = kp_v * (qr[k] - d.qpos[: model.nv]) + kd_v * (qdr[k] - d.qvel) + d.qfrc_bias
+        A = actuator_moments(model, d).T                     # (nv, nu)
+        d.ctrl[:] = c0 + np.linalg.lstsq(A, tau - A @ c0, rcond=None)[0]
+        q[k], qd[k] = d.qpos[: model.nv], d.qvel
         mujoco.mj_step2(model, d)
         eff[k] = d.qfrc_actuator
-    return t, q, qd, eff
+        act[k] = d.actuator_force
+    return t, q, qd, eff, act
 
 
 def record(model, hidden: Hidden = Hidden(), *, duration: float = 12.0, seed: int = 0,
            encoder_bits: int = 18, effort_noise: float = 0.02, effort_quantum: float = 1e-3):
     """A simulated record as a sensor sees it: positions quantised to ``2 pi / 2^bits``, efforts
     times the hidden gain plus white noise (N m) and quantised; NaN for a joint no actuator
-    drives."""
-    t, q, qd, eff = simulate(model, duration, seed)
+    drives. Returns ``(t, q, effort, joint names)``; :func:`record_all` also the tensions."""
+    r = record_all(model, hidden, duration=duration, seed=seed, encoder_bits=encoder_bits,
+                   effort_noise=effort_noise, effort_quantum=effort_quantum)
+    return r["t"], r["q"], r["effort"], r["joints"]
+
+
+def record_all(model, hidden: Hidden = Hidden(), *, duration: float = 12.0, seed: int = 0,
+               encoder_bits: int = 18, effort_noise: float = 0.02, effort_quantum: float = 1e-3,
+               tension_noise: float = 0.2) -> dict:
+    """:func:`record` plus ``tension`` (T, n_tendons): per tendon the pull of the actuators on
+    it (N) with white noise ``tension_noise``, and ``tendons`` their names."""
+    t, q, qd, eff, act = simulate(model, duration, seed)
     rng = np.random.default_rng(seed + 1)
     quantum = 2 * np.pi / 2**encoder_bits
     q_meas = np.round(q / quantum) * quantum
@@ -144,9 +171,15 @@ def record(model, hidden: Hidden = Hidden(), *, duration: float = 12.0, seed: in
     e = eff * gain + rng.normal(0.0, effort_noise, eff.shape)
     e = np.round(e / effort_quantum) * effort_quantum
     driven = np.zeros(model.nv, bool)
-    driven[model.jnt_dofadr[model.actuator_trnid[:, 0]]] = True
+    on_joint = model.actuator_trntype == 0
+    driven[model.jnt_dofadr[model.actuator_trnid[on_joint, 0]]] = True
     e[:, ~driven] = np.nan                 # a joint without actuator has no effort sensor
-    return t, q_meas, e, joints
+    tension = np.zeros((len(t), model.ntendon))
+    for a in np.flatnonzero(model.actuator_trntype == 3):                 # mjTRN_TENDON
+        tension[:, model.actuator_trnid[a, 0]] -= act[:, a] * model.actuator_gear[a, 0]
+    tension += rng.normal(0.0, tension_noise, tension.shape)
+    return {"t": t, "q": q_meas, "effort": e, "joints": joints, "tension": tension,
+            "tendons": names(model, "tendon")}
 
 
 def description_yaml(xml: str, **section) -> str:
@@ -163,21 +196,28 @@ def description_yaml(xml: str, **section) -> str:
 def write_bag(path, xml: str, hidden: Hidden = Hidden(), *, duration: float = 12.0, seed: int = 0,
               overwrite: bool = True, **section) -> str:
     """Simulate the truth (``xml`` + ``hidden``) and write a contract bag of it: the description
-    (the user's model, without the hidden effect), ``/mjcf/joint_states`` and the truth."""
+    (the user's model, without the hidden effect), ``/mjcf/joint_states`` and, for the section's
+    ``tendons``, ``/mjcf/cable_tensions``."""
     from ...bags import BagWriter
 
     model = truth_model(xml, hidden)
-    t, q, e, joints = record(model, hidden, duration=duration, seed=seed)
+    r = record_all(model, hidden, duration=duration, seed=seed)
     desc = description_yaml(xml, **section)
     t0 = 1000.0
     with BagWriter(path, overwrite=overwrite) as w:
         w.write_description(desc, t=t0)
-        w.write_joint_states("/mjcf/joint_states", t0 + t, joints, position=q, effort=e)
+        w.write_joint_states("/mjcf/joint_states", t0 + r["t"], r["joints"], position=r["q"],
+                             effort=r["effort"])
+        measured = list(section.get("tendons") or ())
+        if measured:
+            idx = [r["tendons"].index(x) for x in measured]
+            w.write_joint_states("/mjcf/cable_tensions", t0 + r["t"], measured,
+                                 effort=r["tension"][:, idx])
     return str(path)
 
 
-__all__ = ["Hidden", "MjcfSim", "description_yaml", "excitation", "record", "simulate", "truth_model",
-           "write_bag", "names"]
+__all__ = ["Hidden", "MjcfSim", "actuator_moments", "description_yaml", "excitation", "record",
+           "record_all", "simulate", "truth_model", "write_bag"]
 
 
 class MjcfSim:
