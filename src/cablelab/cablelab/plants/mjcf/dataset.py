@@ -21,13 +21,14 @@ from .topics import JOINT_STATE, topic
 
 
 def dataset_from_arrays(t, q, effort, description, options: dict | None = None, *, qd=None,
-                        tension=None, source: str = "data") -> Dataset:
+                        tension=None, driven=None, source: str = "data") -> Dataset:
     """Dataset from raw arrays in the model's dof order.
 
     Args:
         t: (N,) s; q: (N, nv) joint positions; effort: (N, nv) measured generalised forces
             (0 for a joint without actuator); qd: optional measured velocities (N, nv).
         tension: (N, n_tendons) measured tensions of the section's ``tendons`` (N), or None.
+        driven: (nv,) bool, the joints whose effort is measured (default: every joint).
         description: a :class:`~cablelab.description.Description` with an ``mjcf`` section.
     """
     options = options or {}
@@ -45,7 +46,9 @@ def dataset_from_arrays(t, q, effort, description, options: dict | None = None, 
     with_tendons = bool(sec.tendons)
     res = inverse_dynamics(model, q_c, qd_c, qdd_c, tendons=with_tendons)
     tau, ten_j = (res if with_tendons else (res, None))
+    driven = np.ones(len(joints), bool) if driven is None else np.asarray(driven, bool)
     signals = {"q": q_c, "qd": qd_c, "qdd": qdd_c, KNOWN_OUTPUT: tau, "cutoff_hz": c["cutoff_hz"],
+               "driven": driven,
                "rest_velocity": c["qd_smooth"], "load_warnings": list(c["warnings"]) + list(sec.warnings)}
     if with_tendons:
         tn = names(model, "tendon")
@@ -103,6 +106,7 @@ def dataset(bag, description, options: dict | None = None) -> Dataset:
     from .mjcf import actuated_joints
 
     driven = set(actuated_joints(model)) if measured is None else measured
+    has_effort = np.ones(len(joints), bool)
     for k, j in enumerate(joints):
         if not np.isfinite(q[:, k]).any():
             raise CablelabError(f"{bag.path}: {js_topic} has no position values for joint {j!r}")
@@ -111,6 +115,7 @@ def dataset(bag, description, options: dict | None = None) -> Dataset:
                 raise CablelabError(f"{bag.path}: {js_topic} has no effort values for the driven "
                                     f"joint {j!r}")
             eff[:, k] = 0.0                  # no actuator: its zero-force equation
+            has_effort[k] = False
     qd = js.velocity[:, idx] if js.velocity.size else None
     distrusted = ((options or {}).get("derived_velocity") or {}).get(js_topic, ())
     if qd is not None and (not np.isfinite(qd).all() or any(j in distrusted for j in joints)):
@@ -127,4 +132,4 @@ def dataset(bag, description, options: dict | None = None) -> Dataset:
         tension = np.column_stack([np.interp(js.t, ts.t, ts.effort[:, ts.names.index(x)])
                                    for x in sec.tendons])
     return dataset_from_arrays(js.t, q, eff, description, options, qd=qd, tension=tension,
-                               source=str(bag.path))
+                               driven=has_effort, source=str(bag.path))

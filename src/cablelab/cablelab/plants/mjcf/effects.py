@@ -97,7 +97,10 @@ JOINT_SPRING = register(Effect(
 
 
 def _gain(ds: Dataset) -> np.ndarray:
-    return ds.actuator_block(ds.require_signal(KNOWN_OUTPUT))
+    """The nominal force on each joint whose effort is measured (a joint without an effort
+    sensor has no torque constant: its column is zero, the gain is not excited)."""
+    driven = np.asarray(ds.signals.get("driven", np.ones(ds.n_channels, bool)), bool)
+    return ds.actuator_block(ds.require_signal(KNOWN_OUTPUT) * driven[None, :])
 
 
 def _gain_physical(ds: Dataset):

@@ -6,6 +6,8 @@ HERE = Path(__file__).resolve().parent
 ARM3 = HERE / "arm3.xml"
 #: an overhead crane: driven trolley and hoist, a payload swinging freely on the rope
 GANTRY = HERE / "gantry.xml"
+#: a four-cable camera robot: a carriage on four cables over pulleys (spatial tendons)
+CABLECAM = HERE / "cablecam.xml"
 
 
 def text(path: Path) -> str:
