@@ -151,6 +151,10 @@ def _link_columns(ds: Dataset) -> np.ndarray:
 
 
 def _link_names(ds: Dataset) -> list[str]:
+    """The moving bodies' names; ``["body"]`` (the naming template) for a dataset without an
+    ``mjcf`` description."""
+    if getattr(ds.description, "mjcf", None) is None and LINK_BODIES not in ds.signals:
+        return ["body"]
     if LINK_BODIES not in ds.signals:
         from .description import section_of
         from .mjcf import names
