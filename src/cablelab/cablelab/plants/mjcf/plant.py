@@ -52,6 +52,7 @@ def _topic_names(desc) -> dict:
 PLANT = Plant(
     name="mjcf",
     topics=(),                      # the joint-state topic depends on the description (remapping)
+    checked_topics=(TOPICS["joint_states"][0], TOPICS["cable_tensions"][0]),
     dataset=dataset,
     baseline=baseline,
     candidates=candidates,
