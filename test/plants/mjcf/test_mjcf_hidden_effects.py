@@ -140,3 +140,19 @@ def test_cable_camera_payload_from_measured_tensions(tmp_path):
     assert top["params"]["m"] == pytest.approx(1.5, rel=0.05)
     gain = next(r for r in d.ranking if r["effect"] == "actuator_gain")
     assert not gain["significant"]
+
+
+def test_greedy_finds_two_hidden_effects_in_order(tmp_path):
+    """Payload (large) and elbow viscous friction (small) hidden together: the waterfall adds
+    payload_mass, then joint_viscous_friction, then stops; both recovered."""
+    from cablelab.diagnose import greedy
+
+    hidden = Hidden(payload=("tool", 1.0, (0.03, 0.0, 0.0)), damping={"elbow": 0.4})
+    bag = write_bag(tmp_path / "two", ARM_XML, hidden, duration=12.0, seed=7, payload_body="tool")
+    plant, desc, ds = workbench.load(bag)
+    steps = greedy(workbench.build_model(plant, desc), ds, plant.candidates(desc), max_steps=3)
+    assert [s["added"] for s in steps[1:]] == ["payload_mass", "joint_viscous_friction"], \
+        [(s["added"], s["error"]) for s in steps]
+    final = steps[2]["params"]
+    assert final["m"] == pytest.approx(1.0, rel=0.05)
+    assert final["Fv[elbow]"] == pytest.approx(0.4, rel=0.10)
