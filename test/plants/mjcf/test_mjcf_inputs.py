@@ -1,6 +1,7 @@
 """A user's own model and topics: URDF on a remapped ``/joint_states``, measured tendon tensions
 through the tendon Jacobian (sign: a tension pulls its tendon shorter)."""
 import numpy as np
+import pytest
 import yaml
 
 from cablelab import workbench
@@ -114,3 +115,18 @@ def test_csv_import_onto_the_models_joints(tmp_path, capsys):
     assert d.mjcf.model == ARM3.read_text() and ds.channels == tuple(joints)
     nrmse = workbench.compare(ds, workbench.build_model(plant, d))["channels"]
     assert all(m["nrmse"] < 0.02 for m in nrmse.values()), nrmse
+
+
+def test_payload_estimate_on_a_window():
+    """The estimator's fit on a 4 s window of the example arm carrying 1.2 kg at 5 cm."""
+    from cablelab.description import load_description
+    from cablelab.plants.mjcf.estimation import payload_estimate
+    from cablelab.plants.mjcf.examples import ARM3
+    from cablelab.plants.mjcf.sim import description_yaml
+
+    xml = ARM3.read_text()
+    t, q, e, _ = record(truth_model(xml, Hidden(payload=("tool", 1.2, (0.05, 0.0, 0.0)))),
+                        duration=4.0, seed=2)
+    est = payload_estimate(t, q, e, load_description(description_yaml(xml, payload_body="tool")))
+    assert est.m == pytest.approx(1.2, rel=0.02)
+    assert est.com[0] == pytest.approx(0.05, abs=0.005)

@@ -52,13 +52,16 @@ def _set(joint, attr: str, value: float) -> None:
         setattr(joint, attr, float(value))
 
 
-def truth_model(xml: str, hidden: Hidden = Hidden(), timestep: float | None = None):
-    """The truth :class:`mujoco.MjModel`: ``xml`` edited with MjSpec to hold ``hidden``."""
+def truth_model(xml: str, hidden: Hidden = Hidden(), timestep: float | None = None, *,
+                euler: bool = True):
+    """The truth :class:`mujoco.MjModel`: ``xml`` edited with MjSpec to hold ``hidden``;
+    ``euler``: explicit Euler without implicit damping (else the model's own integrator)."""
     import mujoco
 
     spec = mujoco.MjSpec.from_string(xml)
-    spec.option.integrator = mujoco.mjtIntegrator.mjINT_EULER
-    spec.option.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_EULERDAMP)
+    if euler:
+        spec.option.integrator = mujoco.mjtIntegrator.mjINT_EULER
+        spec.option.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_EULERDAMP)
     if timestep:
         spec.option.timestep = float(timestep)
     if hidden.payload is not None:
@@ -226,12 +229,17 @@ class MjcfSim:
 
     Args:
         section: the parsed ``mjcf:`` section; gravity: g along -z, m/s^2.
+        hidden: what the simulated truth has beyond the section's model (:class:`Hidden`).
     """
 
-    def __init__(self, section, gravity: float = 9.81):
+    def __init__(self, section, gravity: float = 9.81, hidden: Hidden | None = None):
         import mujoco
 
-        self.model = section.compiled(gravity)
+        if hidden is None:
+            self.model = section.compiled(gravity)
+        else:
+            self.model = truth_model(section.model, hidden, euler=False)
+            self.model.opt.gravity[:] = (0.0, 0.0, -float(gravity))
         self.data = mujoco.MjData(self.model)
         self.joints = dof_joints(self.model)
         self.tendons = list(section.tendons)

@@ -24,7 +24,8 @@ from ....ros.params import DESCRIPTION, START_GATE, Param, merge
 from ....ros.plant_node import PlantNode
 from ....ros.qos import publisher_qos, stream_qos
 from ..description import section_of
-from ..sim import MjcfSim
+from ..mjcf import names
+from ..sim import Hidden, MjcfSim
 from ..topics import topic
 
 PARAMETERS = merge((
@@ -33,6 +34,9 @@ PARAMETERS = merge((
           "the model)", "Hz", gt=0.0, le=10000.0, nan=True),
     Param("command_timeout", 0.5, "a command older than this falls back to zero controls (WARN)",
           "s wall", gt=0.0),
+    Param("payload_mass", 0.0, "mass the simulated truth carries on mjcf.payload_body, at its "
+          "centre of mass (not in the published description: what an estimator must find)", "kg",
+          ge=0.0, le=1e6),
 ), START_GATE)
 
 
@@ -50,7 +54,14 @@ class MjcfSimNode(PlantNode):
         v = self.declare_params(PARAMETERS)
         self.description = load_description(v.description or default_description())
         sec = section_of(self.description)
-        self.sim = MjcfSim(sec, self.description.gravity)
+        hidden = None
+        if v.payload_mass > 0:
+            if not sec.payload_body:
+                raise CablelabError("cable_sim_node --plant mjcf: payload_mass needs mjcf.payload_body "
+                                    "in the description")
+            com = sec.compiled().body_ipos[names(sec.compiled(), "body").index(sec.payload_body)]
+            hidden = Hidden(payload=(sec.payload_body, v.payload_mass, tuple(map(float, com))))
+        self.sim = MjcfSim(sec, self.description.gravity, hidden)
         step = self.sim.model.opt.timestep
         self.period = step * max(1, round(1.0 / (v.rate * step))) if v.rate == v.rate else step
         self.ctrl = [0.0] * self.sim.model.nu
