@@ -50,7 +50,14 @@ def _descriptions():
     return {"axis": open_bag(EMPS).description_yaml, "cdpr": open_bag(CDPR).description_yaml,
             "crane": open_bag(REPO / "bags" / "crane_control").description_yaml,
             "leg": (plants / "leg" / "data" / "leg.yaml").read_text(),
-            "suspended": (plants / "suspended" / "data" / "licas.yaml").read_text()}
+            "suspended": (plants / "suspended" / "data" / "licas.yaml").read_text(),
+            "mjcf": _mjcf_description()}
+
+
+def _mjcf_description() -> str:
+    from cablelab.plants.mjcf.nodes.sim import default_description
+
+    return default_description()
 
 
 @st.composite

@@ -7,6 +7,7 @@ arrays, SI units). Unknown keys, missing required keys, wrong types and wrong ve
 """
 from __future__ import annotations
 
+import contextvars
 import dataclasses
 import os
 import re
@@ -21,6 +22,9 @@ from .fields import check_keys, fail, mapping, number
 
 #: keys of the description's top level besides the plant sections
 COMMON_KEYS = ("plant", "name", "gravity")
+#: directory of the description file being parsed ("" for YAML text): a plant section's relative
+#: file names (``mjcf.model_file``) refer to it
+DESCRIPTION_DIR: contextvars.ContextVar[str] = contextvars.ContextVar("description_dir", default="")
 
 
 @dataclass(frozen=True)
@@ -173,13 +177,19 @@ def load_description(src: str | os.PathLike) -> Description:
         raise CablelabError(f"{origin}:{where} bad YAML ({problem})") from None
     if data is None:
         raise CablelabError(f"{origin}: empty description")
+    token = DESCRIPTION_DIR.set(os.path.dirname(os.path.abspath(origin)) if origin != "description" else "")
     try:
         desc = parse_description(data, origin)
     except CablelabError as exc:
         if origin != "description":
             raise CablelabError(f"{origin}: {exc}") from None
         raise
-    return dataclasses.replace(desc, yaml_text=text)
+    finally:
+        DESCRIPTION_DIR.reset(token)
+    # a section that read a file it names (``inlines_files``) is published with the file's text
+    # in it (a bag carries its own model): the YAML is regenerated from the parsed sections
+    inlined = any(getattr(sec, "inlines_files", False) for sec in desc.sections.values())
+    return dataclasses.replace(desc, yaml_text="" if inlined else text)
 
 
 def plain(obj: Any) -> Any:

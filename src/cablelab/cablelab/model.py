@@ -20,6 +20,11 @@ from .effects.base import Effect, Param, RegressorFn, TransformFn
 from .errors import CablelabError
 
 
+#: ``Dataset.signals`` key of a plant's parameter-free prediction (N, C) of the output channels,
+#: part of every model's output (the known part, like fixed parameters)
+KNOWN_OUTPUT = "known_output"
+
+
 @dataclass(frozen=True)
 class Model:
     """A plant, the effects it includes, and its known parameters.
@@ -108,9 +113,19 @@ class Model:
 
             phi = parallel_filter(phi, ds.t, ds.parallel_hz)
         y_known = np.zeros((ds.n, ds.n_channels))
+        nominal = ds.signals.get(KNOWN_OUTPUT)
+        if nominal is not None:
+            # the plant's own parameter-free prediction (e.g. MuJoCo's inverse dynamics of the
+            # given model), filtered like the columns
+            nominal = np.asarray(nominal, dtype=float).reshape(ds.n, ds.n_channels)
+            if ds.parallel_hz:
+                from .parallel_filter import parallel_filter
+
+                nominal = parallel_filter(nominal[:, :, None], ds.t, ds.parallel_hz)[:, :, 0]
+            y_known = y_known + nominal
         if known:
             vals = np.array([self.fixed[names[i]] for i in known])
-            y_known = phi[:, :, known] @ vals
+            y_known = y_known + phi[:, :, known] @ vals
         return phi[:, :, free], [cols[i] for i in free], y_known
 
     def predict(self, ds: Dataset, params: Mapping[str, float]) -> tuple[np.ndarray, np.ndarray]:
@@ -154,5 +169,5 @@ def parse_fixed(items: Sequence[str] | None) -> dict:
     return out
 
 
-__all__ = ["STANDARD_GRAVITY", "Dataset", "Effect", "Model", "Param", "RegressorFn", "TransformFn",
+__all__ = ["KNOWN_OUTPUT", "STANDARD_GRAVITY", "Dataset", "Effect", "Model", "Param", "RegressorFn", "TransformFn",
            "parse_effect_list", "parse_fixed"]

@@ -240,7 +240,9 @@ def load_from_args(args, *, check_out: bool = False):
             raise CablelabError(f"--fix {name}={value}: the value must be a finite number")
     model = build_model(plant, desc, parse_effect_list(args.effects), baseline, fixed,
                         strict=getattr(args, "strict", False))
-    if not model.effects:
+    from ..model import KNOWN_OUTPUT
+
+    if not model.effects and KNOWN_OUTPUT not in ds.signals:   # nothing known, nothing to fit
         from ..errors import CablelabError
 
         raise CablelabError(f"--baseline {args.baseline}: the model has no effects left to fit; add some "

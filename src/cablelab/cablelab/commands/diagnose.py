@@ -42,7 +42,7 @@ def run(args) -> int:
                         where=f"candidate {c.effect}")
     for step in out.greedy:
         flag_impossible(args, step.effects, step.params, step.units,
-                        where=f"model {' + '.join(step.effects)}")
+                        where=f"model {' + '.join(step.effects) or 'nominal'}")
     if args.out:
         write_overlay_out(args, plant, ds, greedy_stages(ds, model, out.greedy))
     from ..diagnose.result import excite_commands

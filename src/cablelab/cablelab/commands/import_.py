@@ -189,23 +189,31 @@ def _check_factor(field: str, op: str, name: str, x, source: str) -> None:
                             f"imported values would be infinite")
 
 
-def joint_topic(plant: str) -> tuple[str, tuple[str, ...]]:
-    """The plant's joint-state topic and joint names (its :class:`~cablelab.registry.Plant`)."""
+def joint_topic(plant: str, desc=None) -> tuple[str, tuple[str, ...]]:
+    """The plant's joint-state topic and joint names (its :class:`~cablelab.registry.Plant`); for
+    a plant whose joints depend on the description (``Plant.joints`` None), the joint-state topic
+    its ``topic_names(desc)`` gives first (the description may remap it) and its names."""
     from ..registry import get_plant
 
     p = get_plant(plant)
-    if not p.joint_topic or not p.joints:
+    topic, joints = p.joint_topic, p.joints
+    if not joints and desc is not None and p.topic_names is not None:
+        named = p.topic_names(desc) or {}
+        if named:
+            topic = topic if topic in named else next(iter(named))
+            joints = named[topic]
+    if not topic or not joints:
         raise CablelabError(f"import --plant {plant}: the plant declares no fixed joint-state topic "
                             "to import into")
-    return p.joint_topic, tuple(p.joints)
+    return topic, tuple(joints)
 
 
-def import_series(path: str, plant: str, spec: str) -> dict:
+def import_series(path: str, plant: str, spec: str, desc=None) -> dict:
     """Read ``path`` and evaluate ``spec`` into ``{"t", "names", "position", "velocity", "effort"}``
     arrays (N, k) (None for an unmapped field)."""
     table = read_table(path)
     fields = parse_spec(spec)
-    topic, joints = joint_topic(plant)
+    topic, joints = joint_topic(plant, desc)
     if "time" not in fields:
         raise CablelabError("--map: missing 'time=' (e.g. time=t)")
     fields_time = fields.pop("time")
@@ -260,7 +268,7 @@ def run(args) -> int:
         raise CablelabError(f"--description is for plant {desc.plant}, not --plant {args.plant}")
     inputs = [args.file] + ([args.description] if os.path.exists(args.description) else [])
     check_target(args.out, overwrite=args.overwrite, inputs=inputs, option="-o")
-    s = import_series(args.file, args.plant, args.map)
+    s = import_series(args.file, args.plant, args.map, desc)
     from ..timebase import check_stamps, raise_if_impossible
 
     tb = check_stamps(s["t"], topic=f"{args.file}: time column", limits=limits_from_args(args))

@@ -103,7 +103,7 @@ class Diagnosis:
 
     def lines(self) -> list[str]:
         """The text report: baseline, ranking (``*`` = significant), waterfall, final values."""
-        out = [f"plant {self.plant}: model {' + '.join(self.baseline_effects)}, held-out NRMSE "
+        out = [f"plant {self.plant}: model {' + '.join(self.baseline_effects) or 'nominal (no effect added)'}, held-out NRMSE "
                f"{100 * self.baseline_error:.2f} % ({self.folds} folds)"]
         for i, c in enumerate(self.ranking, 1):
             after = "-" if c.error_after is None else f"{100 * c.error_after:.2f} %"

@@ -351,7 +351,8 @@ def _identify_once(model: Model, ds: Dataset, *, on_deficient: str = "raise",
     cov_all = np.zeros((0, 0)) if fit.base else np.asarray(fit.cov, dtype=float)
     if jac_nl is not None and not fit.base:
         w = fit.channel_scale
-        a = np.where(valid[:, None, None], phi * w[None, :, None], 0.0).reshape(-1, phi.shape[2])
+        a = np.where(valid[:, None, None], phi * w[None, :, None], 0.0).reshape(
+            phi.shape[0] * phi.shape[1], phi.shape[2])
         jac = np.concatenate([-a, jac_nl], axis=1)
         jtj = jac.T @ jac
         try:
@@ -468,7 +469,7 @@ class _OuterProblem:
                             channel_scale=channel_scale)
         self.w = fit0.channel_scale
         if self.constant:
-            a = (phi[valid] * self.w[None, :, None]).reshape(-1, phi.shape[2])
+            a = (phi[valid] * self.w[None, :, None]).reshape(int(valid.sum()) * phi.shape[1], phi.shape[2])
             self.q = np.linalg.qr(a, mode="reduced")[0] if a.shape[1] else np.zeros((a.shape[0], 0))
 
     def residual(self, x) -> np.ndarray:
@@ -477,10 +478,10 @@ class _OuterProblem:
             b = ((ds2.y - self.y_known)[self.valid] * self.w[None, :]).reshape(-1)
             return b - self.q @ (self.q.T @ b)
         phi, _, y_known = self.model.regressor(ds2)
-        a = (phi[self.valid] * self.w[None, :, None]).reshape(-1, phi.shape[2])
         b = ((ds2.y - y_known)[self.valid] * self.w[None, :]).reshape(-1)
-        if a.shape[1] == 0:
+        if phi.shape[2] == 0:          # a model of known parts only (a delay alone)
             return b
+        a = (phi[self.valid] * self.w[None, :, None]).reshape(-1, phi.shape[2])
         # normal equations on scaled columns: cheap for the few parameters of an outer search
         sc = np.linalg.norm(a, axis=0)
         sc = np.where(sc > 0, sc, 1.0)

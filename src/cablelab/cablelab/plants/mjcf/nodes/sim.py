@@ -1,0 +1,116 @@
+"""Simulator node of any MuJoCo model: ``cable_sim_node --plant mjcf -p description:=FILE``.
+
+Steps the description's model at its own timestep (:class:`..sim.MjcfSim`) with the actuator
+controls of ``effort_commands`` (model actuator order; a stale or missing command: zero controls)
+and publishes, each period, ``joint_states`` (every hinge/slide joint: position, velocity,
+effort = the actuators' generalised force on it), ``cable_tensions`` (the description's
+``tendons``), ``ground_truth/joint_states``, ``/clock`` and ``/plant_description`` (the model
+inline). Topic names follow the description's ``mjcf.topics``. Without ``description`` it runs
+the shipped three-joint arm (``plants/mjcf/examples/arm3.xml``).
+"""
+from __future__ import annotations
+
+import math
+import time
+
+from sensor_msgs.msg import JointState
+from std_msgs.msg import Float64MultiArray
+
+from ....description import load_description
+from ....errors import CablelabError
+from ....ros import convert
+from ....ros.clock import ClockPublisher
+from ....ros.params import DESCRIPTION, START_GATE, Param, merge
+from ....ros.plant_node import PlantNode
+from ....ros.qos import publisher_qos, stream_qos
+from ..description import section_of
+from ..mjcf import names
+from ..sim import Hidden, MjcfSim
+from ..topics import topic
+
+PARAMETERS = merge((
+    DESCRIPTION,
+    Param("rate", float("nan"), "publishing rate = command sampling (NaN: every physics step of "
+          "the model)", "Hz", gt=0.0, le=10000.0, nan=True),
+    Param("command_timeout", 0.5, "a command older than this falls back to zero controls (WARN)",
+          "s wall", gt=0.0),
+    Param("payload_mass", 0.0, "mass the simulated truth carries on mjcf.payload_body, at its "
+          "centre of mass (not in the published description: what an estimator must find)", "kg",
+          ge=0.0, le=1e6),
+), START_GATE)
+
+
+def default_description() -> str:
+    """The shipped example (a three-joint arm, payload on ``tool``) when no description is given."""
+    from ..examples import ARM3
+    from ..sim import description_yaml
+
+    return description_yaml(ARM3.read_text(encoding="utf-8"), payload_body="tool")
+
+
+class MjcfSimNode(PlantNode):
+    def __init__(self):
+        super().__init__("cable_sim_node")
+        v = self.declare_params(PARAMETERS)
+        self.description = load_description(v.description or default_description())
+        sec = section_of(self.description)
+        hidden = None
+        if v.payload_mass > 0:
+            if not sec.payload_body:
+                raise CablelabError("cable_sim_node --plant mjcf: payload_mass needs mjcf.payload_body "
+                                    "in the description")
+            com = sec.compiled().body_ipos[names(sec.compiled(), "body").index(sec.payload_body)]
+            hidden = Hidden(payload=(sec.payload_body, v.payload_mass, tuple(map(float, com))))
+        self.sim = MjcfSim(sec, self.description.gravity, hidden)
+        step = self.sim.model.opt.timestep
+        self.period = step * max(1, round(1.0 / (v.rate * step))) if v.rate == v.rate else step
+        self.ctrl = [0.0] * self.sim.model.nu
+        self.start_gate()
+        self.last_publish = time.monotonic()
+        self.inputs.add("effort_commands", timeout=v.command_timeout, length=self.sim.model.nu)
+        self.pub_js = self.create_publisher(JointState, topic(sec, "joint_states"), publisher_qos())
+        self.pub_truth = self.create_publisher(JointState, topic(sec, "ground_truth_joint_states"),
+                                               publisher_qos())
+        self.pub_ten = (self.create_publisher(JointState, topic(sec, "cable_tensions"), publisher_qos())
+                        if sec.tendons else None)
+        self.clock = ClockPublisher(self)
+        self.publish_description(self.description)
+        self.create_subscription(Float64MultiArray, topic(sec, "effort_commands"), self.on_command,
+                                 stream_qos())
+        self.start_diagnostics()
+        self.timer = self.create_timer(self.period, self.tick)
+        self.publish_state()
+
+    def extend_status(self, level, msg, values):
+        values["sim time s"] = f"{self.sim.t:.3f}"
+        return level, msg, values
+
+    def on_command(self, msg: Float64MultiArray) -> None:
+        values = convert.float_array(msg)
+        if self.inputs.accept("effort_commands", values, time.monotonic()):
+            self.ctrl = [float(x) for x in values]
+
+    def tick(self) -> None:
+        now = time.monotonic()
+        if self.waiting_for_subscribers(self.pub_js, self.last_publish, self.publish_state):
+            return
+        if not self.inputs.fresh("effort_commands", now):
+            self.ctrl = [0.0] * self.sim.model.nu       # no (fresh) command: drives off
+        self.sim.advance(self.ctrl, self.period)
+        self.publish_state()
+
+    def publish_state(self) -> None:
+        self.last_publish = time.monotonic()
+        t, q, qd, effort, tension = self.sim.state()
+        if not all(math.isfinite(x) for x in q):
+            raise CablelabError("cable_sim_node --plant mjcf: the simulation diverged (NaN state)")
+        self.clock.publish(t)
+        joints = self.sim.joints
+        self.pub_js.publish(convert.joint_state_msg(t, joints, q, qd, effort))
+        self.pub_truth.publish(convert.joint_state_msg(t, joints, q, qd, effort))
+        if self.pub_ten is not None:
+            self.pub_ten.publish(convert.joint_state_msg(t, self.sim.tendons, None, None, tension))
+
+
+def make_node(args) -> PlantNode:
+    return MjcfSimNode()

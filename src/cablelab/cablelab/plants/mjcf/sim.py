@@ -1,0 +1,270 @@
+"""Forward simulation of an ``mjcf`` machine (ROS-free): the truth a bag is recorded from.
+
+This is deliberately a separate path from the workbench's inverse dynamics: the truth model is
+the user's model *changed through MuJoCo's own model editor* (:class:`mujoco.MjSpec`: a payload
+body added, joint damping, Coulomb friction (``frictionloss``) or armature set, a wrong torque
+constant on the effort sensor), stepped forward by ``mj_step`` under a PD tracking controller,
+and recorded with encoder quantisation and effort noise. The explicit Euler integrator (with
+implicit damping disabled) makes the recorded positions' second difference the acceleration
+MuJoCo computed, so the record is the machine's motion and nothing of the workbench's code.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .mjcf import dof_joints, names
+
+
+@dataclass(frozen=True)
+class Hidden:
+    """What the truth has and the user's model lacks.
+
+    Args:
+        payload: ``(body, mass kg, (x, y, z) m in the body frame)`` added as a point-mass child
+            body, or None.
+        damping, frictionloss, armature: per joint name: viscous friction (N m s/rad), Coulomb
+            friction (N m), reflected inertia (kg m^2).
+        gain: per joint: the effort sensor reads gain x the applied force.
+        stiffness: per joint ``(k, q0)``: a spring pulling the joint towards q0.
+        link_mass: per body: mass added at its centre of mass (kg; its inertia unchanged).
+    """
+
+    payload: tuple | None = None
+    damping: dict = field(default_factory=dict)
+    frictionloss: dict = field(default_factory=dict)
+    armature: dict = field(default_factory=dict)
+    gain: dict = field(default_factory=dict)
+    stiffness: dict = field(default_factory=dict)
+    link_mass: dict = field(default_factory=dict)
+
+
+def _set(joint, attr: str, value: float) -> None:
+    """Set a joint attribute that is a number or (newer MuJoCo) a coefficient vector whose
+    first entry is the linear coefficient."""
+    old = getattr(joint, attr)
+    if np.ndim(old):
+        new = np.zeros_like(old)
+        new[0] = value
+        setattr(joint, attr, new)
+    else:
+        setattr(joint, attr, float(value))
+
+
+def truth_model(xml: str, hidden: Hidden = Hidden(), timestep: float | None = None, *,
+                euler: bool = True):
+    """The truth :class:`mujoco.MjModel`: ``xml`` edited with MjSpec to hold ``hidden``;
+    ``euler``: explicit Euler without implicit damping (else the model's own integrator)."""
+    import mujoco
+
+    spec = mujoco.MjSpec.from_string(xml)
+    if euler:
+        spec.option.integrator = mujoco.mjtIntegrator.mjINT_EULER
+        spec.option.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_EULERDAMP)
+    if timestep:
+        spec.option.timestep = float(timestep)
+    if hidden.payload is not None:
+        body, mass, pos = hidden.payload
+        b = spec.body(body).add_body(name="hidden_payload", pos=list(pos))
+        b.ipos = [0.0, 0.0, 0.0]
+        b.mass = float(mass)
+        b.inertia = [1e-9, 1e-9, 1e-9]
+        b.explicitinertial = True
+    for b, dm in hidden.link_mass.items():
+        spec.body(b).mass = spec.body(b).mass + float(dm)
+    for attr in ("damping", "frictionloss", "armature"):
+        for j, v in getattr(hidden, attr).items():
+            _set(spec.joint(j), attr, v)
+    for j, (k, q0) in hidden.stiffness.items():
+        _set(spec.joint(j), "stiffness", k)
+        hinge = spec.joint(j).type == mujoco.mjtJoint.mjJNT_HINGE
+        # MJCF angles are in degrees unless the model's compiler says radians
+        spec.joint(j).springref = float(np.degrees(q0) if hinge and spec.compiler.degree else q0)
+    return spec.compile()
+
+
+def excitation(duration: float, dt: float, n: int, seed: int = 0, amplitude: float = 0.8,
+               band_hz: tuple[float, float] = (0.15, 1.2), harmonics: int = 5):
+    """Multisine reference per joint: positions, velocities, accelerations (T, n)."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(int(round(duration / dt))) * dt
+    f = rng.uniform(*band_hz, size=(harmonics, n))
+    ph = rng.uniform(0, 2 * np.pi, size=(harmonics, n))
+    a = amplitude / harmonics / (1 + f)
+    w = 2 * np.pi * f
+    arg = w[None] * t[:, None, None] + ph[None]
+    q = np.sum(a * (np.sin(arg) - np.sin(ph)), axis=1)
+    qd = np.sum(a * w * np.cos(arg), axis=1)
+    qdd = np.sum(-a * w**2 * np.sin(arg), axis=1)
+    return t, q, qd, qdd
+
+
+def actuator_moments(model, data) -> np.ndarray:
+    """(nu, nv) dense actuator moment matrix (generalised force per unit actuator force)."""
+    import mujoco
+
+    out = np.zeros((model.nu, model.nv))
+    mujoco.mju_sparse2dense(out, data.actuator_moment, data.moment_rownnz, data.moment_rowadr,
+                            data.moment_colind)
+    return out
+
+
+def simulate(model, duration: float = 12.0, seed: int = 0, kp: float = 400.0, kd: float = 40.0,
+             amplitude: float = 0.8, pretension: float = 30.0):
+    """Run the truth model under PD + bias feedback tracking a multisine (one sample per step).
+
+    The wanted generalised force is spread over the actuators by least squares around a
+    pretension of ``pretension`` N on every tendon actuator (cables must pull), exactly on the
+    joints an actuator drives (joint actuators: the force itself).
+
+    Returns:
+        ``t (T,), q (T, nv), qd (T, nv), effort (T, nv), act (T, nu)``: the state each step
+        starts from, the generalised actuator force applied during it (``qfrc_actuator``) and
+        the actuator forces.
+    """
+    import mujoco
+
+    d = mujoco.MjData(model)
+    dt = model.opt.timestep
+    t, qr, qdr, _ = excitation(duration, dt, model.nv, seed, amplitude)
+    T = len(t)
+    q = np.empty((T, model.nv))
+    qd = np.empty((T, model.nv))
+    eff = np.empty((T, model.nv))
+    act = np.empty((T, model.nu))
+    mujoco.mj_forward(model, d)
+    mass = np.maximum(np.array(model.dof_M0), 0.05)
+    kp_v, kd_v = kp * mass, kd * mass
+    tendon = model.actuator_trntype == int(mujoco.mjtTrn.mjTRN_TENDON)
+    c0 = np.where(tendon, -pretension / np.maximum(np.abs(model.actuator_gear[:, 0]), 1e-12), 0.0)
+    for k in range(T):
+        mujoco.mj_step1(model, d)
+        tau = kp_v * (qr[k] - d.qpos[: model.nv]) + kd_v * (qdr[k] - d.qvel) + d.qfrc_bias
+        A = actuator_moments(model, d).T                     # (nv, nu)
+        d.ctrl[:] = c0 + np.linalg.lstsq(A, tau - A @ c0, rcond=None)[0]
+        q[k], qd[k] = d.qpos[: model.nv], d.qvel
+        mujoco.mj_step2(model, d)
+        eff[k] = d.qfrc_actuator
+        act[k] = d.actuator_force
+    return t, q, qd, eff, act
+
+
+def record(model, hidden: Hidden = Hidden(), *, duration: float = 12.0, seed: int = 0,
+           encoder_bits: int = 18, effort_noise: float = 0.02, effort_quantum: float = 1e-3):
+    """A simulated record as a sensor sees it: positions quantised to ``2 pi / 2^bits``, efforts
+    times the hidden gain plus white noise (N m) and quantised; NaN for a joint no actuator
+    drives. Returns ``(t, q, effort, joint names)``; :func:`record_all` also the tensions."""
+    r = record_all(model, hidden, duration=duration, seed=seed, encoder_bits=encoder_bits,
+                   effort_noise=effort_noise, effort_quantum=effort_quantum)
+    return r["t"], r["q"], r["effort"], r["joints"]
+
+
+def record_all(model, hidden: Hidden = Hidden(), *, duration: float = 12.0, seed: int = 0,
+               encoder_bits: int = 18, effort_noise: float = 0.02, effort_quantum: float = 1e-3,
+               tension_noise: float = 0.2) -> dict:
+    """:func:`record` plus ``tension`` (T, n_tendons): per tendon the pull of the actuators on
+    it (N) with white noise ``tension_noise``, and ``tendons`` their names."""
+    t, q, qd, eff, act = simulate(model, duration, seed)
+    rng = np.random.default_rng(seed + 1)
+    quantum = 2 * np.pi / 2**encoder_bits
+    q_meas = np.round(q / quantum) * quantum
+    joints = dof_joints(model)
+    gain = np.array([hidden.gain.get(j, 1.0) for j in joints])
+    e = eff * gain + rng.normal(0.0, effort_noise, eff.shape)
+    e = np.round(e / effort_quantum) * effort_quantum
+    driven = np.zeros(model.nv, bool)
+    on_joint = model.actuator_trntype == 0
+    driven[model.jnt_dofadr[model.actuator_trnid[on_joint, 0]]] = True
+    e[:, ~driven] = np.nan                 # a joint without actuator has no effort sensor
+    tension = np.zeros((len(t), model.ntendon))
+    for a in np.flatnonzero(model.actuator_trntype == 3):                 # mjTRN_TENDON
+        tension[:, model.actuator_trnid[a, 0]] -= act[:, a] * model.actuator_gear[a, 0]
+    tension += rng.normal(0.0, tension_noise, tension.shape)
+    return {"t": t, "q": q_meas, "effort": e, "joints": joints, "tension": tension,
+            "tendons": names(model, "tendon")}
+
+
+def description_yaml(xml: str, **section) -> str:
+    """A description (YAML text) of an mjcf machine with the model inline."""
+    from ...description import dump_description, load_description
+
+    import yaml
+
+    text = yaml.safe_dump({"plant": "mjcf", "gravity": 9.81, "mjcf": {"model": xml, **section}},
+                          sort_keys=False)
+    return dump_description(load_description(text))
+
+
+def write_bag(path, xml: str, hidden: Hidden = Hidden(), *, duration: float = 12.0, seed: int = 0,
+              overwrite: bool = True, **section) -> str:
+    """Simulate the truth (``xml`` + ``hidden``) and write a contract bag of it: the description
+    (the user's model, without the hidden effect), ``/mjcf/joint_states`` and, for the section's
+    ``tendons``, ``/mjcf/cable_tensions``."""
+    from ...bags import BagWriter
+
+    model = truth_model(xml, hidden)
+    r = record_all(model, hidden, duration=duration, seed=seed)
+    desc = description_yaml(xml, **section)
+    t0 = 1000.0
+    with BagWriter(path, overwrite=overwrite) as w:
+        w.write_description(desc, t=t0)
+        w.write_joint_states("/mjcf/joint_states", t0 + r["t"], r["joints"], position=r["q"],
+                             effort=r["effort"])
+        measured = list(section.get("tendons") or ())
+        if measured:
+            idx = [r["tendons"].index(x) for x in measured]
+            w.write_joint_states("/mjcf/cable_tensions", t0 + r["t"], measured,
+                                 effort=r["tension"][:, idx])
+    return str(path)
+
+
+__all__ = ["Hidden", "MjcfSim", "actuator_moments", "description_yaml", "excitation", "record",
+           "record_all", "simulate", "truth_model", "write_bag"]
+
+
+class MjcfSim:
+    """A running simulation of an ``mjcf:`` section's model at its own timestep:
+    ``advance(ctrl, duration)`` holds the actuator controls for whole physics steps.
+
+    Args:
+        section: the parsed ``mjcf:`` section; gravity: g along -z, m/s^2.
+        hidden: what the simulated truth has beyond the section's model (:class:`Hidden`).
+    """
+
+    def __init__(self, section, gravity: float = 9.81, hidden: Hidden | None = None):
+        import mujoco
+
+        if hidden is None:
+            self.model = section.compiled(gravity)
+        else:
+            self.model = truth_model(section.model, hidden, euler=False)
+            self.model.opt.gravity[:] = (0.0, 0.0, -float(gravity))
+        self.data = mujoco.MjData(self.model)
+        self.joints = dof_joints(self.model)
+        self.tendons = list(section.tendons)
+        tn = names(self.model, "tendon")
+        self._tendon_ids = [tn.index(x) for x in self.tendons]
+        self._mujoco = mujoco
+        mujoco.mj_forward(self.model, self.data)
+
+    @property
+    def t(self) -> float:
+        return float(self.data.time)
+
+    def advance(self, ctrl, duration: float) -> None:
+        """Hold ``ctrl`` (nu,) for ``duration`` s (at least one step)."""
+        self.data.ctrl[:] = np.asarray(ctrl, float)
+        n = max(1, int(round(duration / self.model.opt.timestep)))
+        self._mujoco.mj_step(self.model, self.data, nstep=n)
+
+    def state(self):
+        """``(t, q (nv,), qd (nv,), effort (nv,) = qfrc_actuator, tension (n_tendons,))``: the
+        tension of a measured tendon is the pull of the actuators on it (N, >= 0 when pulling)."""
+        m, d = self.model, self.data
+        tension = np.zeros(len(self._tendon_ids))
+        for k, tid in enumerate(self._tendon_ids):
+            on = (m.actuator_trntype == 3) & (m.actuator_trnid[:, 0] == tid)   # mjTRN_TENDON
+            tension[k] = -float(np.sum(d.actuator_force[on] * m.actuator_gear[on, 0]))
+        return (float(d.time), np.array(d.qpos[: m.nv]), np.array(d.qvel), np.array(d.qfrc_actuator),
+                tension)
