@@ -14,13 +14,14 @@ import numpy as np
 from ...conditioning import Conditioning, condition_motion
 from ...errors import CablelabError
 from ...model import KNOWN_OUTPUT, Dataset
+from ...plant_interface import DatasetOptions
 from .description import section_of
 from .inverse import inertial_columns, inverse_dynamics, point_mass_columns
 from .mjcf import HINGE, dof_joints, names
 from .topics import JOINT_STATE, topic
 
 
-def dataset_from_arrays(t, q, effort, description, options: dict | None = None, *, qd=None,
+def dataset_from_arrays(t, q, effort, description, options: DatasetOptions | None = None, *, qd=None,
                         tension=None, driven=None, source: str = "data") -> Dataset:
     """Dataset from raw arrays in the model's dof order.
 
@@ -31,11 +32,10 @@ def dataset_from_arrays(t, q, effort, description, options: dict | None = None, 
         driven: (nv,) bool, the joints whose effort is measured (default: every joint).
         description: a :class:`~cablelab.description.Description` with an ``mjcf`` section.
     """
-    options = options or {}
     sec = section_of(description)
     model = sec.compiled(description.gravity)
     joints = dof_joints(model)
-    opts = options.get("conditioning") or Conditioning()
+    opts = options.conditioning if options is not None else Conditioning()
     jtype = [model.jnt_type[names(model, "joint").index(j)] for j in joints]
     revolute = np.array([jt == HINGE for jt in jtype])
     c = condition_motion(np.asarray(t, float), np.asarray(q, float).reshape(len(t), -1),
@@ -82,7 +82,7 @@ def dataset_from_arrays(t, q, effort, description, options: dict | None = None, 
     return exclude_zero_speed(ds, floor=floor)
 
 
-def dataset(bag, description, options: dict | None = None) -> Dataset:
+def dataset(bag, description, options: DatasetOptions | None = None) -> Dataset:
     """Dataset of a bag: ``joint_states`` (remappable) onto the model's joints, tensions of the
     section's ``tendons`` from ``cable_tensions``."""
     sec = section_of(description)
@@ -117,7 +117,7 @@ def dataset(bag, description, options: dict | None = None) -> Dataset:
             eff[:, k] = 0.0                  # no actuator: its zero-force equation
             has_effort[k] = False
     qd = js.velocity[:, idx] if js.velocity.size else None
-    distrusted = ((options or {}).get("derived_velocity") or {}).get(js_topic, ())
+    distrusted = options.derived_velocity.get(js_topic, ()) if options is not None else ()
     if qd is not None and (not np.isfinite(qd).all() or any(j in distrusted for j in joints)):
         qd = None
     tension = None

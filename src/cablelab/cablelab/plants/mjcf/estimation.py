@@ -10,6 +10,7 @@ import numpy as np
 from ...conditioning import Conditioning
 from ...errors import CablelabError
 from ...model import KNOWN_OUTPUT
+from ...plant_interface import DatasetOptions
 from .dataset import dataset_from_arrays
 
 
@@ -34,7 +35,7 @@ def payload_estimate(t, q, effort, description, *, tension=None, driven=None,
     sec = description.mjcf
     if sec is None or not sec.payload_body:
         raise CablelabError("payload estimate: the description names no mjcf.payload_body")
-    ds = dataset_from_arrays(t, q, effort, description, {"conditioning": Conditioning(border=border)},
+    ds = dataset_from_arrays(t, q, effort, description, DatasetOptions(Conditioning(border=border)),
                              tension=tension, driven=driven)
     ok = ds.valid
     if ok.sum() < 10:

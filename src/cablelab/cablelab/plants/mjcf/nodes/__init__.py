@@ -1,2 +1,2 @@
-"""The mjcf plant's ROS 2 nodes, one module per role (``sim``), each with ``make_node(args)``; run
+"""The mjcf plant's ROS 2 nodes, one module per role (``sim``), each with ``make_node()``; run
 by the node executables (``cable_sim_node --plant mjcf -p description:=FILE``)."""

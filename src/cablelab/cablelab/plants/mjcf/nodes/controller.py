@@ -107,5 +107,5 @@ class MjcfController(PlantNode):
         self.pub.publish(convert.command_msg(u, stamp=t, label="joint"))
 
 
-def make_node(args) -> PlantNode:
+def make_node() -> PlantNode:
     return MjcfController()

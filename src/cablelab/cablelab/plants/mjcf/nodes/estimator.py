@@ -102,5 +102,5 @@ class MjcfEstimator(PlantNode):
                                              frame_id=self.description.mjcf.payload_body))
 
 
-def make_node(args) -> PlantNode:
+def make_node() -> PlantNode:
     return MjcfEstimator()

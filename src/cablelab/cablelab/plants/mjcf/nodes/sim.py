@@ -112,5 +112,5 @@ class MjcfSimNode(PlantNode):
             self.pub_ten.publish(convert.joint_state_msg(t, self.sim.tendons, None, None, tension))
 
 
-def make_node(args) -> PlantNode:
+def make_node() -> PlantNode:
     return MjcfSimNode()
