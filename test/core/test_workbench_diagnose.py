@@ -8,7 +8,7 @@ from cablelab.diagnose import (channel_metrics, derived_regimes, fold_indices, r
                                whiteness, worst_segments)
 from cablelab.errors import CablelabError
 from cablelab.fit.simulation import objective_residual
-from cablelab.model import Dataset
+from cablelab.dataset import Dataset
 
 T = np.arange(0, 10, 0.001)
 

@@ -8,7 +8,9 @@ from cablelab.description import load_description
 from cablelab.effects import effects_for, get_effect
 from cablelab.errors import CablelabError
 from cablelab.fit import identify, solve_linear
-from cablelab.model import Dataset, Model, Param
+from cablelab.dataset import Dataset
+from cablelab.effects.base import Param
+from cablelab.model import Model
 from cablelab.plants import get_plant
 
 PRISMATIC = load_description("plant: axis\naxis:\n  joint_type: prismatic\n")
@@ -180,7 +182,8 @@ def test_identify_holds_unexcited_parameters_at_their_nominal_and_fits_the_rest(
     from cablelab.effects.base import Effect
     from cablelab.fit import identify
     from cablelab.fit.linear import RankDeficient
-    from cablelab.model import Dataset, Model
+    from cablelab.dataset import Dataset
+    from cablelab.model import Model
 
     plant = "toy_unexcited"
     sig = lambda name: (lambda ds: ds.require_signal(name).reshape(ds.n, 1, 1))  # noqa: E731

@@ -3,9 +3,6 @@
 :class:`Model` holds the :class:`~cablelab.effects.base.Effect` objects of its effects, looked up
 once in the effect registry when the model is made. Linear in the free parameters:
 ``y = sum_e Phi_e @ theta_e``; fixed parameters are moved to the left-hand side.
-
-:class:`~cablelab.dataset.Dataset`, :class:`~cablelab.effects.base.Param` and
-:class:`~cablelab.effects.base.Effect` are re-exported here for the code written against them.
 """
 from __future__ import annotations
 
@@ -14,9 +11,9 @@ from typing import Mapping, Sequence
 
 import numpy as np
 
-from .dataset import STANDARD_GRAVITY, Dataset
+from .dataset import Dataset
 from .effects import get_effect
-from .effects.base import Effect, Param, RegressorFn, TransformFn
+from .effects.base import Effect, Param
 from .errors import CablelabError
 
 
@@ -182,5 +179,4 @@ def parse_fixed(items: Sequence[str] | None) -> dict:
     return out
 
 
-__all__ = ["STANDARD_GRAVITY", "Dataset", "Effect", "Model", "Param", "RegressorFn", "TransformFn",
-           "parse_effect_list", "parse_fixed"]
+__all__ = ["Evaluation", "Model", "parse_effect_list", "parse_fixed"]

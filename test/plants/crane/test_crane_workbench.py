@@ -93,7 +93,7 @@ def test_control_bag_nothing_significant():
 def test_002_group_fit_goes_negative_without_tilt_and_is_physical_with_it(tilted):
     """002 sec. 6.2: the least squares gave negative inertias; the tilt columns fix it."""
     from cablelab.plants.crane.effects import tilt_columns
-    from cablelab.model import Param
+    from cablelab.effects.base import Param
     from cablelab.plants.crane.identify import FIX_002, identify_groups, physical_check
     from cablelab.plants.crane.model import PARAM_GROUPS
 

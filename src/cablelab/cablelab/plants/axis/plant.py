@@ -15,7 +15,7 @@ import numpy as np
 from ...conditioning import Conditioning, condition_motion
 from ...errors import CablelabError
 from ...fit.simulation import fit_free_run_windows, free_run_windows, window_length, window_starts
-from ...model import Dataset
+from ...dataset import Dataset
 from ...registry import Plant, register_plant
 from .description import parse_section
 
@@ -199,7 +199,7 @@ def fit_free_run(ds: Dataset, start: dict, *, objective: str = "nmse",
         CablelabError: a parameter of the model whose inverse-model value is not positive (a
             negative inertia or friction cannot start a physical simulation), or none to fit.
     """
-    from ...model import Param
+    from ...effects.base import Param
 
     params = []
     names = {"M": "inertia", "Fv": "viscous friction", "Fc": "Coulomb friction"}

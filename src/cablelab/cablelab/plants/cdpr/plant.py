@@ -2,7 +2,7 @@
 
 Geometry, estimation, control and trajectory live in the ``cdpr_*`` modules next to this one;
 this module reads a contract bag into arrays (:func:`load_arrays`), builds the workbench
-:class:`~cablelab.model.Dataset` (output channels = the cable wrench W t, 6 channels, see
+:class:`~cablelab.dataset.Dataset` (output channels = the cable wrench W t, 6 channels, see
 :mod:`cablelab.plants.cdpr.effects`) and runs the offline estimate of ``cablelab estimate``
 (:func:`estimate_bag`): mass and CoM per sample, vectorised over the whole bag (001 eq. 12-13).
 
@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...errors import CablelabError
-from ...model import Dataset
+from ...dataset import Dataset
 from ...rotations import quat_to_matrix, xyzw_to_wxyz
 from ...registry import Plant, register_plant
 from .description import dump_section, parse_section

@@ -28,7 +28,7 @@ import numpy as np
 
 from ...conditioning import Conditioning, condition_motion
 from ...errors import CablelabError
-from ...model import STANDARD_GRAVITY, Dataset
+from ...dataset import STANDARD_GRAVITY, Dataset
 from ...registry import Plant, register_plant
 from .description import parse_section
 from .dynamics_generated import regressor
