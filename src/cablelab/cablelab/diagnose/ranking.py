@@ -223,7 +223,8 @@ def rank_candidates(model: Model, ds: Dataset, candidates, *, folds: int = FOLDS
     # on its valid rows, and each candidate's held-out prediction and projected columns
     from .ambiguity import find_ambiguous, project_out
 
-    ds_base = model.apply_nonlinear(ds, base_full.params)
+    ev_base = model.evaluate(ds, base_full.params)
+    ds_base = ev_base.ds
     w_ch = base_full.linear.channel_scale if base_full.linear.channel_scale is not None \
         else np.ones(ds.n_channels)
     use = base_full.valid & np.isfinite(ds_base.y).all(axis=1)
@@ -231,7 +232,7 @@ def rank_candidates(model: Model, ds: Dataset, candidates, *, folds: int = FOLDS
     def weighted(phi):
         return (phi[use] * w_ch[None, :, None]).reshape(int(use.sum()) * phi.shape[1], phi.shape[2])
 
-    phi0 = weighted(model.regressor(ds_base)[0])
+    phi0 = weighted(ev_base.phi)
     compared = {}
     rows = []
     for c in cands:
@@ -281,7 +282,8 @@ def rank_candidates(model: Model, ds: Dataset, candidates, *, folds: int = FOLDS
                                 f"{ev['channel']} RMS)")
         row.explanation += describe(ident)
         rows.append(row)
-        phi_c, cols_c, _ = m2.regressor(m2.apply_nonlinear(ds, base_full.params))
+        ev_c = m2.evaluate(ds, base_full.params)
+        phi_c, cols_c = ev_c.phi, ev_c.columns
         own_idx = [i for i, p in enumerate(cols_c) if p.name in own]
         compared[c] = {"error": err1, "y": ym1, "y_hat": yh1, "y_hat0": yh0,
                        "columns": project_out(phi0, weighted(phi_c[:, :, own_idx]))}
