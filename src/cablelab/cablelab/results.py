@@ -8,6 +8,11 @@ Each keeps the :class:`~cablelab.fit.Identification` it reports on as ``fit`` (n
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from .fit.identify import Identification
+
 
 
 def _with_held(out: dict, held: dict, held_warning: str | None) -> dict:
@@ -50,7 +55,7 @@ class Comparison:
     held: dict = field(default_factory=dict)
     held_warning: str | None = None
     free_run: dict | None = None
-    fit: object = field(default=None, repr=False, compare=False)
+    fit: Identification | None = field(default=None, repr=False, compare=False)
 
     def to_json(self) -> dict:
         out: dict = {"plant": self.plant, "effects": list(self.effects), "samples": self.samples,
@@ -113,7 +118,7 @@ class IdentifyReport:
     held_warning: str | None = None
     internal: dict = field(default_factory=dict)
     simulation: dict | None = None
-    fit: object = field(default=None, repr=False, compare=False)
+    fit: Identification | None = field(default=None, repr=False, compare=False)
 
     def to_json(self) -> dict:
         out = {"plant": self.plant, "effects": list(self.effects), "samples": self.samples,

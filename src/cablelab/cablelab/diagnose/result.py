@@ -9,6 +9,12 @@ documented extras); ``lines()`` the text the command prints. Built by
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from ..fit.identify import Identification
+    from ..model import Model
+
 
 #: keys of a ranking row that are part of the JSON, in order (contract keys first)
 ROW_KEYS = ("effect", "error_before", "error_after", "params", "significant", "stderr", "units",
@@ -80,7 +86,7 @@ class Step:
     units: dict
     ranking: list
     note: str | None = None
-    fit: object = field(default=None, repr=False, compare=False)
+    fit: Identification | None = field(default=None, repr=False, compare=False)
 
     def to_json(self) -> dict:
         out = {"effects": self.effects, "added": self.added, "error": self.error,
@@ -110,8 +116,8 @@ class Diagnosis:
     held_warning: str | None = None
     alpha: float | None = None
     min_gain: float | None = None
-    model: object = field(default=None, repr=False, compare=False)
-    fit: object = field(default=None, repr=False, compare=False)
+    model: Model | None = field(default=None, repr=False, compare=False)
+    fit: Identification | None = field(default=None, repr=False, compare=False)
 
     @property
     def final(self) -> Step | None:
