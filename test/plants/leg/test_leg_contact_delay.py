@@ -117,8 +117,8 @@ def test_bag_and_contract_json(delayed, tmp_path):
     model = build_model(plant, desc, effects=("impact_restitution",))
     out = diagnose(ds, model, plant.candidates(desc)).to_json()
     top = out["ranking"][0]
-    assert top.effect == "contact_delay" and top.significant
-    assert top.params["tau_c"] == pytest.approx(DELAY, abs=1e-3)
+    assert top["effect"] == "contact_delay" and top["significant"]
+    assert top["params"]["tau_c"] == pytest.approx(DELAY, abs=1e-3)
 
 
 def test_greedy_from_the_no_impact_baseline(delayed):

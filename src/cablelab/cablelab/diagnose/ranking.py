@@ -261,8 +261,8 @@ def rank_candidates(model: Model, ds: Dataset, candidates, *, folds: int = FOLDS
         inner = full.internal(c, ds)
         from .identifiability import confounding, describe
 
-        ident = confounding(full, list(own))
-        significant = significant and bool(ident["identifiable"])
+        confound = confounding(full, list(own))
+        significant = significant and bool(confound["identifiable"])
         row = Candidate(c, err0, err1, params={k: v["value"] for k, v in phys.items()},
                         significant=significant,
                         stderr={k: v["stderr"] for k, v in phys.items()},
@@ -271,16 +271,16 @@ def rank_candidates(model: Model, ds: Dataset, candidates, *, folds: int = FOLDS
                         gain=gain, channels=dict(zip(ds.channels, map(float, channel_nrmse(ym1, yh1)))),
                         evidence=_evidence(by_regime0, residual_by_regime(full.residual, y_ref,
                                                                           regimes, ds.channels)),
-                        identifiability=ident, held=own_held or None,
+                        identifiability=confound, held=own_held or None,
                         internal={k: v["value"] for k, v in inner.items()} or None)
         row.explanation = explain(c, row.params, row.stderr, row.units, err0, err1, significant,
                                   (int(changed.sum()), len(changed)), gain)
         if significant and row.evidence:
-            ev = row.evidence
-            row.explanation += (f"; largest drop where {ev['regime']} is {ev['label']} "
-                                f"({100 * ev['before']:.0f} % -> {100 * ev['after']:.0f} % of the "
-                                f"{ev['channel']} RMS)")
-        row.explanation += describe(ident)
+            where = row.evidence
+            row.explanation += (f"; largest drop where {where['regime']} is {where['label']} "
+                                f"({100 * where['before']:.0f} % -> {100 * where['after']:.0f} % of "
+                                f"the {where['channel']} RMS)")
+        row.explanation += describe(confound)
         rows.append(row)
         ev_c = m2.evaluate(ds, base_full.params)
         phi_c, cols_c = ev_c.phi, ev_c.columns
