@@ -1,9 +1,9 @@
 """``cablelab report``: one ``index.html`` with PNG plots of compare, diagnose and identify.
 
 :func:`build_report` draws a greedy :class:`~cablelab.diagnose.result.Diagnosis` (the fits of
-its waterfall steps, never refitted here) and writes the answer first, then the evidence: summary, the answer sentence with the waterfall, the ranking
-of the candidates (each with the quantities its significance is decided on), the parameter table
-with uncertainties, the metrics and the overlay (gaps shaded), residual over time with the worst
+its waterfall steps, never refitted here) and writes the answer first, then the evidence:
+summary, the answer sentence with the waterfall, the ranking of the candidates (each with the
+quantities its significance is decided on), the parameter table with uncertainties, the metrics and the overlay (gaps shaded), residual over time with the worst
 segments shaded and after each added effect, residual by regime (a table of the worst regime per
 channel, the bar charts folded), residual whiteness and cross-correlation. Every figure has a
 caption naming what it shows and its unit. The sections' HTML is built in :mod:`.sections`.
