@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 
 from cablelab.diagnose.ranking import ALPHA, MIN_GAIN
 from cablelab.diagnose.result import Candidate, Step
-from cablelab.report import metrics_table, ranking_section
+from cablelab.report.sections import metrics_table, ranking_section
 from cablelab.report.plots import _thin_masked, invalid_spans
 
 from robust_helpers import CDPR

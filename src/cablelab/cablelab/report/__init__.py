@@ -23,8 +23,8 @@ from ..diagnose.result import Diagnosis
 from ..errors import CablelabError
 from ..fit.threads import blas_single
 from . import plots
-from .sections import (CSS, _channel_rms, _figure, _num, _table, answer_section,  # noqa: F401
-                       metrics_table, ranking_section, regime_section)
+from .sections import (CSS, _figure, answer_section, metrics_table, parameters_section,
+                       ranking_section, regime_section, segments_table, whiteness_section)
 
 
 @dataclass(frozen=True)
@@ -110,16 +110,7 @@ def build_report(ds: Dataset, diagnosis: Diagnosis, out_dir, *, title: str = "",
     parts.extend(f"<p class='warnings'>{html.escape(line)}</p>"
                  for line in ambiguity_lines(steps[0].ranking)
                  + excite_commands(steps[0].ranking, diagnosis.plant, ds.source))
-    parts.append("<h2>Parameters of the final model</h2>")
-    table = fin.table()
-    any_fixed = any(r["fixed"] for r in table)     # a column for --fix only when it was used
-    rows = [[html.escape(r["name"]), _num(r["value"], "{:.6g}"), _num(r["stderr"], "{:.2g}"),
-             html.escape(r["unit"])] + (["fixed (--fix)" if r["fixed"] else "fitted"] if any_fixed else [])
-            for r in table]
-    parts.append(_table(rows, ["parameter", "value", "std. error", "unit"] + (["source"] if any_fixed else [])))
-    parts.append(f"<p>rank {fin.linear.rank}, condition number {fin.linear.cond:.3g}"
-                 + (f"; unidentifiable: {html.escape('; '.join(fin.linear.unidentifiable))}"
-                    if fin.linear.unidentifiable else "") + "</p>")
+    parts.append(parameters_section(fin))
     parts.append("<h2>Measured vs model</h2>")
     parts.append(metrics_table(ds.channels, ds.units, m_base.channels, m_fin.channels))
     n_bad = int(np.sum(~fin.valid))
@@ -131,29 +122,13 @@ def build_report(ds: Dataset, diagnosis: Diagnosis, out_dir, *, title: str = "",
     parts.append(_figure("residual_time.png", "Residual (measured - model) of the nominal model "
                          "over time; the windows where it rises most above its own level (table "
                          "below) shaded gold." + gaps))
-    unit_of = dict(zip(ds.channels, ds.units))
-    rows = [[html.escape(s["channel"]), f"{s['t_start']:.3f}", f"{s['t_end']:.3f}",
-             f"{s['rms']:.4g} {html.escape(unit_of[s['channel']])}", f"{s['error']:.2f}"] for s in segs]
-    parts.append(_table(rows, ["channel", "from [s]", "to [s]", "residual RMS in the window",
-                               "x the channel's residual RMS over the record"]))
+    parts.append(segments_table(segs, ds.channels, ds.units))
     if not step_figs:
         parts.append("<p>No effect was added: the nominal model is the final model.</p>")
     for i, name, caption in step_figs:
         parts.append(_figure(name, caption))
     parts.append(regime_section(reg_b, reg_f, ds.channels, ds.units, y_meas_b))
-    parts.append("<h2>Residual whiteness of the final model</h2><p>A model that explains "
-                 "everything leaves a white residual: autocorrelation inside the 99 % band at every "
-                 "lag and no correlation with the inputs.</p>")
-    rows = [[html.escape(ch), f"{100 * white[ch]['outside']:.0f} %", "yes" if white[ch]["white"] else "no",
-             html.escape(", ".join(k for k, x in white[ch]["cross"].items() if not x["uncorrelated"]) or "none")]
-            for ch in ds.channels]
-    parts.append(_table(rows, ["channel", "autocorrelation lags outside the 99 % band", "white",
-                               "inputs the residual still correlates with"]))
-    for c, ch in enumerate(ds.channels):
-        w = white[ch]
-        parts.append(_figure(f"whiteness_{c}.png", f"{ch}: {100 * w['outside']:.0f} % of "
-                             f"autocorrelation lags outside the 99 % band "
-                             f"({'white' if w['white'] else 'not white'}); lags in samples."))
+    parts.append(whiteness_section(white, ds.channels))
     doc = (f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>cablelab report</title>"
            f"<style>{CSS}</style></head><body>{''.join(parts)}</body></html>")
     index = os.path.join(out_dir, "index.html")

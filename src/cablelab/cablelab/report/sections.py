@@ -1,7 +1,7 @@
 """The report's HTML sections, one function each, plain strings assembled by
 :func:`cablelab.report.build_report`: the answer (sentence, waterfall, steps), the ranking of the
-candidates with the quantities each significance decision is made on, the metrics table, the
-residual-by-regime summary; and the small helpers they share (tables, numbers, captioned figures).
+candidates with the quantities each significance decision is made on, the parameters, the metrics
+table, the worst segments, the residual-by-regime summary, the residual whiteness; and the small helpers they share (tables, numbers, captioned figures).
 """
 from __future__ import annotations
 
@@ -197,4 +197,47 @@ def regime_section(reg_b: list[dict], reg_f: list[dict], channels, units, y_meas
                              f"{ch} over the record ({_num(rms, '{:.4g}')} {unit}), nominal model "
                              "(orange) vs final model (blue); n = samples in the regime.")
                    + "</details>")
+    return "".join(out)
+
+
+def parameters_section(fit) -> str:
+    """The final model's parameters with standard errors and units (a source column when some
+    were fixed with ``--fix``), and the rank and condition of its regressor."""
+    table = fit.table()
+    any_fixed = any(r["fixed"] for r in table)     # a column for --fix only when it was used
+    rows = [[html.escape(r["name"]), _num(r["value"], "{:.6g}"), _num(r["stderr"], "{:.2g}"),
+             html.escape(r["unit"])] + (["fixed (--fix)" if r["fixed"] else "fitted"] if any_fixed else [])
+            for r in table]
+    return ("<h2>Parameters of the final model</h2>"
+            + _table(rows, ["parameter", "value", "std. error", "unit"] + (["source"] if any_fixed else []))
+            + f"<p>rank {fit.linear.rank}, condition number {fit.linear.cond:.3g}"
+            + (f"; unidentifiable: {html.escape('; '.join(fit.linear.unidentifiable))}"
+               if fit.linear.unidentifiable else "") + "</p>")
+
+
+def segments_table(segs: list[dict], channels, units) -> str:
+    """The worst windows of the residual (:func:`~cablelab.diagnose.localise.worst_segments`)."""
+    unit_of = dict(zip(channels, units))
+    rows = [[html.escape(s["channel"]), f"{s['t_start']:.3f}", f"{s['t_end']:.3f}",
+             f"{s['rms']:.4g} {html.escape(unit_of[s['channel']])}", f"{s['error']:.2f}"] for s in segs]
+    return _table(rows, ["channel", "from [s]", "to [s]", "residual RMS in the window",
+                         "x the channel's residual RMS over the record"])
+
+
+def whiteness_section(white: dict, channels) -> str:
+    """Whiteness of the final model's residual per channel: the table and the figures
+    ``whiteness_<c>.png``."""
+    out = ["<h2>Residual whiteness of the final model</h2><p>A model that explains "
+           "everything leaves a white residual: autocorrelation inside the 99 % band at every "
+           "lag and no correlation with the inputs.</p>"]
+    rows = [[html.escape(ch), f"{100 * white[ch]['outside']:.0f} %", "yes" if white[ch]["white"] else "no",
+             html.escape(", ".join(k for k, x in white[ch]["cross"].items() if not x["uncorrelated"]) or "none")]
+            for ch in channels]
+    out.append(_table(rows, ["channel", "autocorrelation lags outside the 99 % band", "white",
+                             "inputs the residual still correlates with"]))
+    for c, ch in enumerate(channels):
+        w = white[ch]
+        out.append(_figure(f"whiteness_{c}.png", f"{ch}: {100 * w['outside']:.0f} % of "
+                           f"autocorrelation lags outside the 99 % band "
+                           f"({'white' if w['white'] else 'not white'}); lags in samples."))
     return "".join(out)
