@@ -103,8 +103,6 @@ class Identification:
         """``(params, internal)``: every parameter of the model in the user's terms (the
         effects' :meth:`physical` parameters where they have them, with ``fixed``/``held``
         flags for the others) and the internal coefficients those replace."""
-        from ..effects import get_effect
-
         table = {r["name"]: {k: v for k, v in r.items() if k != "name"} for r in self.table()}
         params, internal = {}, {}
         for eid in self.model.effects:
@@ -264,6 +262,63 @@ def held_warning(held: Mapping[str, float], units: Mapping[str, str] | None = No
             f"neutral values: {vals}; record motion that excites them, or --strict to refuse")
 
 
+def _outer_search(model: Model, ds: Dataset, nl_params: list, valid: np.ndarray, channel_scale,
+                  outer_grid: int, start: Mapping[str, float] | None):
+    """The outer problem of the separable least squares: the nonlinear parameter values that
+    minimise the inner linear LS residual (from ``start``, the nominal values or the best grid
+    point, refined by :func:`mujoco.minimize.least_squares` inside the box), the model evaluated
+    there with its inner fit (rank deficiency raises), and the Jacobian of the weighted residual
+    w.r.t. the nonlinear parameters at that fit's theta (for the joint covariance).
+
+    Returns:
+        ``(nl_values, evaluation, fit, jac_nl)``.
+    """
+    names = [p.name for p in nl_params]
+    lo = np.array([p.lower for p in nl_params])
+    hi = np.array([p.upper for p in nl_params])
+    outer = _OuterProblem(model, ds, valid, names, channel_scale)
+
+    def cost(x):
+        r = outer.residual(x)
+        return float(r @ r)
+
+    grid = [np.linspace(a, b, outer_grid) for a, b in zip(lo, hi)]
+    if start is not None and all(k in start for k in names):
+        x0 = np.clip(np.array([float(start[k]) for k in names]), lo, hi)
+    elif len(nl_params) > 2:  # keep the grid small: nominal start
+        x0 = np.array([p.nominal for p in nl_params])
+    else:
+        pts = np.array(list(itertools.product(*grid)))
+        x0 = pts[int(np.argmin([cost(x) for x in pts]))]
+
+    def residual(xs):
+        xs = np.asarray(xs).reshape(len(names), -1)
+        return np.stack([outer.residual(xs[:, k]) for k in range(xs.shape[1])], axis=1)
+
+    import mujoco.minimize as mjmin
+
+    grid_step = np.array([(b - a) / (outer_grid - 1) for a, b in zip(lo, hi)])
+    x_best, _ = mjmin.least_squares(x0, residual, bounds=[lo, hi], verbose=0,
+                                    x_scale=grid_step, max_iter=20, xtol=1e-4)
+    x_best = np.clip(np.asarray(x_best).reshape(-1), lo, hi)
+    if cost(x_best) > cost(x0):
+        x_best = x0
+    nl_values = dict(zip(names, map(float, x_best)))
+    ev = model.evaluate(ds, nl_values)
+    fit = _solve(ev, valid, "raise", channel_scale)
+    # Jacobian of the residual w.r.t. the nonlinear parameters (theta held) for the covariance
+    cols_j = []
+    for i, p in enumerate(nl_params):
+        h = 0.1 * grid_step[i]
+        xp, xm = dict(nl_values), dict(nl_values)
+        xp[p.name] = min(nl_values[p.name] + h, hi[i])
+        xm[p.name] = max(nl_values[p.name] - h, lo[i])
+        rp = _fixed_theta_residual(model, ds, xp, fit, valid)
+        rm = _fixed_theta_residual(model, ds, xm, fit, valid)
+        cols_j.append((rp - rm) / (xp[p.name] - xm[p.name]))
+    return nl_values, ev, fit, np.stack(cols_j, axis=1)
+
+
 def _identify_once(model: Model, ds: Dataset, *, on_deficient: str = "raise",
                    outer_grid: int = OUTER_GRID, start: Mapping[str, float] | None = None,
                    channel_scale=None) -> Identification:
@@ -285,54 +340,10 @@ def _identify_once(model: Model, ds: Dataset, *, on_deficient: str = "raise",
         # samples valid at every corner of the box: the residual keeps a fixed length
         for corner in itertools.product(*[(p.lower, p.nominal, p.upper) for p in nl_params]):
             valid &= model.apply_nonlinear(ds, dict(zip([p.name for p in nl_params], corner))).valid
-        names = [p.name for p in nl_params]
-        lo = np.array([p.lower for p in nl_params])
-        hi = np.array([p.upper for p in nl_params])
-
-        outer = _OuterProblem(model, ds, valid, names, channel_scale)
-
-        def cost(x):
-            r = outer.residual(x)
-            return float(r @ r)
-
-        grid = [np.linspace(a, b, outer_grid) for a, b in zip(lo, hi)]
-        if start is not None and all(k in start for k in names):
-            x0 = np.clip(np.array([float(start[k]) for k in names]), lo, hi)
-        elif len(nl_params) > 2:  # keep the grid small: nominal start
-            x0 = np.array([p.nominal for p in nl_params])
-        else:
-            pts = np.array(list(itertools.product(*grid)))
-            x0 = pts[int(np.argmin([cost(x) for x in pts]))]
-
-        def residual(xs):
-            xs = np.asarray(xs).reshape(len(names), -1)
-            return np.stack([outer.residual(xs[:, k]) for k in range(xs.shape[1])], axis=1)
-
-        import mujoco.minimize as mjmin
-
-        grid_step = np.array([(b - a) / (outer_grid - 1) for a, b in zip(lo, hi)])
-        x_best, _ = mjmin.least_squares(x0, residual, bounds=[lo, hi], verbose=0,
-                                        x_scale=grid_step, max_iter=20, xtol=1e-4)
-        x_best = np.clip(np.asarray(x_best).reshape(-1), lo, hi)
-        if cost(x_best) > cost(x0):
-            x_best = x0
-        nl_values = dict(zip(names, map(float, x_best)))
-        # Jacobian of the residual w.r.t. the nonlinear parameters (theta held) for the covariance
-        ev = model.evaluate(ds, nl_values)
-        f0 = _solve(ev, valid, "raise", channel_scale)
+        nl_values, ev, f0, jac_nl = _outer_search(model, ds, nl_params, valid, channel_scale,
+                                                  outer_grid, start)
         if on_deficient == "raise":
             fit = f0
-        cols_j = []
-        for i, p in enumerate(nl_params):
-            h = 0.1 * grid_step[i]
-            xp, xm = dict(nl_values), dict(nl_values)
-            xp[p.name] = min(nl_values[p.name] + h, hi[i])
-            xm[p.name] = max(nl_values[p.name] - h, lo[i])
-            rp = _fixed_theta_residual(model, ds, xp, f0, valid)
-            rm = _fixed_theta_residual(model, ds, xm, f0, valid)
-            cols_j.append((rp - rm) / (xp[p.name] - xm[p.name]))
-        jac_nl = np.stack(cols_j, axis=1)
-
     if ev is None:
         ev = model.evaluate(ds, nl_values)
     if fit is None:
