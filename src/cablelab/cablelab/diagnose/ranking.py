@@ -194,6 +194,53 @@ class _Progress:
               file=sys.stderr, flush=True)
 
 
+def _fitted_candidate(c: str, ds: Dataset, base_full, full, before: tuple, after: tuple,
+                      n_candidates: int, alpha: float, min_gain: float, own_held: list,
+                      regime_ref: tuple) -> tuple[Candidate, dict]:
+    """The ranking row of a candidate that could be fitted, and its own parameters by name.
+
+    Args:
+        base_full, full: the full-record fits without / with the candidate.
+        before, after: ``(held-out error, y_meas, y_hat)`` without / with it (:func:`cv_error`).
+        n_candidates: the Bonferroni count; own_held: its parameters held as not excited.
+        regime_ref: ``(residual by regime without it, y_ref, regimes)`` for its evidence.
+    """
+    err0, ym0, yh0 = before
+    err1, ym1, yh1 = after
+    by_regime0, y_ref, regimes = regime_ref
+    sig = lr_significance(base_full, full, n_candidates, alpha)
+    gain, changed = practical_gain(ym0, yh0, ym1, yh1)
+    significant = bool(sig["passes"] and gain >= min_gain and err1 < err0)
+    own = full.effect_params(c, ds)
+    # reported in the user's terms (the paper's / spec's parameters, errors propagated);
+    # the regression's own coefficients stay under "internal"
+    phys = full.physical(c, ds)
+    inner = full.internal(c, ds)
+    from .identifiability import confounding, describe
+
+    confound = confounding(full, list(own))
+    significant = significant and bool(confound["identifiable"])
+    row = Candidate(c, err0, err1, params={k: v["value"] for k, v in phys.items()},
+                    significant=significant,
+                    stderr={k: v["stderr"] for k, v in phys.items()},
+                    units={k: v["unit"] for k, v in phys.items()},
+                    p_value=sig["p_value"], delta_bic=sig["delta_bic"], n_eff=sig["n_eff"],
+                    gain=gain, channels=dict(zip(ds.channels, map(float, channel_nrmse(ym1, yh1)))),
+                    evidence=_evidence(by_regime0, residual_by_regime(full.residual, y_ref,
+                                                                      regimes, ds.channels)),
+                    identifiability=confound, held=own_held or None,
+                    internal={k: v["value"] for k, v in inner.items()} or None)
+    row.explanation = explain(c, row.params, row.stderr, row.units, err0, err1, significant,
+                              (int(changed.sum()), len(changed)), gain)
+    if significant and row.evidence:
+        where = row.evidence
+        row.explanation += (f"; largest drop where {where['regime']} is {where['label']} "
+                            f"({100 * where['before']:.0f} % -> {100 * where['after']:.0f} % of "
+                            f"the {where['channel']} RMS)")
+    row.explanation += describe(confound)
+    return row, own
+
+
 @blas_single
 def rank_candidates(model: Model, ds: Dataset, candidates, *, folds: int = FOLDS,
                     alpha: float = ALPHA, min_gain: float = MIN_GAIN, quiet: bool = True) -> Diagnosis:
@@ -251,36 +298,9 @@ def rank_candidates(model: Model, ds: Dataset, candidates, *, folds: int = FOLDS
                                               f"({', '.join(own_held)} cannot be determined from it)"))
             prog.step(c)
             continue
-        sig = lr_significance(base_full, full, len(cands), alpha)
-        gain, changed = practical_gain(ym0, yh0, ym1, yh1)
-        significant = bool(sig["passes"] and gain >= min_gain and err1 < err0)
-        own = full.effect_params(c, ds)
-        # reported in the user's terms (the paper's / spec's parameters, errors propagated);
-        # the regression's own coefficients stay under "internal"
-        phys = full.physical(c, ds)
-        inner = full.internal(c, ds)
-        from .identifiability import confounding, describe
-
-        confound = confounding(full, list(own))
-        significant = significant and bool(confound["identifiable"])
-        row = Candidate(c, err0, err1, params={k: v["value"] for k, v in phys.items()},
-                        significant=significant,
-                        stderr={k: v["stderr"] for k, v in phys.items()},
-                        units={k: v["unit"] for k, v in phys.items()},
-                        p_value=sig["p_value"], delta_bic=sig["delta_bic"], n_eff=sig["n_eff"],
-                        gain=gain, channels=dict(zip(ds.channels, map(float, channel_nrmse(ym1, yh1)))),
-                        evidence=_evidence(by_regime0, residual_by_regime(full.residual, y_ref,
-                                                                          regimes, ds.channels)),
-                        identifiability=confound, held=own_held or None,
-                        internal={k: v["value"] for k, v in inner.items()} or None)
-        row.explanation = explain(c, row.params, row.stderr, row.units, err0, err1, significant,
-                                  (int(changed.sum()), len(changed)), gain)
-        if significant and row.evidence:
-            where = row.evidence
-            row.explanation += (f"; largest drop where {where['regime']} is {where['label']} "
-                                f"({100 * where['before']:.0f} % -> {100 * where['after']:.0f} % of "
-                                f"the {where['channel']} RMS)")
-        row.explanation += describe(confound)
+        row, own = _fitted_candidate(c, ds, base_full, full, (err0, ym0, yh0), (err1, ym1, yh1),
+                                     len(cands), alpha, min_gain, own_held,
+                                     (by_regime0, y_ref, regimes))
         rows.append(row)
         ev_c = m2.evaluate(ds, base_full.params)
         phi_c, cols_c = ev_c.phi, ev_c.columns
