@@ -89,7 +89,9 @@ def test_recorder_on_a_full_disk_stops_with_one_line(launcher, tiny_fs, tmp_path
                                       "-o", str(bag_dir), "--quiet", "--flush-period", "0.1"])
     launcher.wait_for_subscribers(["/axis/joint_states", "/clock"], timeout=120,
                                   node_name="cablelab_recorder")
-    launcher.node("sim", "cable_sim_node", "axis", {"rate": 1000.0})
+    # time starts once the recorder has matched: a recorder that matched late would first get the
+    # simulator's backlog in one burst (transient-local), a first chunk larger than the disk
+    launcher.node("sim", "cable_sim_node", "axis", {"rate": 1000.0, "wait_for_subscribers": 1})
     code = rec.wait(180)
     log = rec.log()
     assert code == 2, log

@@ -16,6 +16,7 @@ import time
 import numpy as np
 
 from cablelab.bags import open_bag
+from cablelab.bags.reader import recorder_lost
 from cablelab.plants.suspended.controller import ArmGravity, fig7_excitation, gains, pd_gravity
 from cablelab.plants.suspended.params import parameter_set
 from cablelab.rotations import quat_to_matrix, xyzw_to_wxyz
@@ -60,6 +61,8 @@ def test_lockstep_closed_loop_sim_estimator_controller_recorder(launcher, tmp_pa
     codes = launcher.stop_all()
     assert codes == {"sim": 0, "controller": 0, "estimator": 0, "recorder": 0}, codes
 
+    lost = recorder_lost(bag_dir)
+    assert lost is not None and not any(lost.values()), lost   # nothing published was lost
     bag = open_bag(bag_dir)
     js = bag.joint_state("/suspended/joint_states")
     _, first = np.unique(js.t, return_index=True)          # (the start state may be resent)

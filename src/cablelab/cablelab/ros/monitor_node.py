@@ -25,7 +25,7 @@ from ..errors import CablelabError
 from . import convert
 from .params import DESCRIPTION, Param, executor_params, help_text, merge
 from .plant_node import PlantNode
-from .qos import stream_qos
+from .qos import publisher_qos, stream_qos
 
 PARAMETERS = merge((
     Param("identify_json", "", "file written by `cablelab identify BAG --json` (the model's effects, "
@@ -74,7 +74,7 @@ class ModelMonitorNode(PlantNode):
         self.monitor = None
         self.use_fast_executor(False)
         q = stream_qos()
-        self.pubs = {k: self.create_publisher(JointState, f"/{plant}/model/{k}", q)
+        self.pubs = {k: self.create_publisher(JointState, f"/{plant}/model/{k}", publisher_qos())
                      for k in ("measured", "prediction", "residual")}
         self.listen_for_description(v.description)
         from ..monitor import ResidualMonitor

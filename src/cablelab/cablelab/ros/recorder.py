@@ -1,7 +1,9 @@
 """The bag recorder node behind ``cablelab record``.
 
-Subscribes to a topic set with serialised (raw) callbacks and matching QoS (transient-local for
-/plant_description, reliable keep-all for streams), writes every message as received into a
+Subscribes to a topic set with serialised (raw) callbacks and matching QoS (reliable,
+transient-local: depth 1 for /plant_description, keep-all for streams, so that a recorder whose
+side of a match completes late still gets the samples it missed; downgraded to what a publisher
+offers), writes every message as received into a
 rosbag2 MCAP bag (log time = receive time, wall clock ns) and flushes a complete MCAP chunk to
 disk every ``flush_period`` s. Topics whose type is not known in advance (``--topics``) are
 subscribed as soon as they appear in the ROS graph.
@@ -98,7 +100,7 @@ class RecorderNode(Node):
         write = self.writer.write_raw
         counts = self.counts
         if transient is None:
-            transient = topic == "/plant_description"
+            transient = True        # downgraded by _adapt_qos for a volatile publisher
         registered = self.registered
         gaps = self.lost_gaps
         gaps.setdefault(topic, 0)
@@ -123,7 +125,8 @@ class RecorderNode(Node):
                     gaps[topic] += seq - prev - 1
                 last_seq[topic] = seq
 
-        sub = self.create_subscription(cls, topic, callback, recorder_qos(transient, reliable), raw=True)
+        qos = recorder_qos(transient, reliable, latched=topic == "/plant_description")
+        sub = self.create_subscription(cls, topic, callback, qos, raw=True)
         self.subs[topic] = sub
         self.sub_qos[topic] = (reliable, transient)
         self._lost_handles[topic] = (_lost_event(sub), self.lost_events.get(topic, 0))
@@ -142,9 +145,13 @@ class RecorderNode(Node):
         if transient and any(i.qos_profile.durability == DurabilityPolicy.VOLATILE for i in infos):
             transient = False
         if (reliable, transient) != self.sub_qos[topic]:
-            self.get_logger().warning(f"{topic}: a publisher offers "
-                                      f"{'best-effort' if not reliable else 'volatile'} QoS; "
-                                      "recording it with that QoS")
+            # a volatile stream is normal for a third-party publisher (the recorder only asks
+            # for transient-local to get what it missed by matching late); anything else is
+            # less than the contract asks
+            log = (self.get_logger().info if reliable and topic != "/plant_description"
+                   else self.get_logger().warning)
+            log(f"{topic}: a publisher offers {'best-effort' if not reliable else 'volatile'} "
+                "QoS; recording it with that QoS")
             self._retire_lost_handle(topic)
             self.destroy_subscription(self.subs.pop(topic))
             self._subscribe(topic, msgtype, reliable, transient)

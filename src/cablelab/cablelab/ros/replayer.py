@@ -20,7 +20,7 @@ from rclpy.node import Node
 from ..bags import CLOCK_TOPIC, DESCRIPTION_TOPIC, open_bag
 from ..pacing import replay_times
 from .convert import clock_msg, message_class
-from .qos import DESCRIPTION_QOS, stream_qos
+from .qos import DESCRIPTION_QOS, publisher_qos
 
 
 class ReplayNode(Node):
@@ -47,7 +47,7 @@ class ReplayNode(Node):
                                           "installed; not replayed")
                 names.remove(topic)
                 continue
-            qos = DESCRIPTION_QOS if topic == DESCRIPTION_TOPIC else stream_qos(1000)
+            qos = DESCRIPTION_QOS if topic == DESCRIPTION_TOPIC else publisher_qos()
             self.pubs[topic] = self.create_publisher(cls, topic, qos)
         if DESCRIPTION_TOPIC in self.pubs and bag.counts[DESCRIPTION_TOPIC]:
             self.pubs[DESCRIPTION_TOPIC].publish(bytes(bag.raw(DESCRIPTION_TOPIC)[1][-1]))
@@ -67,7 +67,7 @@ class ReplayNode(Node):
         if self.own_clock:
             from rosgraph_msgs.msg import Clock
 
-            self.clock_pub = self.create_publisher(Clock, CLOCK_TOPIC, stream_qos(10))
+            self.clock_pub = self.create_publisher(Clock, CLOCK_TOPIC, publisher_qos())
         self.clock_period_ns = int(clock_period * 1e9)
         self.next_clock = self.t0_bag
         self.i = 0

@@ -97,7 +97,7 @@ class CdprControlLoop(ControlLoopNode):
         self.pub_ref = self.create_publisher(MultiDOFJointTrajectory, "/cdpr/reference", q)
         self.pub_cmd = self.create_publisher(Float64MultiArray, "/cdpr/effort_commands", q)
         self.pub_pose = self.create_publisher(PoseStamped, "/cdpr/platform_pose", q)
-        self.pub_clock = self.create_publisher(Clock, "/clock", stream_qos(10))
+        self.pub_clock = self.create_publisher(Clock, "/clock", publisher_qos())
         if self.simulated:
             self.pub_tpose = self.create_publisher(PoseStamped, "/cdpr/ground_truth/pose", q)
             self.pub_tpay = self.create_publisher(InertiaStamped, "/cdpr/ground_truth/payload", q)

@@ -31,7 +31,7 @@ from ....ros.fastspin import drain, poll
 from ....stamped import StampedBuffer
 from ....ros.params import DESCRIPTION, Param, executor_params, merge
 from ....ros.plant_node import PlantNode
-from ....ros.qos import stream_qos
+from ....ros.qos import publisher_qos, stream_qos
 from ....ros import rawmsg
 from ....ros.rawmsg import CommandTemplate, RawReader
 
@@ -91,7 +91,7 @@ class CdprController(PlantNode):
         self.inputs.add("payload_estimate", timeout=self.estimate_timeout, length=1,
                         required=False)
         q = stream_qos(1000)     # deep queue: a busy moment delays samples instead of dropping them
-        self.pub_cmd = self.create_publisher(Float64MultiArray, "/cdpr/effort_commands", q)
+        self.pub_cmd = self.create_publisher(Float64MultiArray, "/cdpr/effort_commands", publisher_qos())
         self.keep_first_description = True   # the first valid description configures the law
         self.listen_for_description(v.description)
         # the 1 kHz inputs arrive as bytes, decoded without rclpy message objects (RawReader)

@@ -30,7 +30,7 @@ from ....ros.fastspin import drain, poll
 from ....stamped import StampedBuffer
 from ....ros.params import Param, executor_params, merge
 from ....ros.plant_node import PlantNode
-from ....ros.qos import stream_qos
+from ....ros.qos import publisher_qos, stream_qos
 from ....ros import rawmsg
 from ....ros.rawmsg import RawReader, RawTemplate
 
@@ -83,7 +83,7 @@ class CdprPayloadEstimator(PlantNode):
         if self.config.tensions == "motor":
             self.inputs.add("joint_states", timeout=timeout)
         q = stream_qos(1000)     # deep queue: a busy moment delays samples instead of dropping them
-        self.pub = self.create_publisher(InertiaStamped, "/cdpr/payload_estimate", q)
+        self.pub = self.create_publisher(InertiaStamped, "/cdpr/payload_estimate", publisher_qos())
         self.keep_first_description = True   # the first valid description configures the law
         self.listen_for_description(v.description)
         # batch mode: the inputs wake nobody; a timer takes what queued every poll_period s and

@@ -38,7 +38,7 @@ from ....ros.fastspin import poll, take_newest
 from ....ros.markers import start_markers
 from ....ros.params import DESCRIPTION, START_GATE, Param, executor_params, merge
 from ....ros.plant_node import PlantNode
-from ....ros.qos import stream_qos
+from ....ros.qos import publisher_qos, stream_qos
 from ....ros import rawmsg
 from ....ros.rawmsg import RawTemplate
 from ..geometry import check_pulley_radius
@@ -176,14 +176,14 @@ class CdprSimNode(PlantNode):
         self._last_pub_wall = time.monotonic()
         self._wall0 = None          # wall time of sim time 0 (real-time mode)
 
-        q = stream_qos()
-        self.pub_js = self.create_publisher(JointState, "/cdpr/joint_states", q)
-        self.pub_ten = self.create_publisher(JointState, "/cdpr/cable_tensions", q)
-        self.pub_pose = self.create_publisher(PoseStamped, "/cdpr/platform_pose", q)
-        self.pub_ref = self.create_publisher(MultiDOFJointTrajectory, "/cdpr/reference", q)
-        self.pub_tpose = self.create_publisher(PoseStamped, "/cdpr/ground_truth/pose", q)
-        self.pub_tpay = self.create_publisher(InertiaStamped, "/cdpr/ground_truth/payload", q)
-        self.pub_clock = self.create_publisher(Clock, "/clock", stream_qos(10))
+        q, pq = stream_qos(), publisher_qos()
+        self.pub_js = self.create_publisher(JointState, "/cdpr/joint_states", pq)
+        self.pub_ten = self.create_publisher(JointState, "/cdpr/cable_tensions", pq)
+        self.pub_pose = self.create_publisher(PoseStamped, "/cdpr/platform_pose", pq)
+        self.pub_ref = self.create_publisher(MultiDOFJointTrajectory, "/cdpr/reference", pq)
+        self.pub_tpose = self.create_publisher(PoseStamped, "/cdpr/ground_truth/pose", pq)
+        self.pub_tpay = self.create_publisher(InertiaStamped, "/cdpr/ground_truth/payload", pq)
+        self.pub_clock = self.create_publisher(Clock, "/clock", publisher_qos())
         self.publish_description(self.description)
         if not self.real_time and v.rt_priority > 0:
             self.get_logger().warning("rt_priority ignored: lock-step mode runs as fast as possible")

@@ -106,7 +106,7 @@ class CraneSimNode(PlantNode):
         self.pub_tip = self.create_publisher(PoseStamped, "/crane/boom_tip_pose", publisher_qos())
         self.pub_pay = self.create_publisher(PoseStamped, "/crane/payload_pose", publisher_qos())
         self.pub_truth = self.create_publisher(JointState, "/crane/ground_truth/swing", publisher_qos())
-        self.pub_clock = self.create_publisher(Clock, "/clock", stream_qos(10))
+        self.pub_clock = self.create_publisher(Clock, "/clock", publisher_qos())
         self.publish_description(self.description)
         self.create_subscription(Float64MultiArray, "/crane/effort_commands", self.on_command, stream_qos())
         self.start_diagnostics()
