@@ -10,7 +10,7 @@ import pytest
 from cablelab.dataset import Dataset
 from cablelab.diagnose import greedy, rank_candidates
 from cablelab.diagnose.ambiguity import canonical_correlation, paired_log_spread, project_out
-from cablelab.diagnose.result import Step, ambiguity_lines, step_from_dict
+from cablelab.diagnose.result import Step, ambiguity_lines
 from cablelab.effects import register
 from cablelab.effects.base import Effect, Param
 from cablelab.model import Model
@@ -77,21 +77,21 @@ def test_identical_columns_are_ambiguous_and_greedy_says_it_chose():
     ds = _dataset(lambda u, h, g: 2.0 * u + 0.5 * h)
     model = Model(PLANT, ("toy_base",))
     d = rank_candidates(model, ds, ["toy_twin_a", "toy_twin_b", "toy_other", "toy_idle"])
-    by = {r["effect"]: r for r in d.ranking}
-    assert by["toy_twin_a"]["significant"] and by["toy_twin_b"]["significant"]
-    assert by["toy_twin_a"]["ambiguous_with"] == ["toy_twin_b"]
-    assert by["toy_twin_b"]["ambiguous_with"] == ["toy_twin_a"]
-    assert by["toy_twin_a"]["ambiguity"]["toy_twin_b"]["collinearity"] == pytest.approx(1.0, abs=1e-9)
-    assert "ambiguous" in by["toy_twin_a"]["explanation"]
-    assert "ambiguous_with" not in by["toy_other"] and "ambiguous_with" not in by["toy_idle"]
+    by = {r.effect: r for r in d.ranking}
+    assert by["toy_twin_a"].significant and by["toy_twin_b"].significant
+    assert by["toy_twin_a"].ambiguous_with == ["toy_twin_b"]
+    assert by["toy_twin_b"].ambiguous_with == ["toy_twin_a"]
+    assert by["toy_twin_a"].ambiguity["toy_twin_b"]["collinearity"] == pytest.approx(1.0, abs=1e-9)
+    assert "ambiguous" in by["toy_twin_a"].explanation
+    assert by["toy_other"].ambiguous_with is None and by["toy_idle"].ambiguous_with is None
+    assert "ambiguous_with" not in by["toy_other"].to_json()
     lines = ambiguity_lines(d.ranking)
     assert len(lines) == 1 and "toy_twin_a" in lines[0] and "toy_twin_b" in lines[0]
     steps = greedy(model, ds, ["toy_twin_a", "toy_twin_b", "toy_other"])
-    assert steps[1]["added"] in ("toy_twin_a", "toy_twin_b")
-    assert "chose" in steps[1]["note"] and "cannot tell" in steps[1]["note"]
-    # the note survives the typed result (JSON and text)
-    st = step_from_dict(steps[1])
-    assert isinstance(st, Step) and st.to_json()["note"] == steps[1]["note"]
+    assert steps[1].added in ("toy_twin_a", "toy_twin_b")
+    assert "chose" in steps[1].note and "cannot tell" in steps[1].note
+    # the note is in the JSON
+    assert isinstance(steps[1], Step) and steps[1].to_json()["note"] == steps[1].note
 
 
 def test_separable_candidates_that_gain_alike_are_not_ambiguous():
@@ -99,8 +99,8 @@ def test_separable_candidates_that_gain_alike_are_not_ambiguous():
     # of the error, but with a different correction (orthogonal columns)
     ds = _dataset(lambda u, h, g: 2.0 * u + 0.35 * h + 0.5 * g)
     d = rank_candidates(Model(PLANT, ("toy_base",)), ds, ["toy_twin_a", "toy_other"])
-    by = {r["effect"]: r for r in d.ranking}
-    assert by["toy_twin_a"]["significant"] and by["toy_other"]["significant"]
-    assert "ambiguous_with" not in by["toy_twin_a"] and "ambiguous_with" not in by["toy_other"]
+    by = {r.effect: r for r in d.ranking}
+    assert by["toy_twin_a"].significant and by["toy_other"].significant
+    assert by["toy_twin_a"].ambiguous_with is None and by["toy_other"].ambiguous_with is None
     steps = greedy(Model(PLANT, ("toy_base",)), ds, ["toy_twin_a", "toy_other"])
-    assert [s["added"] for s in steps[1:]] and all("note" not in s for s in steps)
+    assert [s.added for s in steps[1:]] and all("note" not in s.to_json() for s in steps)

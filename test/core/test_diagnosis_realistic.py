@@ -81,8 +81,8 @@ def test_control_nothing_significant_and_residual_white(tmp_path, flavour, truth
     assert len(out["greedy"]) == 1
     # the whiteness test is valid on the filtered data: the right model is called white
     cmp = workbench.compare(ds, model)
-    assert cmp["whiteness"]["joint"]["decimate"] > 1
-    assert cmp["whiteness"]["joint"]["white"]
+    assert cmp.whiteness["joint"]["decimate"] > 1
+    assert cmp.whiteness["joint"]["white"]
 
 
 # ----------------------------------------------------------------------------- bad input
@@ -188,7 +188,7 @@ def test_slow_slew_axis_under_chirps_coulomb_and_inertia_with_parallel_filtering
     # the whiteness test stays valid on parallel-filtered data: the right model is called white
     plant, desc, _ = workbench.load(tmp_path / f"case_{case.seed}")
     cmp = workbench.compare(ds, workbench.build_model(plant, desc, ["joint_coulomb_friction"]))
-    assert cmp["whiteness"]["joint"]["decimate"] > 1 and cmp["whiteness"]["joint"]["white"]
+    assert cmp.whiteness["joint"]["decimate"] > 1 and cmp.whiteness["joint"]["white"]
     # the same bag with the positions filtered alone: biased (the failure this fixes)
     plant, desc, ds_old = workbench.load(tmp_path / f"case_{case.seed}",
                                          options={"conditioning": Conditioning(parallel=False)})

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from cablelab.fit.simulation import fit_simulation
-from cablelab.model import Param
+from cablelab.effects.base import Param
 
 T_TRUE, X0 = 0.35, 2.0
 t = np.linspace(0.0, 1.0, 200)

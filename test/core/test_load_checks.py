@@ -26,7 +26,7 @@ def full_fit():
 
     plant, desc, ds = load(EMPS)
     out = compare(ds, build_model(plant, desc))
-    return out["params"]["M"]["value"], out["samples"], ds
+    return out.params["M"]["value"], out.samples, ds
 
 
 def test_gap_is_masked_not_interpolated(cli, tmp_path, full_fit):
@@ -55,7 +55,7 @@ def test_gap_is_masked_not_interpolated(cli, tmp_path, full_fit):
     b = open_bag(bag)
     plant = get_plant("axis")
     ds = plant.dataset(b, b.description, DatasetOptions())
-    M_interp = compare(ds, build_model(plant, b.description))["params"]["M"]["value"]
+    M_interp = compare(ds, build_model(plant, b.description)).params["M"]["value"]
     assert abs(M_interp - M_full) > 5 * abs(M - M_full)
     # text output: the warning line is printed too
     txt = cli("compare", bag)

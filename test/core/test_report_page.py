@@ -12,7 +12,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from cablelab.diagnose.ranking import ALPHA, MIN_GAIN
-from cablelab.report import metrics_table, ranking_section
+from cablelab.diagnose.result import Candidate, Step
+from cablelab.report.sections import metrics_table, ranking_section
 from cablelab.report.plots import _thin_masked, invalid_spans
 
 from robust_helpers import CDPR
@@ -130,9 +131,14 @@ def check_ranking_rows(table: dict, baseline_percent: float) -> int:
 # ------------------------------------------------------------------------ the ranking, unit level
 def _row(effect, after, gain, p, identifiable=True, before=0.20):
     sig = (gain >= MIN_GAIN and after < before and p < ALPHA / 4 and identifiable)
-    return {"effect": effect, "error_before": before, "error_after": after, "gain": gain,
-            "p_value": p, "significant": sig, "explanation": f"{effect} ...",
-            "identifiability": {"identifiable": identifiable, "confounded": []}}
+    return Candidate(effect, before, after, gain=gain, p_value=p, significant=sig,
+                     explanation=f"{effect} ...",
+                     identifiability={"identifiable": identifiable, "confounded": []})
+
+
+def _step(ranking, error, effects):
+    return Step(effects=effects, added=None, error=error, params={}, stderr={}, units={},
+                ranking=ranking)
 
 
 def test_ranking_shows_the_decisive_quantity_beside_every_decision():
@@ -142,9 +148,8 @@ def test_ranking_shows_the_decisive_quantity_beside_every_decision():
             _row("tiny_p_small_gain", 0.194, 0.03, 6.5e-124),
             _row("big_gain_but_confounded", 0.12, 0.40, 1e-30, identifiable=False),
             _row("gain_but_p_large", 0.15, 0.25, 0.2)]
-    rows.append({"effect": "unfittable", "error_before": 0.2, "error_after": None, "params": {},
-                 "significant": False, "explanation": "unfittable: cannot be fitted (rank)"})
-    page = Page(ranking_section([{"ranking": rows, "error": 0.20, "effects": ["m"], "added": None}]))
+    rows.append(Candidate("unfittable", 0.2, None, explanation="unfittable: cannot be fitted (rank)"))
+    page = Page(ranking_section([_step(rows, 0.20, ["m"])]))
     assert check_ranking_rows(page.table_with("significant"), 20.0) == 5
     t = page.table_with("significant")
     sig = {r[0]: r[t["header"].index("significant")] for r in t["rows"]}
@@ -159,8 +164,8 @@ def test_ranking_consistency_check_catches_a_contradiction():
     """The checker itself fails on the page the probe saw (p tiny, gain large, 'no' without a
     reason the numbers show)."""
     row = _row("x", 0.10, 0.50, 1e-124)
-    row["significant"] = False           # the diagnosis said no for a reason the page cannot show
-    step = {"ranking": [row], "error": 0.20, "effects": [], "added": None}
+    row.significant = False           # the diagnosis said no for a reason the page cannot show
+    step = _step([row], 0.20, [])
     page = Page(ranking_section([step]).replace("see the explanation", "held-out gain below 5 %"))
     with pytest.raises(AssertionError):
         check_ranking_rows(page.table_with("significant"), 20.0)

@@ -7,7 +7,7 @@ import pytest
 from cablelab.effects.friction import coulomb_sign
 from cablelab.errors import CablelabError
 from cablelab.fit.simulation import free_run_windows, window_length, window_starts
-from cablelab.model import Dataset
+from cablelab.dataset import Dataset
 from cablelab.rotations import cross, matrix_to_quat, quat_to_matrix, wxyz_to_xyzw, xyzw_to_wxyz
 
 

@@ -64,7 +64,7 @@ def emps_fit():
     from cablelab.workbench import build_model, compare, load
 
     plant, desc, ds = load(EMPS)
-    p = compare(ds, build_model(plant, desc))["params"]
+    p = compare(ds, build_model(plant, desc)).params
     return p["M"]["value"], p["Fv"]["value"]
 
 

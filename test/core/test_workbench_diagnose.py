@@ -8,7 +8,7 @@ from cablelab.diagnose import (channel_metrics, derived_regimes, fold_indices, r
                                whiteness, worst_segments)
 from cablelab.errors import CablelabError
 from cablelab.fit.simulation import objective_residual
-from cablelab.model import Dataset
+from cablelab.dataset import Dataset
 
 T = np.arange(0, 10, 0.001)
 
@@ -138,9 +138,11 @@ def test_typed_diagnosis_is_the_ranking_once_reshaped():
     assert isinstance(d, Diagnosis) and d.final is None
     rows = rank_candidates(model, ds, cands, folds=4).ranking
     js = d.to_json()
-    assert [r["effect"] for r in js["ranking"]] == [r["effect"] for r in rows]
-    for got, row in zip(js["ranking"], rows):
-        assert got == {k: row[k] for k in ROW_KEYS if k in row}
+    assert [r["effect"] for r in js["ranking"]] == [r.effect for r in rows]
+    for got, row in zip(js["ranking"], rows):      # every field set is in the JSON, in order
+        assert list(got) == [k for k in ROW_KEYS if getattr(row, k) is not None
+                             or k in ("error_before", "error_after")]
+        assert got == {k: getattr(row, k) for k in got}
     assert d.ranking[0].effect == "joint_coulomb_friction" and d.ranking[0].significant
     g = diagnose(ds, model, cands, folds=4, greedy_mode=True)
     assert g.final.effects[-1] == "joint_coulomb_friction" and g.to_json()["final"]["error"] == g.final.error

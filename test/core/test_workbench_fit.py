@@ -8,7 +8,9 @@ from cablelab.description import load_description
 from cablelab.effects import effects_for, get_effect
 from cablelab.errors import CablelabError
 from cablelab.fit import identify, solve_linear
-from cablelab.model import Dataset, Model, Param
+from cablelab.dataset import Dataset
+from cablelab.effects.base import Param
+from cablelab.model import Model
 from cablelab.plants import get_plant
 
 PRISMATIC = load_description("plant: axis\naxis:\n  joint_type: prismatic\n")
@@ -113,6 +115,32 @@ def test_known_parameters_move_to_the_left_hand_side():
         identify(Model("axis", ("axis_inertia",), fixed={"X": 1.0}), ds)
 
 
+def test_a_linear_fit_builds_its_regressor_once_and_predicts_from_it(monkeypatch):
+    """One evaluation per fit: the model's regressor is built once and the fitted output is that
+    regressor times the parameters (closed form: noise-free data, exact parameters)."""
+    fs = 200.0
+    t = np.arange(0, 10, 1 / fs)
+    q = np.sin(t) + 0.3 * np.sin(3.1 * t)
+    qd, qdd = np.cos(t) + 0.93 * np.cos(3.1 * t), -np.sin(t) - 2.883 * np.sin(3.1 * t)
+    ds = _axis_data(t, q, 5.0 * qdd + 2.0 * qd)
+    model = Model("axis", ("axis_inertia", "joint_viscous_friction"))
+    builds = []
+    real = Model.regressor
+
+    def counted(self, data):
+        builds.append(data)
+        return real(self, data)
+
+    monkeypatch.setattr(Model, "regressor", counted)
+    monkeypatch.setattr(Model, "predict", lambda *a: pytest.fail("the fit rebuilt its prediction"))
+    r = identify(model, ds)
+    assert len(builds) == 1
+    assert r.params["M"] == pytest.approx(5.0, rel=1e-3) and r.params["Fv"] == pytest.approx(2.0, rel=1e-3)
+    ev = model.evaluate(ds, {})
+    ok = r.valid
+    assert np.allclose(r.y_hat[ok], ev.phi[ok] @ [r.params[c.name] for c in ev.columns])
+
+
 def test_conditioning_derivatives_unwrap_and_irregular_times():
     fs = 1000.0
     t = np.arange(0, 5, 1 / fs)
@@ -180,7 +208,8 @@ def test_identify_holds_unexcited_parameters_at_their_nominal_and_fits_the_rest(
     from cablelab.effects.base import Effect
     from cablelab.fit import identify
     from cablelab.fit.linear import RankDeficient
-    from cablelab.model import Dataset, Model
+    from cablelab.dataset import Dataset
+    from cablelab.model import Model
 
     plant = "toy_unexcited"
     sig = lambda name: (lambda ds: ds.require_signal(name).reshape(ds.n, 1, 1))  # noqa: E731

@@ -3,9 +3,6 @@
 :class:`Model` holds the :class:`~cablelab.effects.base.Effect` objects of its effects, looked up
 once in the effect registry when the model is made. Linear in the free parameters:
 ``y = sum_e Phi_e @ theta_e``; fixed parameters are moved to the left-hand side.
-
-:class:`~cablelab.dataset.Dataset`, :class:`~cablelab.effects.base.Param` and
-:class:`~cablelab.effects.base.Effect` are re-exported here for the code written against them.
 """
 from __future__ import annotations
 
@@ -14,9 +11,9 @@ from typing import Mapping, Sequence
 
 import numpy as np
 
-from .dataset import STANDARD_GRAVITY, Dataset
+from .dataset import Dataset
 from .effects import get_effect
-from .effects.base import Effect, Param, RegressorFn, TransformFn
+from .effects.base import Effect, Param
 from .errors import CablelabError
 
 
@@ -32,7 +29,7 @@ class Model:
     Args:
         plant: plant name.
         effects: effect ids or :class:`Effect` objects, in order (the regressor columns follow
-            this order); stored as ids, with the looked-up objects in ``units``.
+            this order); stored as ids, with the looked-up objects in ``effect_objects``.
         fixed: known parameter values by name, moved to the left-hand side of the fit.
         unexcited: what a fit does with parameters the data cannot determine (a rank-deficient
             regressor): ``"raise"`` refuses with the unidentifiable directions named; ``"hold"``
@@ -43,42 +40,38 @@ class Model:
     plant: str
     effects: tuple[str, ...]
     fixed: Mapping[str, float] = field(default_factory=dict)
-    units: tuple[Effect, ...] = field(init=False, repr=False, compare=False)
+    effect_objects: tuple[Effect, ...] = field(init=False, repr=False, compare=False)
     unexcited: str = "raise"
 
     def __post_init__(self) -> None:
         if self.unexcited not in ("raise", "hold"):
             raise ValueError(f"unexcited={self.unexcited!r}: expected 'raise' or 'hold'")
-        units: list[Effect] = []
+        objects: list[Effect] = []
         for e in self.effects:
-            unit = e if isinstance(e, Effect) else get_effect(e, self.plant)  # validates id, plant
-            if any(u.id == unit.id for u in units):
-                raise CablelabError(f"effect {unit.id} listed twice in the model")
-            units.append(unit)
-        object.__setattr__(self, "effects", tuple(u.id for u in units))
-        object.__setattr__(self, "units", tuple(units))
+            obj = e if isinstance(e, Effect) else get_effect(e, self.plant)  # validates id, plant
+            if any(o.id == obj.id for o in objects):
+                raise CablelabError(f"effect {obj.id} listed twice in the model")
+            objects.append(obj)
+        object.__setattr__(self, "effects", tuple(o.id for o in objects))
+        object.__setattr__(self, "effect_objects", tuple(objects))
 
     def with_effect(self, effect: "str | Effect") -> "Model":
         """The model with one more effect (an id or an :class:`Effect`)."""
-        return Model(self.plant, self.units + (effect,), self.fixed, unexcited=self.unexcited)
+        return Model(self.plant, self.effect_objects + (effect,), self.fixed, unexcited=self.unexcited)
 
     def with_effects(self, effects, fixed: Mapping[str, float] | None = None) -> "Model":
         """The same plant and policy with other effects (and known parameters)."""
         return Model(self.plant, tuple(effects), dict(self.fixed if fixed is None else fixed),
                      unexcited=self.unexcited)
 
-    def effect_units(self) -> list[Effect]:
-        """The model's :class:`Effect` objects, in order."""
-        return list(self.units)
-
     def nonlinear_params(self) -> list[Param]:
-        return [p for e in self.effect_units() for p in e.nonlinear if p.name not in self.fixed]
+        return [p for e in self.effect_objects for p in e.nonlinear if p.name not in self.fixed]
 
     def apply_nonlinear(self, ds: Dataset, values: Mapping[str, float]) -> Dataset:
         """Apply every effect's data transform with the given nonlinear parameter values."""
-        vals = {**{p.name: p.nominal for e in self.effect_units() for p in e.nonlinear},
+        vals = {**{p.name: p.nominal for e in self.effect_objects for p in e.nonlinear},
                 **{k: v for k, v in self.fixed.items()}, **dict(values)}
-        for e in self.effect_units():
+        for e in self.effect_objects:
             if e.transform is not None:
                 ds = e.transform(ds, vals)
         return ds
@@ -92,7 +85,7 @@ class Model:
             by the dataset's parallel filter when it declares one (``ds.parallel_hz``).
         """
         blocks, cols = [], []
-        for e in self.effect_units():
+        for e in self.effect_objects:
             blk = e.block(ds)
             blocks.append(blk)
             cols.extend(e.columns(ds))
@@ -102,7 +95,7 @@ class Model:
             phi = np.zeros((ds.n, ds.n_channels, 0))
         names = [c.name for c in cols]
         for k in self.fixed:
-            if k not in names and k not in {p.name for e in self.effect_units() for p in e.nonlinear}:
+            if k not in names and k not in {p.name for e in self.effect_objects for p in e.nonlinear}:
                 raise CablelabError(f"fixed parameter {k!r} is not in the model (parameters: "
                                     f"{', '.join(names) or 'none'})")
         free = [i for i, nme in enumerate(names) if nme not in self.fixed]
@@ -128,17 +121,49 @@ class Model:
             y_known = y_known + phi[:, :, known] @ vals
         return phi[:, :, free], [cols[i] for i in free], y_known
 
+    def evaluate(self, ds: Dataset, values: Mapping[str, float]) -> "Evaluation":
+        """The model on a dataset at given nonlinear parameter values: the transformed dataset
+        and its regressor, built once (what a fit solves and predicts with)."""
+        ds2 = self.apply_nonlinear(ds, values)
+        phi, cols, y_known = self.regressor(ds2)
+        return Evaluation(ds2, phi, cols, y_known)
+
     def predict(self, ds: Dataset, params: Mapping[str, float]) -> tuple[np.ndarray, np.ndarray]:
         """Model output (N, C) and the valid mask for given parameter values (by name)."""
-        ds2 = self.apply_nonlinear(ds, params)
-        return self.linear_output(ds2, params), ds2.valid
+        ev = self.evaluate(ds, params)
+        return ev.output(params), ev.ds.valid
 
-    def linear_output(self, ds: Dataset, params: Mapping[str, float]) -> np.ndarray:
-        """(N, C) linear part ``Phi theta + y_known`` on a dataset the nonlinear parameters are
-        already applied to (:meth:`apply_nonlinear`)."""
-        phi, cols, y_known = self.regressor(ds)
-        theta = np.array([params[c.name] for c in cols]) if cols else np.zeros(0)
-        return phi @ theta + y_known
+
+@dataclass(frozen=True)
+class Evaluation:
+    """A model evaluated on a dataset (:meth:`Model.evaluate`).
+
+    Attributes:
+        ds: the dataset after the effects' transforms (e.g. shifted by a delay).
+        phi: (N, C, p) regressor of the free linear parameters (parallel-filtered when the
+            dataset declares it).
+        columns: their :class:`Param` list.
+        y_known: (N, C) contribution of the fixed parameters.
+    """
+
+    ds: Dataset
+    phi: np.ndarray
+    columns: list
+    y_known: np.ndarray
+
+    @property
+    def lhs(self) -> np.ndarray:
+        """(N, C) what the free columns must explain: the measurement minus the known part."""
+        return self.ds.y - self.y_known
+
+    def output(self, params: "Mapping[str, float] | np.ndarray") -> np.ndarray:
+        """(N, C) model output ``Phi theta + y_known``; ``params`` by name or the free
+        parameters' values in column order."""
+        if isinstance(params, Mapping):
+            theta = np.array([params[c.name] for c in self.columns]) if self.columns else np.zeros(0)
+        else:
+            theta = np.asarray(params, dtype=float)
+        return self.phi @ theta + self.y_known
 
 
 def parse_effect_list(text: str | Sequence[str] | None) -> tuple[str, ...]:
@@ -169,5 +194,4 @@ def parse_fixed(items: Sequence[str] | None) -> dict:
     return out
 
 
-__all__ = ["KNOWN_OUTPUT", "STANDARD_GRAVITY", "Dataset", "Effect", "Model", "Param", "RegressorFn", "TransformFn",
-           "parse_effect_list", "parse_fixed"]
+__all__ = ["KNOWN_OUTPUT", "Evaluation", "Model", "parse_effect_list", "parse_fixed"]

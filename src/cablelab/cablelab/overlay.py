@@ -27,7 +27,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .bags import DESCRIPTION_TOPIC, BagWriter
-from .model import Dataset, Model
+from .dataset import Dataset
+from .model import Model
 
 #: the kinds of per-stage topics and what each holds
 KINDS = ("measured", "prediction", "residual")

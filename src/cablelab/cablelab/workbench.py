@@ -1,8 +1,11 @@
 """The workbench verbs as library functions (what ``cablelab compare/diagnose/identify`` print).
 
-Each takes a plant :class:`~cablelab.model.Dataset` and a :class:`~cablelab.model.Model` and
-returns a JSON-ready dict (``diagnose``: a typed :class:`~cablelab.diagnose.result.Diagnosis`) in the shape of CONTRACT section 5; :func:`load` turns a bag (+ optional
-description file) into (plant, description, dataset), :func:`build_model` a plant's baseline plus
+Each takes a plant :class:`~cablelab.dataset.Dataset` and a :class:`~cablelab.model.Model` and
+returns a typed result whose ``to_json()`` is the verb's JSON (CONTRACT section 5):
+:func:`compare` a :class:`~cablelab.results.Comparison`, :func:`identify_report` an
+:class:`~cablelab.results.IdentifyReport`, :func:`diagnose` a
+:class:`~cablelab.diagnose.result.Diagnosis`. :func:`load` turns a bag (+ optional description
+file) into (plant, description, dataset), :func:`build_model` a plant's baseline plus
 ``--effects`` into a model.
 """
 from __future__ import annotations
@@ -12,15 +15,17 @@ from typing import Mapping, Sequence
 
 import numpy as np
 
-from .diagnose import (channel_metrics, cv_error, derived_regimes, greedy, rank_candidates,
-                       residual_by_regime, whiteness, worst_segments)
+from .dataset import Dataset
+from .diagnose import cv_error, greedy, rank_candidates, worst_segments
+from .diagnose.fit_metrics import fit_metrics
 from .diagnose.ranking import ALPHA, FOLDS, MIN_GAIN
-from .diagnose.result import Candidate, Diagnosis, step_from_dict
+from .diagnose.result import Diagnosis
 from .errors import CablelabError
 from .fit import identify as _identify
 from .fit.threads import blas_single
-from .model import Dataset, Model
+from .model import Model
 from .plant_interface import DatasetOptions
+from .results import Comparison, FitQuality, IdentifyReport
 
 
 def load(bag_path, description_path=None, options: DatasetOptions | Mapping | None = None):
@@ -138,50 +143,23 @@ def _effect_table(ident) -> dict:
             for row in ident.table()}
 
 
-def _held(out: dict, ident) -> dict:
-    """``out`` with ``"held"`` (name -> value) and its line in ``"warnings"`` when the fit held
-    parameters."""
-    if ident.held:
-        out["held"] = ident.held
-        out.setdefault("warnings", []).append(ident.held_warning())
-    return out
-
-
-def _fit_on_record(model: Model, ds: Dataset):
-    """``(identification, y_meas (N, C) NaN where invalid, metrics per channel)`` of the model
-    fitted on the whole record."""
-    ident = _identify(model, ds)
-    y_meas = np.where(ident.valid[:, None], ident.residual + ident.y_hat, np.nan)
-    return ident, y_meas, channel_metrics(y_meas, ident.y_hat, ident.valid)
-
-
 @blas_single
-def compare(ds: Dataset, model: Model, *, segments: int = 5) -> dict:
+def compare(ds: Dataset, model: Model, *, segments: int = 5) -> Comparison:
     """Inverse-model comparison: fit on the whole record, metrics per channel, worst segments,
-    residual by regime and whiteness. JSON of CONTRACT section 5 (``compare``) + extras."""
-    return compare_fit(ds, model, segments=segments)[0]
-
-
-@blas_single
-def compare_fit(ds: Dataset, model: Model, *, segments: int = 5):
-    """:func:`compare` and the identification it reports on (for the overlay bag)."""
-    ident, y_meas, mets = _fit_on_record(model, ds)
-    out: dict = {"plant": ds.plant, "effects": list(model.effects), "samples": int(ident.valid.sum())}
-    out["channels"] = {}
-    for ch, m in zip(ds.channels, mets):
-        out["channels"][ch] = m
-        out.setdefault(ch, m)
-    out["worst_segments"] = worst_segments(ds.t, ident.residual, y_meas, ds.channels, count=segments)
-    out["params"] = _effect_table(ident)
-    out["regimes"] = residual_by_regime(ident.residual, y_meas, derived_regimes(ds), ds.channels)
-    out["whiteness"] = {ch: _whiteness_summary(ident.residual[:, c], ds.inputs, _decimation(ds))
-                        for c, ch in enumerate(ds.channels)}
-    out["rank"], out["condition"] = ident.linear.rank, ident.linear.cond
-    _held(out, ident)
+    residual by regime and whiteness. ``.to_json()`` is CONTRACT section 5 (``compare``) + extras."""
+    ident = _identify(model, ds)
+    m = fit_metrics(ds, ident)
     plant = _plant_of(ds)
-    if plant is not None and plant.simulate is not None:
-        out["free_run"] = plant.simulate(ds, ident.params)
-    return out, ident
+    free_run = plant.simulate(ds, ident.params) if plant is not None and plant.simulate is not None \
+        else None
+    return Comparison(
+        plant=ds.plant, effects=list(model.effects), samples=int(ident.valid.sum()),
+        channels=dict(zip(ds.channels, m.channels)),
+        worst_segments=worst_segments(ds.t, ident.residual, m.y_meas, ds.channels, count=segments),
+        params=_effect_table(ident), regimes=m.regimes,
+        whiteness={ch: _whiteness_summary(w) for ch, w in m.whiteness.items()},
+        rank=ident.linear.rank, condition=ident.linear.cond, held=ident.held,
+        held_warning=ident.held_warning(), free_run=free_run, fit=ident)
 
 
 def _plant_of(ds: Dataset):
@@ -193,15 +171,8 @@ def _plant_of(ds: Dataset):
         return None
 
 
-def _decimation(ds: Dataset) -> int:
-    """Samples per independent sample of a residual of signals low-passed at the dataset's
-    cut-off (``signals["cutoff_hz"]``): fs / (2 f_c); 1 when unknown."""
-    fc = ds.signals.get("cutoff_hz")
-    return max(1, int(ds.fs / (2.0 * float(fc)))) if fc else 1
-
-
-def _whiteness_summary(res, inputs, decimate: int = 1) -> dict:
-    w = whiteness(res, inputs, decimate=decimate)
+def _whiteness_summary(w: dict) -> dict:
+    """The JSON summary of one channel's :func:`~cablelab.diagnose.whiteness.whiteness`."""
     return {"band": w["band"], "white": w["white"], "autocorr_outside": w["outside"],
             "decimate": w["decimate"],
             "autocorr_lag1": w["autocorr"][1] if len(w["autocorr"]) > 1 else None,
@@ -217,38 +188,37 @@ def _mean_nrmse(mets) -> float | None:
 
 
 @blas_single
-def identify(ds: Dataset, model: Model, *, folds: int = FOLDS, simulation: str | None = None,
-             quiet: bool = True) -> dict:
-    """Identified parameters with standard errors, rank/condition, in-sample and held-out fit.
+def identify_report(ds: Dataset, model: Model, *, folds: int = FOLDS, simulation: str | None = None,
+                    quiet: bool = True) -> IdentifyReport:
+    """Identified parameters with standard errors, rank/condition, in-sample and held-out fit
+    (what ``cablelab identify`` prints; the fit itself is :func:`cablelab.fit.identify`).
 
     With ``simulation`` (``"nmse"`` or ``"pearson"``) the inverse-model result starts a
     simulation-based fit of the plant (if it offers one), reported under ``"simulation"``."""
-    ident, y_meas, mets = _fit_on_record(model, ds)
+    ident = _identify(model, ds)
+    mets = fit_metrics(ds, ident, with_regimes=False, with_whiteness=False).channels
     cv = cv_error(model, ds, folds)[0] if folds else None
-    out = {
-        "plant": ds.plant, "effects": list(model.effects), "samples": int(ident.valid.sum()),
-        "params": None,
-        "fit": {"nrmse": _mean_nrmse(mets), "cv_nrmse": cv, "folds": folds,
-                "channels": dict(zip(ds.channels, mets)), "rank": ident.linear.rank,
-                "parameters": len(ident.linear.names), "condition": ident.linear.cond,
-                "unidentifiable": ident.linear.unidentifiable,
-                "active_bounds": ident.linear.active_bounds},
-    }
-    _held(out, ident)
+    quality = FitQuality(nrmse=_mean_nrmse(mets), cv_nrmse=cv, folds=folds,
+                         channels=dict(zip(ds.channels, mets)), rank=ident.linear.rank,
+                         parameters=len(ident.linear.names), condition=ident.linear.cond,
+                         unidentifiable=ident.linear.unidentifiable,
+                         active_bounds=ident.linear.active_bounds)
     # the parameters in the user's terms; the regression's own coefficients they replace
     # (e.g. c_td, c_lo for beta_td, beta_lo) under "internal"
-    out["params"], internal = ident.reported(ds)
-    if internal:
-        out["internal"] = internal
+    params, internal = ident.reported(ds)
+    sim = None
     if simulation:
         plant = _plant_of(ds)
         if plant is None or plant.simulation_fit is None:
             raise CablelabError(f"plant {ds.plant} offers no simulation-based fit")
         sf = plant.simulation_fit(ds, ident.params, objective=simulation, progress=not quiet)
-        out["simulation"] = {"objective": sf.objective, "nmse": sf.nmse, "pearson": sf.pearson,
-                             "iterations": sf.iterations, "evaluations": sf.evaluations,
-                             "params": {k: {"value": v, "stderr": sf.stderr[k]} for k, v in sf.params.items()}}
-    return out
+        sim = {"objective": sf.objective, "nmse": sf.nmse, "pearson": sf.pearson,
+               "iterations": sf.iterations, "evaluations": sf.evaluations,
+               "params": {k: {"value": v, "stderr": sf.stderr[k]} for k, v in sf.params.items()}}
+    return IdentifyReport(plant=ds.plant, effects=list(model.effects), samples=int(ident.valid.sum()),
+                          params=params, quality=quality, held=ident.held,
+                          held_warning=ident.held_warning(), internal=internal, simulation=sim,
+                          fit=ident)
 
 
 @blas_single
@@ -265,14 +235,10 @@ def diagnose(ds: Dataset, model: Model, candidates: Sequence[str], *, folds: int
     check_dataset(ds)  # bad input: a one-line refusal, never a confident ranking
     cands = [c for c in candidates if c not in model.effects]
     if greedy_mode:
-        steps = [step_from_dict(s) for s in greedy(model, ds, cands, folds=folds, alpha=alpha,
-                                                    min_gain=min_gain, quiet=quiet)]
+        steps = greedy(model, ds, cands, folds=folds, alpha=alpha, min_gain=min_gain, quiet=quiet)
         first = steps[0]
-        base_fit = _identify(model, ds)
         return Diagnosis(plant=ds.plant, baseline_effects=first.effects, baseline_error=first.error,
-                         ranking=first.ranking, folds=folds, greedy=steps, held=base_fit.held,
-                         held_warning=base_fit.held_warning())
-    d = rank_candidates(model, ds, cands, folds=folds, alpha=alpha, min_gain=min_gain, quiet=quiet)
-    return Diagnosis(plant=ds.plant, baseline_effects=list(model.effects), baseline_error=d.error,
-                     ranking=[Candidate.from_row(r) for r in d.ranking], folds=folds,
-                     held=d.ident.held, held_warning=d.ident.held_warning())
+                         ranking=first.ranking, folds=folds, greedy=steps, held=first.fit.held,
+                         held_warning=first.fit.held_warning(), alpha=alpha, min_gain=min_gain,
+                         model=model, fit=first.fit)
+    return rank_candidates(model, ds, cands, folds=folds, alpha=alpha, min_gain=min_gain, quiet=quiet)

@@ -56,13 +56,13 @@ def test_hidden_effect_is_ranked_first_and_recovered(kind, extra, effect, param,
     delay = value if effect == "time_delay" else 0.0
     ds, model, d = _diagnose(desc, _truth(kind, extra), noise=noise, delay=delay)
     top = d.ranking[0]
-    assert top["effect"] == effect, [(r["effect"], r["error_after"]) for r in d.ranking]
-    assert top["significant"], top
-    assert top["params"][param] == pytest.approx(value, rel=0.10)
-    assert top["error_after"] < top["error_before"]
+    assert top.effect == effect, [(r.effect, r.error_after) for r in d.ranking]
+    assert top.significant, top
+    assert top.params[param] == pytest.approx(value, rel=0.10)
+    assert top.error_after < top.error_before
     # once the hidden effect is in the model, nothing else is significant
     d2 = rank_candidates(model.with_effect(effect), ds, AXIS.candidates(desc))
-    assert not any(r["significant"] for r in d2.ranking), [(r["effect"], r["gain"]) for r in d2.ranking]
+    assert not any(r.significant for r in d2.ranking), [(r.effect, r.gain) for r in d2.ranking]
 
 
 @pytest.mark.parametrize("desc,truth", [(PRISMATIC, _truth("prismatic", {})),
@@ -72,15 +72,15 @@ def test_control_nothing_hidden_nothing_significant(desc, truth, noise_rel):
     effort_scale = 7.0 if desc is PRISMATIC else 3.0
     ds, model, d = _diagnose(desc, truth, noise=noise_rel * effort_scale, seed=3)
     assert len(d.ranking) == len(set(AXIS.candidates(desc)) - set(model.effects))
-    assert not any(r["significant"] for r in d.ranking), [(r["effect"], r["p_value"], r["gain"])
+    assert not any(r.significant for r in d.ranking), [(r.effect, r.p_value, r.gain)
                                                           for r in d.ranking]
     # and the nominal model is already at the noise floor
-    assert d.error < 2.5 * noise_rel
+    assert d.baseline_error < 2.5 * noise_rel
 
 
 def test_effect_below_noise_is_not_marked_significant():
     ds, model, d = _diagnose(PRISMATIC, _truth("prismatic", dict(coulomb=0.01)), noise=0.5, seed=5)
-    assert not any(r["significant"] for r in d.ranking)
+    assert not any(r.significant for r in d.ranking)
 
 
 @pytest.mark.parametrize("kind,extra,order,noise", [
@@ -94,10 +94,10 @@ def test_two_hidden_effects_greedy_adds_both_larger_first(kind, extra, order, no
                         noise_effort=noise, noise_position=1e-6, seed=7)
     ds = dataset_from_arrays(run.t, run.q, run.effort, desc)
     steps = greedy(Model("axis", AXIS.baseline(desc)), ds, AXIS.candidates(desc))
-    assert [s["added"] for s in steps] == [None, *order]
-    errs = [s["error"] for s in steps]
+    assert [s.added for s in steps] == [None, *order]
+    errs = [s.error for s in steps]
     assert errs[0] > errs[1] > errs[2]
-    p = steps[-1]["params"]
+    p = steps[-1].params
     assert p["Fc"] == pytest.approx(truth.coulomb, rel=0.10)
     assert p["OF"] == pytest.approx(truth.offset, rel=0.10)
     assert p["M"] == pytest.approx(truth.inertia, rel=0.03)
@@ -112,5 +112,5 @@ def test_pendulum_gravity_moment_recovered_as_candidate_when_not_in_the_model():
     run = simulate_axis(sim_desc, _truth("pendulum", {}), amplitude=0.8, noise_effort=0.02, seed=2)
     ds = dataset_from_arrays(run.t, run.q, run.effort, desc)
     d = rank_candidates(Model("axis", AXIS.baseline(desc)), ds, AXIS.candidates(desc))
-    assert d.ranking[0]["effect"] == "axis_gravity" and d.ranking[0]["significant"]
-    assert d.ranking[0]["params"]["mc"] == pytest.approx(0.4, rel=0.05)
+    assert d.ranking[0].effect == "axis_gravity" and d.ranking[0].significant
+    assert d.ranking[0].params["mc"] == pytest.approx(0.4, rel=0.05)

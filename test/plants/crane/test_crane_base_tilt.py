@@ -9,7 +9,7 @@ import pytest
 from scipy.optimize import root
 
 from cablelab.description import load_description
-from cablelab.model import Dataset
+from cablelab.dataset import Dataset
 from cablelab.plants.crane import kinematics as kin
 from cablelab.plants.crane import plant as C
 from cablelab.plants.crane.effects import BASE_TILT, tilt_masses

@@ -51,12 +51,12 @@ def test_slew_torque_at_rest_shows_the_tilt_offset():
 def test_diagnose_ranks_base_tilt_first(tilted):
     d = rank_candidates(Model("crane", C.baseline(DESC), KNOWN_LC), tilted, C.candidates(DESC))
     best = d.ranking[0]
-    assert best["effect"] == "base_tilt" and best["significant"]
-    assert best["error_after"] < 0.1 * best["error_before"]
+    assert best.effect == "base_tilt" and best.significant
+    assert best.error_after < 0.1 * best.error_before
     # its parameters are the tilt angles: tilt_x = -g_y / g, tilt_y = g_x / g = 0 (002 sec. 6.5)
     g = gravity_in_base(CraneTruth(params=P, base_tilt=(TILT_X, 0.0)))
-    assert best["params"]["tilt_x"] == pytest.approx(-g[1] / P.gravity, rel=0.02)
-    assert abs(best["params"]["tilt_y"]) < 0.02 * abs(TILT_X)
+    assert best.params["tilt_x"] == pytest.approx(-g[1] / P.gravity, rel=0.02)
+    assert abs(best.params["tilt_y"]) < 0.02 * abs(TILT_X)
 
 
 def test_base_tilt_makes_identified_parameters_physical_again(tilted):
@@ -78,7 +78,7 @@ def test_missing_counterbalance_is_ranked_first():
     assert desc.crane.counterbalance is None
     ds = _dataset(CraneTruth(params=P), desc, seed=1)
     d = rank_candidates(Model("crane", C.baseline(desc), {}), ds, C.candidates(desc))
-    assert d.ranking[0]["effect"] == "counterbalance" and d.ranking[0]["significant"]
+    assert d.ranking[0].effect == "counterbalance" and d.ranking[0].significant
     # with the boom mass measured (002 fixed measurable parameters) m_c and l_c are identified
     ident = identify(Model("crane", C.baseline(desc) + ("counterbalance",), {"m_b": P.boom_mass}), ds)
     assert ident.params["m_c"] == pytest.approx(P.counterbalance_mass, rel=0.05)
@@ -88,13 +88,13 @@ def test_missing_counterbalance_is_ranked_first():
 def test_control_bag_nothing_significant():
     ds = _dataset(CraneTruth(params=P), DESC, seed=2)
     d = rank_candidates(Model("crane", C.baseline(DESC), KNOWN_LC), ds, C.candidates(DESC))
-    assert not any(r["significant"] for r in d.ranking)
+    assert not any(r.significant for r in d.ranking)
 
 
 def test_002_group_fit_goes_negative_without_tilt_and_is_physical_with_it(tilted):
     """002 sec. 6.2: the least squares gave negative inertias; the tilt columns fix it."""
     from cablelab.plants.crane.effects import tilt_columns
-    from cablelab.model import Param
+    from cablelab.effects.base import Param
     from cablelab.plants.crane.identify import FIX_002, identify_groups, physical_check
     from cablelab.plants.crane.model import PARAM_GROUPS
 
@@ -119,6 +119,6 @@ def test_generic_joint_effects_in_the_truth_are_found(truth_kw, effect, names, v
     ds = _dataset(CraneTruth(params=P, **truth_kw), DESC, seed=3, duration=40.0)
     d = rank_candidates(Model("crane", C.baseline(DESC), KNOWN_LC), ds, C.candidates(DESC))
     best = d.ranking[0]
-    assert best["effect"] == effect and best["significant"]
+    assert best.effect == effect and best.significant
     for n, v in zip(names, values):
-        assert best["params"][n] == pytest.approx(v, rel=0.1, abs=0.01), n
+        assert best.params[n] == pytest.approx(v, rel=0.1, abs=0.01), n

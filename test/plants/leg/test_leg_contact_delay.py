@@ -90,17 +90,17 @@ def test_diagnose_ranks_contact_delay_first_with_tau_c(delayed):
     _, ds = delayed
     d = rank_candidates(_nominal(), ds, effects.CANDIDATES)
     top = d.ranking[0]
-    assert top["effect"] == "contact_delay" and top["significant"], [r["effect"] for r in d.ranking]
-    assert top["params"]["tau_c"] == pytest.approx(DELAY, abs=1e-3)
-    assert top["error_after"] < 0.5 * top["error_before"]
+    assert top.effect == "contact_delay" and top.significant, [r.effect for r in d.ranking]
+    assert top.params["tau_c"] == pytest.approx(DELAY, abs=1e-3)
+    assert top.error_after < 0.5 * top.error_before
 
 
 def test_control_without_delay_does_not_call_it_significant(punctual):
     _, ds = punctual
     d = rank_candidates(_nominal(), ds, effects.CANDIDATES)
-    row = next(r for r in d.ranking if r["effect"] == "contact_delay")
-    assert not row["significant"]
-    assert row["params"]["tau_c"] < 1e-3
+    row = next(r for r in d.ranking if r.effect == "contact_delay")
+    assert not row.significant
+    assert row.params["tau_c"] < 1e-3
     assert d.best_significant() is None
 
 

@@ -82,8 +82,8 @@ def test_b7_diagnose_on_the_same_records_ranks_impact_first(records):
     ds = dataset_from_records([(r.t, r.z, r.contact, r.tau) for r in records], desc)
     d = rank_candidates(Model("leg", effects.BASELINE), ds, effects.CANDIDATES)
     top = d.ranking[0]
-    assert top["effect"] == "impact_restitution" and top["significant"], [r["effect"] for r in d.ranking]
-    assert d.error > 0.10 and top["error_after"] < 0.05          # held-out NRMSE of the force
+    assert top.effect == "impact_restitution" and top.significant, [r.effect for r in d.ranking]
+    assert d.baseline_error > 0.10 and top.error_after < 0.05          # held-out NRMSE of the force
     p = identify_linear(Model("leg", effects.BASELINE + ("impact_restitution",)), ds).params
     assert 1 - p["c_td"] / p["m"] == pytest.approx(TRUE.beta_td, rel=0.05)
     assert 1 - p["c_lo"] / p["m"] == pytest.approx(TRUE.beta_lo, rel=0.05)

@@ -19,7 +19,7 @@ from cablelab.description import load_description
 from cablelab.plants.leg.hybrid import LegParams, flight_closed_form, static_deflection
 from cablelab.plants.leg.reference import run_reference, sampled_trajectory
 from cablelab.plants.leg.sim import simulate, write_bag
-from cablelab.workbench import build_model, diagnose, identify, load
+from cablelab.workbench import build_model, diagnose, identify_report, load
 
 M_F, M_S = 1.50, 1.72          # weighed mass, stance inertia (kg): dm_f = m_f - m_s = -0.22 kg
 HIDDEN = LegParams(m=M_S, m_f=M_F)
@@ -111,10 +111,10 @@ def test_mass_free_the_phase_mass_is_a_spring_preload(hidden):
     ``m_s (zdd + g) - F_0`` with F_0 = (m_s - m_f) g, and flight fits any m (its equation is
     homogeneous in the mass): the preload model fits the phase-mass data as well, with m = m_s."""
     plant, desc, ds = hidden
-    pre = identify(ds, build_model(plant, desc, ("impact_restitution", "spring_preload")), folds=0)
-    ph = identify(ds, build_model(plant, desc, ("impact_restitution", "phase_effective_mass"),
+    pre = identify_report(ds, build_model(plant, desc, ("impact_restitution", "spring_preload")), folds=0)
+    ph = identify_report(ds, build_model(plant, desc, ("impact_restitution", "phase_effective_mass"),
                                   fixed={"m": M_F}), folds=0)
-    assert pre["params"]["F0"]["value"] == pytest.approx((M_S - M_F) * 9.81, rel=0.05)
-    assert pre["params"]["m"]["value"] == pytest.approx(M_S, rel=0.01)
+    assert pre.params["F0"]["value"] == pytest.approx((M_S - M_F) * 9.81, rel=0.05)
+    assert pre.params["m"]["value"] == pytest.approx(M_S, rel=0.01)
     # the same fit up to the flight rows, whose residual (acceleration noise x mass) grows by m_s / m_f
-    assert ph["fit"]["nrmse"] <= pre["fit"]["nrmse"] <= ph["fit"]["nrmse"] * M_S / M_F
+    assert ph.quality.nrmse <= pre.quality.nrmse <= ph.quality.nrmse * M_S / M_F

@@ -10,7 +10,7 @@ from cablelab.plants.suspended.bag import description_yaml, write_run
 from cablelab.plants.suspended.mjcf import build_virtual
 from cablelab.plants.suspended.params import parameter_set
 from cablelab.plants.suspended.sim import initial_state, simulate
-from cablelab.workbench import build_model, identify, load
+from cablelab.workbench import build_model, identify_report, load
 
 OFFSET = np.array([0.02, -0.01, 0.0])          # m, added to every measured platform position
 
@@ -22,10 +22,10 @@ def test_pose_offset_in_metres(tmp_path):
     write_run(tmp_path / "off", dataclasses.replace(r, pos=r.pos + OFFSET), p.S,
               description_yaml("licas"), pos_noise=1e-3, seed=7)
     plant, desc, ds = load(tmp_path / "off")
-    out = identify(ds, build_model(plant, desc, ["pose_sensor_offset"]), folds=0)
-    assert out["params"]["d_rx"]["unit"] == "m"
-    assert out["params"]["d_rx"]["value"] == pytest.approx(OFFSET[0], rel=0.1)
-    assert out["params"]["d_ry"]["value"] == pytest.approx(OFFSET[1], rel=0.1)
-    assert 0 < out["params"]["d_rx"]["stderr"] < 0.1 * abs(OFFSET[0])
-    assert {"off_x", "off_y", "off_yaw"} <= set(out["internal"])
-    assert "d_yaw" not in out["params"]          # no yaw stiffness in the model: no angle to give
+    out = identify_report(ds, build_model(plant, desc, ["pose_sensor_offset"]), folds=0)
+    assert out.params["d_rx"]["unit"] == "m"
+    assert out.params["d_rx"]["value"] == pytest.approx(OFFSET[0], rel=0.1)
+    assert out.params["d_ry"]["value"] == pytest.approx(OFFSET[1], rel=0.1)
+    assert 0 < out.params["d_rx"]["stderr"] < 0.1 * abs(OFFSET[0])
+    assert {"off_x", "off_y", "off_yaw"} <= set(out.internal)
+    assert "d_yaw" not in out.params          # no yaw stiffness in the model: no angle to give

@@ -198,17 +198,13 @@ def write_overlay_bag(args, plant, ds, stages, path) -> None:
     args.warnings = list(getattr(args, "warnings", []) or []) + warnings
 
 
-def greedy_stages(ds, model, steps) -> list:
-    """The overlay stages of a greedy waterfall (steps as dicts or :class:`Step`): each step's
-    model fitted on the whole record, ``nominal`` then ``plus_<effect>``."""
-    from ..model import Model
-    from ..overlay import fit_stage, stage_name
+def greedy_stages(ds, steps) -> list:
+    """The overlay stages of a greedy waterfall (:class:`~cablelab.diagnose.result.Step` s):
+    each step's model as the diagnosis fitted it on the whole record, ``nominal`` then
+    ``plus_<effect>``."""
+    from ..overlay import stage_from_fit, stage_name
 
-    def get(s, k):
-        return s[k] if isinstance(s, dict) else getattr(s, k)
-
-    return [fit_stage(stage_name(get(s, "added")), ds, Model(ds.plant, tuple(get(s, "effects")), model.fixed))
-            for s in steps]
+    return [stage_from_fit(stage_name(s.added), ds, s.fit) for s in steps]
 
 
 def load_from_args(args, *, check_out: bool = False):

@@ -17,29 +17,29 @@ def add_arguments(p) -> None:
 
 def run(args) -> int:
     from ..overlay import stage_from_fit
-    from ..workbench import compare_fit
+    from ..workbench import compare
 
     plant, _, ds, model = load_from_args(args, check_out=True)
-    res, ident = compare_fit(ds, model, segments=args.segments)
-    flag_impossible(args, model.effects, res["params"])
-    write_overlay_out(args, plant, ds, [stage_from_fit(None, ds, ident)])
-    out = with_warnings(args, res)
+    res = compare(ds, model, segments=args.segments)
+    flag_impossible(args, model.effects, res.params)
+    write_overlay_out(args, plant, ds, [stage_from_fit(None, ds, res.fit)])
+    out = with_warnings(args, res.to_json())
     if args.json:
         print(dump_json(out))
         return 0
-    print(f"plant {out['plant']}, model {' + '.join(out['effects'])}, {out['samples']} samples")
-    for ch, m in out["channels"].items():
+    print(f"plant {res.plant}, model {' + '.join(res.effects)}, {res.samples} samples")
+    for ch, m in res.channels.items():
         pearson = "n/a" if m["pearson"] is None else f"{m['pearson']:.4f}"   # constant model output
         print(f"  {ch}: NRMSE {100 * m['nrmse']:.2f} %  fit {m['fit_percent']:.1f} %  pearson "
               f"{pearson}  MAE {m['mae']:.4g}  max {m['max_abs']:.4g}")
-    for name, v in out["params"].items():
+    for name, v in res.params.items():
         print(param_line(name, v))
-    if "free_run" in out:
-        fr = out["free_run"]
+    if res.free_run is not None:
+        fr = res.free_run
         print(f"  free run ({fr['horizon_s']} s windows): {fr['channel']} NRMSE {100 * fr['nrmse']:.2f} %, "
               f"max {fr['max_abs']:.4g}")
     print("worst segments:")
-    for s in out["worst_segments"]:
+    for s in res.worst_segments:
         print(f"  {s['channel']}: {s['t_start']:.3f}-{s['t_end']:.3f} s  NRMSE {100 * s['error']:.1f} %")
     if args.out:
         print(f"model overlay (measured, prediction, residual) written to {args.out}")

@@ -38,13 +38,13 @@ def run(args) -> int:
     out = diagnose(ds, model, cands, folds=args.folds, alpha=args.alpha, min_gain=args.min_gain,
                    greedy_mode=args.greedy, quiet=args.json)
     for c in out.ranking:
-        flag_impossible(args, (c.effect,), c.params, c.extra.get("units"),
+        flag_impossible(args, (c.effect,), c.params, c.units,
                         where=f"candidate {c.effect}")
     for step in out.greedy:
         flag_impossible(args, step.effects, step.params, step.units,
                         where=f"model {' + '.join(step.effects) or 'nominal'}")
     if args.out:
-        write_overlay_out(args, plant, ds, greedy_stages(ds, model, out.greedy))
+        write_overlay_out(args, plant, ds, greedy_stages(ds, out.greedy))
     from ..diagnose.result import excite_commands
 
     doc = with_warnings(args, out.to_json())

@@ -16,29 +16,29 @@ def add_arguments(p) -> None:
 
 
 def run(args) -> int:
-    from ..workbench import identify
+    from ..workbench import identify_report
 
     _, _, ds, model = load_from_args(args)
-    out = identify(ds, model, folds=args.folds, simulation=args.simulation, quiet=args.json)
-    flag_impossible(args, model.effects, out["params"])
-    if "simulation" in out:
-        units = {k: v.get("unit", "") for k, v in out["params"].items()}
-        flag_impossible(args, model.effects, {k: v["value"] for k, v in out["simulation"]["params"].items()},
+    res = identify_report(ds, model, folds=args.folds, simulation=args.simulation, quiet=args.json)
+    flag_impossible(args, model.effects, res.params)
+    if res.simulation is not None:
+        units = {k: v.get("unit", "") for k, v in res.params.items()}
+        flag_impossible(args, model.effects, {k: v["value"] for k, v in res.simulation["params"].items()},
                         units, where="simulation-based fit")
-    with_warnings(args, out)
+    out = with_warnings(args, res.to_json())
     if args.json:
         print(dump_json(out))
         return 0
-    f = out["fit"]
-    held = f"held-out {100 * f['cv_nrmse']:.2f} %, {f['folds']} folds" if f["cv_nrmse"] is not None \
+    f = res.quality
+    held = f"held-out {100 * f.cv_nrmse:.2f} %, {f.folds} folds" if f.cv_nrmse is not None \
         else "no cross-validation"
-    print(f"plant {out['plant']}, model {' + '.join(out['effects'])}: NRMSE {100 * f['nrmse']:.2f} % "
-          f"({held}), rank {f['rank']}, condition {f['condition']:.3g}")
-    for name, v in out["params"].items():
+    print(f"plant {res.plant}, model {' + '.join(res.effects)}: NRMSE {100 * f.nrmse:.2f} % "
+          f"({held}), rank {f.rank}, condition {f.condition:.3g}")
+    for name, v in res.params.items():
         print(param_line(name, v, " (held: not excited)" if v.get("held") else
                          " (fixed)" if v["fixed"] else ""))
-    if "simulation" in out:
-        sim = out["simulation"]
+    if res.simulation is not None:
+        sim = res.simulation
         print(f"simulation-based fit ({sim['objective']}): NMSE {sim['nmse']:.4g}, Pearson "
               f"{sim['pearson']:.5f}, {sim['iterations']} iterations")
         for name, v in sim["params"].items():

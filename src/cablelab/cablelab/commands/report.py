@@ -6,6 +6,7 @@ The directory is written under a temporary name and moved into place when comple
 from __future__ import annotations
 
 import os
+import time
 
 from ._workbench_args import (add_common, add_folds, add_overwrite, dump_json, greedy_stages, load_from_args,
                               with_warnings, write_overlay_bag)
@@ -30,26 +31,27 @@ def _moved(path, tmp, final):
 def run(args) -> int:
     from ..atomic import atomic_output, check_target
     from ..report import build_report
+    from ..workbench import diagnose
 
     inputs = [args.bag, args.description]
     check_target(args.out, overwrite=args.overwrite, inputs=inputs, option="-o")  # before the work
+    t0 = time.monotonic()
     plant, desc, ds, model = load_from_args(args)
+    d = diagnose(ds, model, plant.candidates(desc), folds=args.folds, greedy_mode=True, quiet=args.json)
     with atomic_output(args.out, overwrite=args.overwrite, inputs=inputs, option="-o", verb="report") as tmp:
-        res = build_report(ds, model, plant.candidates(desc), str(tmp), folds=args.folds,
-                           title=f"cablelab report: {desc.name or plant.name}", quiet=args.json,
-                           warnings=getattr(args, "warnings", ()), overlay="overlay")
-        write_overlay_bag(args, plant, ds, greedy_stages(ds, model, res["steps"]),
-                          os.path.join(str(tmp), "overlay"))
-    res["index"] = _moved(res["index"], tmp, args.out)
-    res["figures"] = [_moved(f, tmp, args.out) for f in res["figures"]]
-    out = with_warnings(args, {"index": res["index"], "figures": res["figures"], "seconds": res["seconds"],
-                               "final": res["steps"][-1]["effects"], "error": res["steps"][-1]["error"]})
+        page = build_report(ds, d, str(tmp), title=f"cablelab report: {desc.name or plant.name}",
+                            warnings=getattr(args, "warnings", ()), overlay="overlay")
+        write_overlay_bag(args, plant, ds, greedy_stages(ds, d.greedy), os.path.join(str(tmp), "overlay"))
+    seconds = time.monotonic() - t0
+    index = _moved(page.index, tmp, args.out)
+    figures = [_moved(f, tmp, args.out) for f in page.figures]
+    out = with_warnings(args, {"index": index, "figures": figures, "seconds": seconds,
+                               "final": d.final.effects, "error": d.final.error})
     if args.json:
         print(dump_json(out))
     else:
-        steps = res["steps"]
-        added = [s["added"] for s in steps[1:]]
+        added = [s.added for s in d.greedy[1:]]
         print(f"missing: {', '.join(added) if added else 'no significant effect'} (held-out NRMSE "
-              f"{100 * steps[0]['error']:.2f} % -> {100 * steps[-1]['error']:.2f} %)")
-        print(f"wrote {res['index']} ({len(res['figures'])} figures, {res['seconds']:.1f} s)")
+              f"{100 * d.baseline_error:.2f} % -> {100 * d.final.error:.2f} %)")
+        print(f"wrote {index} ({len(figures)} figures, {seconds:.1f} s)")
     return 0

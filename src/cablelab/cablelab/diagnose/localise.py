@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..model import Dataset
+from ..dataset import Dataset
 
 #: at rest: |v| below this fraction of the 99th-percentile speed of that actuator
 REST_FRACTION = 0.02

@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import sys
 import time
-from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.stats
@@ -33,9 +32,10 @@ from ..errors import CablelabError
 from ..fit import evaluate, identify
 from ..fit.identify import lag1_autocorrelation
 from ..fit.threads import blas_single
-from ..model import Dataset, Model
+from ..dataset import Dataset
+from ..model import Model
 from .localise import derived_regimes, residual_by_regime
-from .metrics import nrmse  # noqa: F401  (re-exported name used by older callers)
+from .result import Candidate, Diagnosis, Step
 from .score import channel_nrmse, heldout_error, lr_significance, practical_gain
 
 #: default number of folds, significance level, guard band (fraction of samples per side)
@@ -174,24 +174,6 @@ def explain(effect_id: str, params: dict, stderr: dict, units: dict, before: flo
             "not significant beyond noise and its added parameters")
 
 
-@dataclass
-class Diagnosis:
-    """Result of :func:`rank_candidates`."""
-
-    plant: str
-    model: Model
-    error: float
-    ranking: list[dict]
-    ident: object = None
-    extra: dict = field(default_factory=dict)
-
-    def best_significant(self) -> dict | None:
-        for r in self.ranking:
-            if r["significant"]:
-                return r
-        return None
-
-
 class _Progress:
     """Periodic progress line with ETA on stderr (only for runs longer than a few seconds)."""
 
@@ -212,6 +194,53 @@ class _Progress:
               file=sys.stderr, flush=True)
 
 
+def _fitted_candidate(c: str, ds: Dataset, base_full, full, before: tuple, after: tuple,
+                      n_candidates: int, alpha: float, min_gain: float, own_held: list,
+                      regime_ref: tuple) -> tuple[Candidate, dict]:
+    """The ranking row of a candidate that could be fitted, and its own parameters by name.
+
+    Args:
+        base_full, full: the full-record fits without / with the candidate.
+        before, after: ``(held-out error, y_meas, y_hat)`` without / with it (:func:`cv_error`).
+        n_candidates: the Bonferroni count; own_held: its parameters held as not excited.
+        regime_ref: ``(residual by regime without it, y_ref, regimes)`` for its evidence.
+    """
+    err0, ym0, yh0 = before
+    err1, ym1, yh1 = after
+    by_regime0, y_ref, regimes = regime_ref
+    sig = lr_significance(base_full, full, n_candidates, alpha)
+    gain, changed = practical_gain(ym0, yh0, ym1, yh1)
+    significant = bool(sig["passes"] and gain >= min_gain and err1 < err0)
+    own = full.effect_params(c, ds)
+    # reported in the user's terms (the paper's / spec's parameters, errors propagated);
+    # the regression's own coefficients stay under "internal"
+    phys = full.physical(c, ds)
+    inner = full.internal(c, ds)
+    from .identifiability import confounding, describe
+
+    confound = confounding(full, list(own))
+    significant = significant and bool(confound["identifiable"])
+    row = Candidate(c, err0, err1, params={k: v["value"] for k, v in phys.items()},
+                    significant=significant,
+                    stderr={k: v["stderr"] for k, v in phys.items()},
+                    units={k: v["unit"] for k, v in phys.items()},
+                    p_value=sig["p_value"], delta_bic=sig["delta_bic"], n_eff=sig["n_eff"],
+                    gain=gain, channels=dict(zip(ds.channels, map(float, channel_nrmse(ym1, yh1)))),
+                    evidence=_evidence(by_regime0, residual_by_regime(full.residual, y_ref,
+                                                                      regimes, ds.channels)),
+                    identifiability=confound, held=own_held or None,
+                    internal={k: v["value"] for k, v in inner.items()} or None)
+    row.explanation = explain(c, row.params, row.stderr, row.units, err0, err1, significant,
+                              (int(changed.sum()), len(changed)), gain)
+    if significant and row.evidence:
+        where = row.evidence
+        row.explanation += (f"; largest drop where {where['regime']} is {where['label']} "
+                            f"({100 * where['before']:.0f} % -> {100 * where['after']:.0f} % of "
+                            f"the {where['channel']} RMS)")
+    row.explanation += describe(confound)
+    return row, own
+
+
 @blas_single
 def rank_candidates(model: Model, ds: Dataset, candidates, *, folds: int = FOLDS,
                     alpha: float = ALPHA, min_gain: float = MIN_GAIN, quiet: bool = True) -> Diagnosis:
@@ -223,9 +252,8 @@ def rank_candidates(model: Model, ds: Dataset, candidates, *, folds: int = FOLDS
         folds: k of the blocked k-fold; alpha: family-wise significance level; min_gain: minimum
             relative held-out error reduction.
     Returns:
-        :class:`Diagnosis` with ``ranking`` sorted by held-out error after (best first), each
-        ``{"effect", "error_before", "error_after", "params", "stderr", "units",
-        "significant", "p_value", "delta_bic", "n_eff", "explanation"}``.
+        :class:`~cablelab.diagnose.result.Diagnosis` with ``ranking`` (:class:`Candidate` s)
+        sorted by held-out error after (best first), ``fit`` the model's own fit.
     """
     cands = [c for c in dict.fromkeys(candidates) if c not in model.effects]
     for c in cands:
@@ -242,7 +270,8 @@ def rank_candidates(model: Model, ds: Dataset, candidates, *, folds: int = FOLDS
     # on its valid rows, and each candidate's held-out prediction and projected columns
     from .ambiguity import find_ambiguous, project_out
 
-    ds_base = model.apply_nonlinear(ds, base_full.params)
+    ev_base = model.evaluate(ds, base_full.params)
+    ds_base = ev_base.ds
     w_ch = base_full.linear.channel_scale if base_full.linear.channel_scale is not None \
         else np.ones(ds.n_channels)
     use = base_full.valid & np.isfinite(ds_base.y).all(axis=1)
@@ -250,7 +279,7 @@ def rank_candidates(model: Model, ds: Dataset, candidates, *, folds: int = FOLDS
     def weighted(phi):
         return (phi[use] * w_ch[None, :, None]).reshape(int(use.sum()) * phi.shape[1], phi.shape[2])
 
-    phi0 = weighted(model.regressor(ds_base)[0])
+    phi0 = weighted(ev_base.phi)
     compared = {}
     rows = []
     for c in cands:
@@ -259,80 +288,54 @@ def rank_candidates(model: Model, ds: Dataset, candidates, *, folds: int = FOLDS
             full = identify(m2, ds)
             err1, ym1, yh1 = cv_error(m2, ds, folds, start=full.params)
         except CablelabError as exc:  # e.g. the effect is not excited: rank-deficient
-            rows.append({"effect": c, "error_before": err0, "error_after": None, "params": {},
-                         "significant": False, "explanation": f"{c}: cannot be fitted ({exc})"})
+            rows.append(Candidate(c, err0, None, explanation=f"{c}: cannot be fitted ({exc})"))
             prog.step(c)
             continue
         own_held = [k for k in full.held if k not in base_full.held]
         if own_held and set(own_held) >= {p.name for p in get_effect(c).columns(ds)}:
-            rows.append({"effect": c, "error_before": err0, "error_after": err1, "params": {},
-                         "significant": False, "held": own_held,
-                         "explanation": f"{c}: not excited by this recording ({', '.join(own_held)} "
-                                        "cannot be determined from it)"})
+            rows.append(Candidate(c, err0, err1, held=own_held,
+                                  explanation=f"{c}: not excited by this recording "
+                                              f"({', '.join(own_held)} cannot be determined from it)"))
             prog.step(c)
             continue
-        sig = lr_significance(base_full, full, len(cands), alpha)
-        gain, changed = practical_gain(ym0, yh0, ym1, yh1)
-        significant = bool(sig["passes"] and gain >= min_gain and err1 < err0)
-        own = full.effect_params(c, ds)
-        # reported in the user's terms (the paper's / spec's parameters, errors propagated);
-        # the regression's own coefficients stay under "internal"
-        phys = full.physical(c, ds)
-        inner = full.internal(c, ds)
-        row = {"effect": c, "error_before": err0, "error_after": err1,
-               "params": {k: v["value"] for k, v in phys.items()},
-               "stderr": {k: v["stderr"] for k, v in phys.items()},
-               "units": {k: v["unit"] for k, v in phys.items()},
-               **({"internal": {k: v["value"] for k, v in inner.items()}} if inner else {}),
-               "significant": significant, "p_value": sig["p_value"], "delta_bic": sig["delta_bic"],
-               "n_eff": sig["n_eff"], "gain": gain, **({"held": own_held} if own_held else {}),
-               "channels": dict(zip(ds.channels, map(float, channel_nrmse(ym1, yh1))))}
-        from .identifiability import confounding, describe
-
-        row["identifiability"] = confounding(full, list(own))
-        if not row["identifiability"]["identifiable"]:
-            significant = row["significant"] = False
-        row["evidence"] = _evidence(by_regime0, residual_by_regime(full.residual, y_ref, regimes,
-                                                                  ds.channels))
-        row["explanation"] = explain(c, row["params"], row["stderr"], row["units"], err0, err1, significant,
-                                     (int(changed.sum()), len(changed)), gain)
-        if significant and row["evidence"]:
-            ev = row["evidence"]
-            row["explanation"] += (f"; largest drop where {ev['regime']} is {ev['label']} "
-                                   f"({100 * ev['before']:.0f} % -> {100 * ev['after']:.0f} % of the "
-                                   f"{ev['channel']} RMS)")
-        row["explanation"] += describe(row["identifiability"])
+        row, own = _fitted_candidate(c, ds, base_full, full, (err0, ym0, yh0), (err1, ym1, yh1),
+                                     len(cands), alpha, min_gain, own_held,
+                                     (by_regime0, y_ref, regimes))
         rows.append(row)
-        phi_c, cols_c, _ = m2.regressor(m2.apply_nonlinear(ds, base_full.params))
+        ev_c = m2.evaluate(ds, base_full.params)
+        phi_c, cols_c = ev_c.phi, ev_c.columns
         own_idx = [i for i, p in enumerate(cols_c) if p.name in own]
         compared[c] = {"error": err1, "y": ym1, "y_hat": yh1, "y_hat0": yh0,
                        "columns": project_out(phi0, weighted(phi_c[:, :, own_idx]))}
         prog.step(c)
-    rows.sort(key=lambda r: (r["error_after"] is None, r["error_after"] if r["error_after"] is not None else 0))
-    helps = [r["effect"] for r in rows if r["error_after"] is not None
-             and (r["significant"] or r.get("gain", 0.0) >= min_gain)]
+    rows.sort(key=lambda r: (r.error_after is None, r.error_after if r.error_after is not None else 0))
+    helps = [r.effect for r in rows if r.error_after is not None
+             and (r.significant or (r.gain or 0.0) >= min_gain)]
     rms = np.sqrt(np.nanmean(np.where(use[:, None], ds_base.y, np.nan) ** 2, axis=0))
     pairs = find_ambiguous(err0, compared, helps, 1.0 / np.where(rms > 0, rms, 1.0))
     from .ambiguity import describe as describe_ambiguity
 
     for r in rows:
-        others = pairs.get(r["effect"])
+        others = pairs.get(r.effect)
         if others:
-            r["ambiguous_with"] = [o["effect"] for o in rows if o["effect"] in others]
-            r["ambiguity"] = {o: others[o] for o in r["ambiguous_with"]}
-            r["explanation"] += describe_ambiguity(r["effect"], r["ambiguous_with"])
-    return Diagnosis(model.plant, model, err0, rows, base_full)
+            r.ambiguous_with = [o.effect for o in rows if o.effect in others]
+            r.ambiguity = {o: others[o] for o in r.ambiguous_with}
+            r.explanation += describe_ambiguity(r.effect, r.ambiguous_with)
+    return Diagnosis(plant=model.plant, baseline_effects=list(model.effects), baseline_error=err0,
+                     ranking=rows, folds=folds, held=base_full.held,
+                     held_warning=base_full.held_warning(), alpha=alpha, min_gain=min_gain,
+                     model=model, fit=base_full)
 
 
 @blas_single
 def greedy(model: Model, ds: Dataset, candidates, *, folds: int = FOLDS, alpha: float = ALPHA,
-           min_gain: float = MIN_GAIN, max_steps: int = 10, quiet: bool = True) -> list[dict]:
+           min_gain: float = MIN_GAIN, max_steps: int = 10, quiet: bool = True) -> list[Step]:
     """Add the best significant candidate until none is significant (the waterfall).
 
     Returns:
-        steps ``[{"effects", "added", "error", "params", "stderr", "units", "ranking"}]``: step 0 is
-        the model as given, each further step adds one effect; the last step's ranking shows that
-        no remaining candidate is significant.
+        :class:`~cablelab.diagnose.result.Step` list: step 0 is the model as given, each further
+        step adds one effect; the last step's ranking shows that no remaining candidate is
+        significant.
     """
     steps = []
     current = model
@@ -340,16 +343,15 @@ def greedy(model: Model, ds: Dataset, candidates, *, folds: int = FOLDS, alpha: 
     for _ in range(max_steps + 1):
         d = rank_candidates(current, ds, candidates, folds=folds, alpha=alpha, min_gain=min_gain,
                             quiet=quiet)
-        ident = d.ident
-        steps.append({"effects": list(current.effects), "added": added, "error": d.error,
-                      "params": dict(ident.params), "stderr": dict(ident.stderr),
-                      "units": dict(ident.units), "ranking": d.ranking,
-                      **({"note": note} if note else {})})
+        fit = d.fit
+        steps.append(Step(effects=list(current.effects), added=added, error=d.baseline_error,
+                          params=dict(fit.params), stderr=dict(fit.stderr), units=dict(fit.units),
+                          ranking=d.ranking, note=note, fit=fit))
         best = d.best_significant()
         if best is None:
             break
-        added = best["effect"]
-        rivals = list(best.get("ambiguous_with", ()))
+        added = best.effect
+        rivals = list(best.ambiguous_with or ())
         note = (f"chose {added} over {', '.join(rivals)} (ambiguous: held-out errors equal within "
                 "noise, this recording cannot tell them apart)") if rivals else None
         current = current.with_effect(added)

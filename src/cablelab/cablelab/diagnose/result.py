@@ -3,12 +3,18 @@
 :class:`Diagnosis` holds the baseline, the ranked :class:`Candidate` list and, in greedy mode, the
 waterfall :class:`Step` list. ``to_json()`` is the contract JSON (``plant``, ``baseline``,
 ``ranking`` with ``effect``, ``error_before``, ``error_after``, ``params``, ``significant`` and the
-documented extras); ``lines()`` the text the command prints. Built once from the ranking rows of
+documented extras); ``lines()`` the text the command prints. Built by
 :mod:`cablelab.diagnose.ranking`; every consumer (command, report, fleet) reads this object.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from ..fit.identify import Identification
+    from ..model import Model
+
 
 #: keys of a ranking row that are part of the JSON, in order (contract keys first)
 ROW_KEYS = ("effect", "error_before", "error_after", "params", "significant", "stderr", "units",
@@ -16,40 +22,61 @@ ROW_KEYS = ("effect", "error_before", "error_after", "params", "significant", "s
             "ambiguous_with", "ambiguity", "held", "internal", "explanation")
 
 
-@dataclass(frozen=True)
+@dataclass
 class Candidate:
-    """One ranked candidate effect: held-out errors before/after, its own fitted parameters
-    (name -> value, with ``stderr`` and ``units``), significance and the one-line explanation;
-    ``extra`` holds any further documented fields the ranking reports (JSON order kept)."""
+    """One ranked candidate effect (:func:`cablelab.diagnose.ranking.rank_candidates`).
+
+    Attributes:
+        effect: effect id.
+        error_before, error_after: held-out error of the model without / with it (None after:
+            it could not be fitted).
+        params, stderr, units: its own fitted parameters in the user's terms, by name.
+        significant: passes the held-out gain, the F-test and the identifiability check.
+        explanation: one sentence (signature, values, gain, evidence, ambiguity).
+        p_value, delta_bic, n_eff: the nested F-test and BIC against the model
+            (:func:`~cablelab.diagnose.score.lr_significance`); gain: relative held-out drop on
+            the channels it changes; channels: held-out NRMSE per channel with it.
+        evidence: the regime where it lowers the residual most; identifiability: its
+            confounding report (:mod:`.identifiability`).
+        ambiguous_with, ambiguity: candidates the recording cannot tell it from (:mod:`.ambiguity`).
+        held: its parameters the recording does not excite; internal: the regression's own
+            coefficients its physical parameters replace.
+    Fields left None are not in the JSON (:meth:`to_json`).
+    """
 
     effect: str
     error_before: float | None
     error_after: float | None
-    params: dict
-    significant: bool
+    params: dict = field(default_factory=dict)
+    significant: bool = False
     explanation: str | None = None
-    extra: dict = field(default_factory=dict)
-
-    @classmethod
-    def from_row(cls, row: dict) -> "Candidate":
-        """From a ranking row (:func:`cablelab.diagnose.ranking.rank_candidates`)."""
-        return cls(effect=row["effect"], error_before=row.get("error_before"),
-                   error_after=row.get("error_after"), params=row.get("params") or {},
-                   significant=bool(row.get("significant")), explanation=row.get("explanation"),
-                   extra={k: row[k] for k in ROW_KEYS[5:-1] if k in row})
+    stderr: dict | None = None
+    units: dict | None = None
+    p_value: float | None = None
+    delta_bic: float | None = None
+    n_eff: float | None = None
+    gain: float | None = None
+    channels: dict | None = None
+    evidence: dict | None = None
+    identifiability: dict | None = None
+    ambiguous_with: list | None = None
+    ambiguity: dict | None = None
+    held: list | None = None
+    internal: dict | None = None
 
     def to_json(self) -> dict:
-        base = {"effect": self.effect, "error_before": self.error_before,
-                "error_after": self.error_after, "params": self.params,
-                "significant": self.significant, **self.extra, "explanation": self.explanation}
-        return {k: base[k] for k in ROW_KEYS if k in base and base[k] is not None
-                or k in ("error_after", "error_before")}
+        """The contract row: keys in :data:`ROW_KEYS` order, None fields left out (the held-out
+        errors always present)."""
+        return {k: getattr(self, k) for k in ROW_KEYS
+                if getattr(self, k) is not None or k in ("error_after", "error_before")}
 
 
 @dataclass(frozen=True)
 class Step:
     """One step of the greedy waterfall: the model's effects, the one added (None first), its
-    held-out error, identified parameters and the ranking of the remaining candidates."""
+    held-out error, identified parameters and the ranking of the remaining candidates;
+    ``fit`` is that model's :class:`~cablelab.fit.Identification` on the whole record (not in
+    the JSON: what the report and the overlay draw)."""
 
     effects: list
     added: str | None
@@ -59,6 +86,7 @@ class Step:
     units: dict
     ranking: list
     note: str | None = None
+    fit: Identification | None = field(default=None, repr=False, compare=False)
 
     def to_json(self) -> dict:
         out = {"effects": self.effects, "added": self.added, "error": self.error,
@@ -71,7 +99,12 @@ class Step:
 
 @dataclass(frozen=True)
 class Diagnosis:
-    """What ``cablelab diagnose`` found (see module docstring)."""
+    """What a diagnosis found (see module docstring): the model's held-out error, the ranked
+    :class:`Candidate` list and, in greedy mode, the waterfall :class:`Step` list.
+
+    ``alpha`` and ``min_gain`` are the significance criteria it used; ``model`` and ``fit`` (the
+    model and its :class:`~cablelab.fit.Identification` on the whole record) are what the report
+    draws. None of these four is in the JSON."""
 
     plant: str
     baseline_effects: list
@@ -81,11 +114,19 @@ class Diagnosis:
     greedy: list = field(default_factory=list)
     held: dict = field(default_factory=dict)
     held_warning: str | None = None
+    alpha: float | None = None
+    min_gain: float | None = None
+    model: Model | None = field(default=None, repr=False, compare=False)
+    fit: Identification | None = field(default=None, repr=False, compare=False)
 
     @property
     def final(self) -> Step | None:
         """The last waterfall step (greedy mode), else None."""
         return self.greedy[-1] if self.greedy else None
+
+    def best_significant(self) -> Candidate | None:
+        """The best-ranked significant candidate, or None."""
+        return next((c for c in self.ranking if c.significant), None)
 
     def to_json(self) -> dict:
         out = {"plant": self.plant,
@@ -119,17 +160,16 @@ class Diagnosis:
 
 
 def ambiguity_lines(ranking) -> list[str]:
-    """One line per group of ambiguous candidates (ranking rows or :class:`Candidate`): the data
-    cannot tell them apart, so none of them is the answer."""
+    """One line per group of ambiguous :class:`Candidate` s: the data cannot tell them apart, so
+    none of them is the answer."""
     out, seen = [], set()
     for c in ranking:
-        row = c.to_json() if isinstance(c, Candidate) else c
-        others = row.get("ambiguous_with") or []
-        group = tuple(sorted({row["effect"], *others}))
+        others = c.ambiguous_with or []
+        group = tuple(sorted({c.effect, *others}))
         if not others or group in seen:
             continue
         seen.add(group)
-        out.append(f"ambiguous: {' and '.join([row['effect'], *others])} explain the same residual "
+        out.append(f"ambiguous: {' and '.join([c.effect, *others])} explain the same residual "
                    "within noise; this recording cannot tell them apart, so the ranking names no "
                    "winner among them")
     return out
@@ -144,13 +184,12 @@ def excite_commands(ranking, plant: str, source: str, held=()) -> list[str]:
 
     groups: list[tuple[str, ...]] = []
     for c in ranking:
-        row = c.to_json() if isinstance(c, Candidate) else c
-        for r in (row.get("identifiability") or {}).get("confounded", []):
+        for r in (c.identifiability or {}).get("confounded", []):
             pair = tuple(sorted((r["param"], r["with"])))
             if pair not in groups:
                 groups.append(pair)
-        if row.get("held"):
-            g = tuple(row["held"])
+        if c.held:
+            g = tuple(c.held)
             if g not in groups:
                 groups.append(g)
     if held and tuple(held) not in groups:
@@ -174,10 +213,4 @@ def _slug(name: str) -> str:
     return "".join(ch if ch.isalnum() else "_" for ch in name).strip("_")
 
 
-def step_from_dict(s: dict) -> Step:
-    return Step(effects=list(s["effects"]), added=s["added"], error=s["error"], params=s["params"],
-                stderr=s["stderr"], units=s["units"],
-                ranking=[Candidate.from_row(r) for r in s["ranking"]], note=s.get("note"))
-
-
-__all__ = ["Candidate", "Diagnosis", "Step", "ambiguity_lines", "excite_commands", "step_from_dict"]
+__all__ = ["Candidate", "Diagnosis", "Step", "ambiguity_lines", "excite_commands"]

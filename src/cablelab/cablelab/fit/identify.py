@@ -17,7 +17,8 @@ import numpy as np
 import scipy.linalg
 
 from ..errors import CablelabError
-from ..model import Dataset, Model, Param
+from ..dataset import Dataset
+from ..model import Evaluation, Model
 from .linear import LinearFit, RankDeficient, solve_linear, unexcited_columns
 
 #: grid points per nonlinear parameter for the start of the outer search
@@ -165,18 +166,10 @@ def propagate(fn, params: Mapping[str, float], names=(), cov=None, *, stderr=Non
     return value, float(np.sqrt(max(var, 0.0)))
 
 
-def _linear_system(model: Model, ds: Dataset):
-    phi, cols, y_known = model.regressor(ds)
-    return phi, cols, ds.y - y_known, ds.valid
-
-
-def _inner(model: Model, ds: Dataset, nl: Mapping[str, float], valid: np.ndarray,
-           on_deficient: str, channel_scale="rms") -> tuple[LinearFit, np.ndarray, np.ndarray, list[Param], Dataset]:
-    ds2 = model.apply_nonlinear(ds, nl)
-    phi, cols, lhs, _ = _linear_system(model, ds2)
-    fit = solve_linear(phi, lhs, cols, valid=valid, on_deficient=on_deficient,
-                       channel_scale=channel_scale)
-    return fit, phi, lhs, cols, ds2
+def _solve(ev: Evaluation, valid: np.ndarray, on_deficient: str, channel_scale="rms") -> LinearFit:
+    """The inner linear least squares on an evaluated model."""
+    return solve_linear(ev.phi, ev.lhs, ev.columns, valid=valid, on_deficient=on_deficient,
+                        channel_scale=channel_scale)
 
 
 def _weighted_residual(fit: LinearFit, phi, lhs, valid) -> np.ndarray:
@@ -218,7 +211,7 @@ def identify(model: Model, ds: Dataset, *, on_deficient: str | None = None,
 def held_value(model: Model, ds: Dataset, name: str) -> float:
     """The value a parameter the data do not excite is held at: the description's
     (``Effect.described``), else the parameter's nominal (the effect's neutral value)."""
-    for e in model.effect_units():
+    for e in model.effect_objects:
         for p in e.columns(ds):
             if p.name == name:
                 if e.described is not None:
@@ -233,10 +226,9 @@ def hold_unexcited(model: Model, ds: Dataset, nl: Mapping[str, float] | None = N
     """``{name: value}`` of the free linear parameters to hold so the rest of the model has a
     full-rank regressor on ``ds`` (:func:`~cablelab.fit.linear.unexcited_columns`, evaluated
     with the nonlinear parameters at ``nl`` or nominal), each at :func:`held_value`."""
-    ds2 = model.apply_nonlinear(ds, dict(nl or {}))
-    phi, cols, y_known = model.regressor(ds2)
-    idx = unexcited_columns(phi, ds2.y - y_known, cols, valid=ds2.valid)
-    return {cols[i].name: held_value(model, ds, cols[i].name) for i in idx}
+    ev = model.evaluate(ds, dict(nl or {}))
+    idx = unexcited_columns(ev.phi, ev.lhs, ev.columns, valid=ev.ds.valid)
+    return {ev.columns[i].name: held_value(model, ds, ev.columns[i].name) for i in idx}
 
 
 def _identify_holding(model: Model, ds: Dataset, **kw) -> Identification:
@@ -270,6 +262,63 @@ def held_warning(held: Mapping[str, float], units: Mapping[str, str] | None = No
             f"neutral values: {vals}; record motion that excites them, or --strict to refuse")
 
 
+def _outer_search(model: Model, ds: Dataset, nl_params: list, valid: np.ndarray, channel_scale,
+                  outer_grid: int, start: Mapping[str, float] | None):
+    """The outer problem of the separable least squares: the nonlinear parameter values that
+    minimise the inner linear LS residual (from ``start``, the nominal values or the best grid
+    point, refined by :func:`mujoco.minimize.least_squares` inside the box), the model evaluated
+    there with its inner fit (rank deficiency raises), and the Jacobian of the weighted residual
+    w.r.t. the nonlinear parameters at that fit's theta (for the joint covariance).
+
+    Returns:
+        ``(nl_values, evaluation, fit, jac_nl)``.
+    """
+    names = [p.name for p in nl_params]
+    lo = np.array([p.lower for p in nl_params])
+    hi = np.array([p.upper for p in nl_params])
+    outer = _OuterProblem(model, ds, valid, names, channel_scale)
+
+    def cost(x):
+        r = outer.residual(x)
+        return float(r @ r)
+
+    grid = [np.linspace(a, b, outer_grid) for a, b in zip(lo, hi)]
+    if start is not None and all(k in start for k in names):
+        x0 = np.clip(np.array([float(start[k]) for k in names]), lo, hi)
+    elif len(nl_params) > 2:  # keep the grid small: nominal start
+        x0 = np.array([p.nominal for p in nl_params])
+    else:
+        pts = np.array(list(itertools.product(*grid)))
+        x0 = pts[int(np.argmin([cost(x) for x in pts]))]
+
+    def residual(xs):
+        xs = np.asarray(xs).reshape(len(names), -1)
+        return np.stack([outer.residual(xs[:, k]) for k in range(xs.shape[1])], axis=1)
+
+    import mujoco.minimize as mjmin
+
+    grid_step = np.array([(b - a) / (outer_grid - 1) for a, b in zip(lo, hi)])
+    x_best, _ = mjmin.least_squares(x0, residual, bounds=[lo, hi], verbose=0,
+                                    x_scale=grid_step, max_iter=20, xtol=1e-4)
+    x_best = np.clip(np.asarray(x_best).reshape(-1), lo, hi)
+    if cost(x_best) > cost(x0):
+        x_best = x0
+    nl_values = dict(zip(names, map(float, x_best)))
+    ev = model.evaluate(ds, nl_values)
+    fit = _solve(ev, valid, "raise", channel_scale)
+    # Jacobian of the residual w.r.t. the nonlinear parameters (theta held) for the covariance
+    cols_j = []
+    for i, p in enumerate(nl_params):
+        h = 0.1 * grid_step[i]
+        xp, xm = dict(nl_values), dict(nl_values)
+        xp[p.name] = min(nl_values[p.name] + h, hi[i])
+        xm[p.name] = max(nl_values[p.name] - h, lo[i])
+        rp = _fixed_theta_residual(model, ds, xp, fit, valid)
+        rm = _fixed_theta_residual(model, ds, xm, fit, valid)
+        cols_j.append((rp - rm) / (xp[p.name] - xm[p.name]))
+    return nl_values, ev, fit, np.stack(cols_j, axis=1)
+
+
 def _identify_once(model: Model, ds: Dataset, *, on_deficient: str = "raise",
                    outer_grid: int = OUTER_GRID, start: Mapping[str, float] | None = None,
                    channel_scale=None) -> Identification:
@@ -286,56 +335,20 @@ def _identify_once(model: Model, ds: Dataset, *, on_deficient: str = "raise",
     nl_values: dict[str, float] = {}
     valid = ds.valid.copy()
     jac_nl = None
+    ev = fit = None
     if nl_params:
         # samples valid at every corner of the box: the residual keeps a fixed length
         for corner in itertools.product(*[(p.lower, p.nominal, p.upper) for p in nl_params]):
             valid &= model.apply_nonlinear(ds, dict(zip([p.name for p in nl_params], corner))).valid
-        names = [p.name for p in nl_params]
-        lo = np.array([p.lower for p in nl_params])
-        hi = np.array([p.upper for p in nl_params])
-
-        outer = _OuterProblem(model, ds, valid, names, channel_scale)
-
-        def cost(x):
-            r = outer.residual(x)
-            return float(r @ r)
-
-        grid = [np.linspace(a, b, outer_grid) for a, b in zip(lo, hi)]
-        if start is not None and all(k in start for k in names):
-            x0 = np.clip(np.array([float(start[k]) for k in names]), lo, hi)
-        elif len(nl_params) > 2:  # keep the grid small: nominal start
-            x0 = np.array([p.nominal for p in nl_params])
-        else:
-            pts = np.array(list(itertools.product(*grid)))
-            x0 = pts[int(np.argmin([cost(x) for x in pts]))]
-
-        def residual(xs):
-            xs = np.asarray(xs).reshape(len(names), -1)
-            return np.stack([outer.residual(xs[:, k]) for k in range(xs.shape[1])], axis=1)
-
-        import mujoco.minimize as mjmin
-
-        step = np.array([(b - a) / (outer_grid - 1) for a, b in zip(lo, hi)])
-        x_best, _ = mjmin.least_squares(x0, residual, bounds=[lo, hi], verbose=0,
-                                        x_scale=step, max_iter=20, xtol=1e-4)
-        x_best = np.clip(np.asarray(x_best).reshape(-1), lo, hi)
-        if cost(x_best) > cost(x0):
-            x_best = x0
-        nl_values = dict(zip(names, map(float, x_best)))
-        # Jacobian of the residual w.r.t. the nonlinear parameters (theta held) for the covariance
-        f0, phi0, lhs0, _, _ = _inner(model, ds, nl_values, valid, "raise", channel_scale)
-        cols_j = []
-        for i, p in enumerate(nl_params):
-            h = 0.1 * step[i]
-            xp, xm = dict(nl_values), dict(nl_values)
-            xp[p.name] = min(nl_values[p.name] + h, hi[i])
-            xm[p.name] = max(nl_values[p.name] - h, lo[i])
-            rp = _fixed_theta_residual(model, ds, xp, f0, valid)
-            rm = _fixed_theta_residual(model, ds, xm, f0, valid)
-            cols_j.append((rp - rm) / (xp[p.name] - xm[p.name]))
-        jac_nl = np.stack(cols_j, axis=1)
-
-    fit, phi, lhs, cols, ds2 = _inner(model, ds, nl_values, valid, on_deficient, channel_scale)
+        nl_values, ev, f0, jac_nl = _outer_search(model, ds, nl_params, valid, channel_scale,
+                                                  outer_grid, start)
+        if on_deficient == "raise":
+            fit = f0
+    if ev is None:
+        ev = model.evaluate(ds, nl_values)
+    if fit is None:
+        fit = _solve(ev, valid, on_deficient, channel_scale)
+    phi, cols = ev.phi, ev.columns
     params: dict[str, float] = {}
     stderr: dict[str, float] = {}
     units: dict[str, str] = {}
@@ -365,14 +378,15 @@ def _identify_once(model: Model, ds: Dataset, *, on_deficient: str = "raise",
         except np.linalg.LinAlgError:
             pass
     # known parameters
-    all_units = {p.name: p.unit for e in model.effect_units() for p in list(e.columns(ds)) + list(e.nonlinear)}
+    param_units = {p.name: p.unit for e in model.effect_objects
+                   for p in list(e.columns(ds)) + list(e.nonlinear)}
     for k, v in model.fixed.items():
-        params[k], stderr[k], units[k] = float(v), 0.0, all_units.get(k, "")
+        params[k], stderr[k], units[k] = float(v), 0.0, param_units.get(k, "")
     if fit.base:  # regrouped: predict with the independent columns only
         y_hat = np.full_like(ds.y, np.nan)
     else:
-        y_hat, _ = model.predict(ds, params)
-    resid = np.where(valid[:, None], ds2.y - y_hat, np.nan)
+        y_hat = ev.output(fit.theta)
+    resid = np.where(valid[:, None], ev.ds.y - y_hat, np.nan)
     # coloured residuals: the LS covariance assumes independent samples; inflate the standard
     # errors by sqrt(n / n_eff) with the AR(1) effective sample size n_eff of the residual taken
     # every `step` samples (parallel-filtered data: one sample per 1 / (2 f_c), else every one)
@@ -457,15 +471,16 @@ class _OuterProblem:
         self.model, self.ds, self.valid, self.names = model, ds, valid, names
         nl = model.nonlinear_params()
         nominal = {p.name: p.nominal for p in nl}
-        ds0 = model.apply_nonlinear(ds, nominal)
+        ev0 = model.evaluate(ds, nominal)
+        ds0 = ev0.ds
         # probe away from the nominal point: do the transforms touch the regressor inputs?
         probe = {p.name: (0.5 * (p.nominal + p.upper) if np.isfinite(p.upper) else p.nominal + 1.0)
                  if p.upper != p.nominal else 0.5 * (p.nominal + p.lower) for p in nl}
         dsp = model.apply_nonlinear(ds, probe)
         self.constant = all(dsp.signals.get(k) is v for k, v in ds0.signals.items()) and \
             dsp.act_map is ds0.act_map and dsp.act_vel is ds0.act_vel
-        phi, self.cols, self.y_known = model.regressor(ds0)
-        fit0 = solve_linear(phi, ds0.y - self.y_known, self.cols, valid=valid, bounded=False,
+        phi, self.cols, self.y_known = ev0.phi, ev0.columns, ev0.y_known
+        fit0 = solve_linear(phi, ev0.lhs, self.cols, valid=valid, bounded=False,
                             channel_scale=channel_scale)
         self.w = fit0.channel_scale
         if self.constant:
@@ -473,15 +488,16 @@ class _OuterProblem:
             self.q = np.linalg.qr(a, mode="reduced")[0] if a.shape[1] else np.zeros((a.shape[0], 0))
 
     def residual(self, x) -> np.ndarray:
-        ds2 = self.model.apply_nonlinear(self.ds, dict(zip(self.names, np.ravel(x))))
-        if self.constant:
+        values = dict(zip(self.names, np.ravel(x)))
+        if self.constant:   # the regressor does not move: only the transformed measurement
+            ds2 = self.model.apply_nonlinear(self.ds, values)
             b = ((ds2.y - self.y_known)[self.valid] * self.w[None, :]).reshape(-1)
             return b - self.q @ (self.q.T @ b)
-        phi, _, y_known = self.model.regressor(ds2)
-        b = ((ds2.y - y_known)[self.valid] * self.w[None, :]).reshape(-1)
-        if phi.shape[2] == 0:          # a model of known parts only (a delay alone)
+        ev = self.model.evaluate(self.ds, values)
+        a = (ev.phi[self.valid] * self.w[None, :, None]).reshape(-1, ev.phi.shape[2])
+        b = (ev.lhs[self.valid] * self.w[None, :]).reshape(-1)
+        if a.shape[1] == 0:            # a model of known parts only (a delay alone)
             return b
-        a = (phi[self.valid] * self.w[None, :, None]).reshape(-1, phi.shape[2])
         # normal equations on scaled columns: cheap for the few parameters of an outer search
         sc = np.linalg.norm(a, axis=0)
         sc = np.where(sc > 0, sc, 1.0)
@@ -495,9 +511,8 @@ class _OuterProblem:
 
 def _fixed_theta_residual(model: Model, ds: Dataset, nl: Mapping[str, float], fit: LinearFit,
                           valid: np.ndarray) -> np.ndarray:
-    ds2 = model.apply_nonlinear(ds, nl)
-    phi, _, lhs, _ = _linear_system(model, ds2)
-    return _weighted_residual(fit, phi, lhs, valid)
+    ev = model.evaluate(ds, nl)
+    return _weighted_residual(fit, ev.phi, ev.lhs, valid)
 
 
 def evaluate(model: Model, ds: Dataset, params: Mapping[str, float]
@@ -509,5 +524,5 @@ def evaluate(model: Model, ds: Dataset, params: Mapping[str, float]
         model's data transforms (e.g. shifted by an identified delay); compare it with ``y_hat``
         where ``valid``.
     """
-    ds2 = model.apply_nonlinear(ds, params)
-    return ds2.y, model.linear_output(ds2, params), ds2.valid & np.isfinite(ds2.y).all(axis=1)
+    ev = model.evaluate(ds, params)
+    return ev.ds.y, ev.output(params), ev.ds.valid & np.isfinite(ev.ds.y).all(axis=1)

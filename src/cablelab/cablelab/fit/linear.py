@@ -21,7 +21,7 @@ import scipy.linalg
 import scipy.optimize
 
 from ..errors import CablelabError
-from ..model import Param
+from ..effects.base import Param
 
 #: singular values below RANK_TOL * largest (of the column-scaled regressor) count as zero
 RANK_TOL = 1e-8

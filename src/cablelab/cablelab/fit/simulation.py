@@ -25,7 +25,7 @@ from typing import Callable, Sequence
 import numpy as np
 
 from ..errors import CablelabError
-from ..model import Param
+from ..effects.base import Param
 
 OBJECTIVES = ("nmse", "pearson")
 

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..report import CSS, _table
+from ..report.sections import CSS, _table
 from ..report.plots import DPI
 
 Z95 = 1.959963984540054  # two-sided 95 % normal quantile: band = value +- Z95 stderr

@@ -2,9 +2,9 @@
 cannot be diagnosed gives one row whose ``status`` is the one-line reason.
 
 The work is the library's own: :func:`cablelab.workbench.load`, :func:`~cablelab.workbench.build_model`,
-:func:`~cablelab.workbench.diagnose` (held-out ranking, optional greedy waterfall) and
-:func:`~cablelab.workbench.identify` (the model's own parameters with standard errors).
-Optionally the bag's own ``cablelab report`` is written next to the results.
+:func:`~cablelab.workbench.diagnose` (held-out ranking, optional greedy waterfall; its fit of the
+model gives the model's own parameters with standard errors). Optionally the bag's own
+``cablelab report`` is written next to the results, from the same diagnosis when it is greedy.
 """
 from __future__ import annotations
 
@@ -80,7 +80,7 @@ def _rows(ref, base, effects, greedy, folds, report_dir):
     import shutil
 
     from ..model import parse_effect_list
-    from ..workbench import build_model, diagnose, identify, load
+    from ..workbench import build_model, diagnose, load
 
     path, tmp = _local(ref)
     try:
@@ -94,46 +94,43 @@ def _rows(ref, base, effects, greedy, folds, report_dir):
                     start_time=start)
         model = build_model(plant, desc, parse_effect_list(list(effects)))
         cands = plant.candidates(desc)
-        out = diagnose(ds, model, cands, folds=folds, greedy_mode=greedy, quiet=True).to_json()
-        first = {r["effect"]: (i, r) for i, r in enumerate(out["ranking"])}
+        d = diagnose(ds, model, cands, folds=folds, greedy_mode=greedy, quiet=True)
+        first = {c.effect: (i, c) for i, c in enumerate(d.ranking)}
         if greedy:
-            final_effects = list(out["final"]["effects"])
-            fvals, ferr = out["final"]["params"], out["final"]["stderr"]
-            last = {r["effect"]: r for r in out["greedy"][-1]["ranking"]}
-            final_error = out["final"]["error"]
+            final_effects, final_error = list(d.final.effects), d.final.error
+            fvals, ferr = d.final.params, d.final.stderr
+            last = {c.effect: c for c in d.final.ranking}
         else:
-            final_effects = list(model.effects)
-            idn = identify(ds, model, folds=0, quiet=True)
-            fvals = {k: v["value"] for k, v in idn["params"].items()}
-            ferr = {k: v["stderr"] for k, v in idn["params"].items()}
-            last = {r["effect"]: r for r in out["ranking"]}
-            final_error = out["baseline"]["error"]
+            final_effects, final_error = list(model.effects), d.baseline_error
+            reported = d.fit.reported(ds)[0]   # the model's parameters in the user's terms
+            fvals = {k: v["value"] for k, v in reported.items()}
+            ferr = {k: v["stderr"] for k, v in reported.items()}
+            last = {c.effect: c for c in d.ranking}
         rows = []
-        base_err = out["baseline"]["error"]
         model_text = "+".join(final_effects)
         for eff in final_effects:
-            rank, r = first.get(eff, (None, None))
+            rank, c = first.get(eff, (None, None))
             rows.append(dict(base, effect=eff, in_model=True, rank=rank,
-                             significant=None if r is None else bool(r["significant"]),
-                             error_before=base_err if r is None else r["error_before"],
-                             error_after=final_error if r is None else r["error_after"],
-                             p_value=None if r is None else r.get("p_value"),
+                             significant=None if c is None else bool(c.significant),
+                             error_before=d.baseline_error if c is None else c.error_before,
+                             error_after=final_error if c is None else c.error_after,
+                             p_value=None if c is None else c.p_value,
                              params=_params_json(fvals, ferr, _effect_names(eff, ds)),
                              model=model_text, status="ok"))
-        for eff, (rank, r) in first.items():
+        for eff, (rank, c) in first.items():
             if eff in final_effects:
                 continue
-            lr = last.get(eff, r)
-            rows.append(dict(base, effect=eff, in_model=False, rank=rank, significant=bool(r["significant"]),
-                             error_before=r["error_before"], error_after=r["error_after"],
-                             p_value=r.get("p_value"),
-                             params=_params_json(lr.get("params", {}), lr.get("stderr"), list(lr.get("params", {}))),
+            lc = last.get(eff, c)
+            rows.append(dict(base, effect=eff, in_model=False, rank=rank, significant=bool(c.significant),
+                             error_before=c.error_before, error_after=c.error_after, p_value=c.p_value,
+                             params=_params_json(lc.params, lc.stderr, list(lc.params)),
                              model=model_text, status="ok"))
         if report_dir:
             from ..report import build_report
 
-            build_report(ds, model, cands, report_dir, folds=folds,
-                         title=f"cablelab report: {base['machine']} {start.isoformat()}", quiet=True)
+            page_diagnosis = d if greedy else diagnose(ds, model, cands, folds=folds, greedy_mode=True)
+            build_report(ds, page_diagnosis, report_dir,
+                         title=f"cablelab report: {base['machine']} {start.isoformat()}")
         return rows
     finally:
         if tmp:

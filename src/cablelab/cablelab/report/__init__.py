@@ -1,9 +1,9 @@
 """``cablelab report``: one ``index.html`` with PNG plots of compare, diagnose and identify.
 
-:func:`build_report` runs the analysis once (nominal fit, greedy diagnosis, final fit) and writes
-the answer first, then the evidence: summary, the answer sentence with the waterfall, the ranking
-of the candidates (each with the quantities its significance is decided on), the parameter table
-with uncertainties, the metrics and the overlay (gaps shaded), residual over time with the worst
+:func:`build_report` draws a greedy :class:`~cablelab.diagnose.result.Diagnosis` (the fits of
+its waterfall steps, never refitted here) and writes the answer first, then the evidence:
+summary, the answer sentence with the waterfall, the ranking of the candidates (each with the
+quantities its significance is decided on), the parameter table with uncertainties, the metrics and the overlay (gaps shaded), residual over time with the worst
 segments shaded and after each added effect, residual by regime (a table of the worst regime per
 channel, the bar charts folded), residual whiteness and cross-correlation. Every figure has a
 caption naming what it shows and its unit. The sections' HTML is built in :mod:`.sections`.
@@ -12,53 +12,58 @@ from __future__ import annotations
 
 import html
 import os
-import time
+from dataclasses import dataclass
 
 import numpy as np
 
-from ..diagnose import derived_regimes, greedy, residual_by_regime, whiteness, worst_segments
-from ..diagnose.metrics import channel_metrics
-from ..diagnose.ranking import ALPHA, MIN_GAIN
+from ..dataset import Dataset
+from ..diagnose import derived_regimes, worst_segments
+from ..diagnose.fit_metrics import fit_metrics
+from ..diagnose.result import Diagnosis
 from ..errors import CablelabError
-from ..fit import identify
 from ..fit.threads import blas_single
-from ..model import Dataset, Model
-from ..workbench import _decimation
 from . import plots
-from .sections import (CSS, _channel_rms, _figure, _num, _table, answer_section,  # noqa: F401
-                       metrics_table, ranking_section, regime_section)
+from .sections import (CSS, _figure, answer_section, metrics_table, parameters_section,
+                       ranking_section, regime_section, segments_table, whiteness_section)
+
+
+@dataclass(frozen=True)
+class ReportPage:
+    """A written report: ``index`` the page's path, ``figures`` its PNG file names."""
+
+    index: str
+    figures: list
 
 
 @blas_single
-def build_report(ds: Dataset, model: Model, candidates, out_dir, *, folds: int = 5,
-                 title: str = "", quiet: bool = True, warnings=(), alpha: float = ALPHA,
-                 min_gain: float = MIN_GAIN, overlay: str = "") -> dict:
-    """Analyse and write ``out_dir/index.html`` + PNGs; ``warnings`` (the input checks' lines,
-    :func:`cablelab.bagcheck.check_bag`) are shown at the top of the page; ``overlay``: path
-    (relative to ``out_dir``) of the model overlay bag the page links (:mod:`cablelab.overlay`).
+def build_report(ds: Dataset, diagnosis: Diagnosis, out_dir, *, title: str = "", warnings=(),
+                 overlay: str = "") -> ReportPage:
+    """Write ``out_dir/index.html`` + PNGs of a greedy diagnosis of ``ds``
+    (:func:`cablelab.workbench.diagnose` with ``greedy_mode``); ``warnings`` (the input checks'
+    lines, :func:`cablelab.bagcheck.check_bag`) are shown at the top of the page; ``overlay``:
+    path (relative to ``out_dir``) of the model overlay bag the page links (:mod:`cablelab.overlay`).
 
-    Returns:
-        ``{"index": path, "figures": [...], "steps": greedy steps, "seconds": elapsed}``.
+    Raises:
+        CablelabError: the output directory cannot be made.
+        ValueError: a diagnosis without its greedy waterfall.
     """
-    t0 = time.monotonic()
+    if not diagnosis.greedy:
+        raise ValueError("build_report draws the greedy waterfall: diagnose with greedy_mode=True")
     try:
         os.makedirs(out_dir, exist_ok=True)
     except OSError as exc:
         raise CablelabError(f"{out_dir}: cannot create report directory ({exc.strerror})") from None
-    steps = greedy(model, ds, candidates, folds=folds, alpha=alpha, min_gain=min_gain, quiet=quiet)
-    final_model = model.with_effects(steps[-1]["effects"])
-    base = identify(model, ds)
-    fin = identify(final_model, ds)
-    y_meas = np.where(fin.valid[:, None], fin.residual + fin.y_hat, np.nan)
-    y_meas_b = np.where(base.valid[:, None], base.residual + base.y_hat, np.nan)
+    steps = diagnosis.greedy
+    folds, alpha, min_gain = diagnosis.folds, diagnosis.alpha, diagnosis.min_gain
+    base, fin = steps[0].fit, steps[-1].fit
+    regimes = derived_regimes(ds)
+    m_base = fit_metrics(ds, base, regimes=regimes, with_whiteness=False)
+    m_fin = fit_metrics(ds, fin, regimes=regimes)
+    y_meas_b = m_base.y_meas
     # windows where the residual rises most above its own level over the record (normalised by the
     # residual, not the signal: a noisy, well-modelled channel would otherwise take every window)
     segs = worst_segments(ds.t, base.residual, base.residual, ds.channels)
-    regimes = derived_regimes(ds)
-    reg_b = residual_by_regime(base.residual, y_meas_b, regimes, ds.channels)
-    reg_f = residual_by_regime(fin.residual, y_meas, regimes, ds.channels)
-    met_b = channel_metrics(y_meas_b, base.y_hat, base.valid)
-    met_f = channel_metrics(y_meas, fin.y_hat, fin.valid)
+    reg_b, reg_f = m_base.regimes, m_fin.regimes
 
     figs = []
 
@@ -73,17 +78,17 @@ def build_report(ds: Dataset, model: Model, candidates, out_dir, *, folds: int =
                         "residual of the nominal model; worst segments shaded", valid=base.valid)
     step_figs = []
     for i, st in enumerate(steps[1:], 1):
-        ident_i = fin if i == len(steps) - 1 else identify(model.with_effects(st["effects"]), ds)
         name = f"step_{i}_residual.png"
-        plots.residual_time(fig(name), ds.t, ident_i.residual, [], ds.channels, ds.units,
-                            f"step {i}: + {st['added']} (held-out NRMSE {100 * st['error']:.2f} %)",
-                            valid=ident_i.valid)
+        plots.residual_time(fig(name), ds.t, st.fit.residual, [], ds.channels, ds.units,
+                            f"step {i}: + {st.added} (held-out NRMSE {100 * st.error:.2f} %)",
+                            valid=st.fit.valid)
         final = " (the final model)" if i == len(steps) - 1 else ""
-        step_figs.append((i, name, f"Residual after step {i} (+ {st['added']}){final} over time."))
-    white = {}
+        step_figs.append((i, name, f"Residual after step {i} (+ {st.added}){final} over time."))
+    # whiteness on the decimated residual: a residual of low-passed signals is correlated over
+    # fs / (2 f_c) samples by the filter alone
+    white = m_fin.whiteness
     for c, (ch, unit) in enumerate(zip(ds.channels, ds.units)):
         plots.residual_regimes(fig(f"regimes_{c}.png"), reg_b, reg_f, ch, unit)
-        white[ch] = whiteness(fin.residual[:, c], ds.inputs, decimate=_decimation(ds))  # issue 10
         plots.correlations(fig(f"whiteness_{c}.png"), white[ch], ch)
 
     parts = [f"<h1>{html.escape(title or 'cablelab report')}</h1>",
@@ -103,20 +108,11 @@ def build_report(ds: Dataset, model: Model, candidates, out_dir, *, folds: int =
     from ..diagnose.result import ambiguity_lines, excite_commands
 
     parts.extend(f"<p class='warnings'>{html.escape(line)}</p>"
-                 for line in ambiguity_lines(steps[0]["ranking"])
-                 + excite_commands(steps[0]["ranking"], model.plant, ds.source))
-    parts.append("<h2>Parameters of the final model</h2>")
-    table = fin.table()
-    any_fixed = any(r["fixed"] for r in table)     # a column for --fix only when it was used
-    rows = [[html.escape(r["name"]), _num(r["value"], "{:.6g}"), _num(r["stderr"], "{:.2g}"),
-             html.escape(r["unit"])] + (["fixed (--fix)" if r["fixed"] else "fitted"] if any_fixed else [])
-            for r in table]
-    parts.append(_table(rows, ["parameter", "value", "std. error", "unit"] + (["source"] if any_fixed else [])))
-    parts.append(f"<p>rank {fin.linear.rank}, condition number {fin.linear.cond:.3g}"
-                 + (f"; unidentifiable: {html.escape('; '.join(fin.linear.unidentifiable))}"
-                    if fin.linear.unidentifiable else "") + "</p>")
+                 for line in ambiguity_lines(steps[0].ranking)
+                 + excite_commands(steps[0].ranking, diagnosis.plant, ds.source))
+    parts.append(parameters_section(fin))
     parts.append("<h2>Measured vs model</h2>")
-    parts.append(metrics_table(ds.channels, ds.units, met_b, met_f))
+    parts.append(metrics_table(ds.channels, ds.units, m_base.channels, m_fin.channels))
     n_bad = int(np.sum(~fin.valid))
     gaps = (f" Grey bands: {n_bad} samples ({100 * n_bad / max(ds.n, 1):.1f} %) with no valid "
             "measurement (gaps, NaN, filter edges); nothing is fitted or drawn there." if n_bad else "")
@@ -126,32 +122,16 @@ def build_report(ds: Dataset, model: Model, candidates, out_dir, *, folds: int =
     parts.append(_figure("residual_time.png", "Residual (measured - model) of the nominal model "
                          "over time; the windows where it rises most above its own level (table "
                          "below) shaded gold." + gaps))
-    unit_of = dict(zip(ds.channels, ds.units))
-    rows = [[html.escape(s["channel"]), f"{s['t_start']:.3f}", f"{s['t_end']:.3f}",
-             f"{s['rms']:.4g} {html.escape(unit_of[s['channel']])}", f"{s['error']:.2f}"] for s in segs]
-    parts.append(_table(rows, ["channel", "from [s]", "to [s]", "residual RMS in the window",
-                               "x the channel's residual RMS over the record"]))
+    parts.append(segments_table(segs, ds.channels, ds.units))
     if not step_figs:
         parts.append("<p>No effect was added: the nominal model is the final model.</p>")
     for i, name, caption in step_figs:
         parts.append(_figure(name, caption))
     parts.append(regime_section(reg_b, reg_f, ds.channels, ds.units, y_meas_b))
-    parts.append("<h2>Residual whiteness of the final model</h2><p>A model that explains "
-                 "everything leaves a white residual: autocorrelation inside the 99 % band at every "
-                 "lag and no correlation with the inputs.</p>")
-    rows = [[html.escape(ch), f"{100 * white[ch]['outside']:.0f} %", "yes" if white[ch]["white"] else "no",
-             html.escape(", ".join(k for k, x in white[ch]["cross"].items() if not x["uncorrelated"]) or "none")]
-            for ch in ds.channels]
-    parts.append(_table(rows, ["channel", "autocorrelation lags outside the 99 % band", "white",
-                               "inputs the residual still correlates with"]))
-    for c, ch in enumerate(ds.channels):
-        w = white[ch]
-        parts.append(_figure(f"whiteness_{c}.png", f"{ch}: {100 * w['outside']:.0f} % of "
-                             f"autocorrelation lags outside the 99 % band "
-                             f"({'white' if w['white'] else 'not white'}); lags in samples."))
+    parts.append(whiteness_section(white, ds.channels))
     doc = (f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>cablelab report</title>"
            f"<style>{CSS}</style></head><body>{''.join(parts)}</body></html>")
     index = os.path.join(out_dir, "index.html")
     with open(index, "w", encoding="utf-8") as fh:
         fh.write(doc)
-    return {"index": index, "figures": figs, "steps": steps, "seconds": time.monotonic() - t0}
+    return ReportPage(index, figs)

@@ -146,8 +146,8 @@ def residual_regimes(path, rows_base, rows_final, channel, unit: str = "") -> No
 
 def waterfall(path, steps) -> None:
     """Held-out NRMSE at each greedy step: baseline -> +effect 1 -> +effect 2."""
-    labels = ["nominal"] + [f"+ {s['added']}" for s in steps[1:]]
-    vals = [100 * s["error"] for s in steps]
+    labels = ["nominal"] + [f"+ {s.added}" for s in steps[1:]]
+    vals = [100 * s.error for s in steps]
     fig, ax = plt.subplots(figsize=(1.8 * len(vals) + 3, 3.6))
     x = np.arange(len(vals))
     colors = ["tab:orange"] + ["tab:blue"] * (len(vals) - 1)

@@ -12,7 +12,7 @@ import numpy as np
 
 from ...conditioning import condition_motion
 from ...errors import CablelabError
-from ...model import Dataset
+from ...dataset import Dataset
 from ...plant_interface import DatasetOptions
 
 from .topics import JOINT_STATE, JOINT_STATES as TOPIC

@@ -8,7 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...model import Dataset, Effect, Param
+from ...dataset import Dataset
+from ...effects.base import Effect, Param
 from ...effects import register
 
 

@@ -6,7 +6,7 @@ import numpy as np
 
 from ...errors import CablelabError
 from ...fit.simulation import fit_free_run_windows, free_run_windows, window_length, window_starts
-from ...model import Dataset
+from ...dataset import Dataset
 
 #: free-run horizon: the record is cut into windows of this length, each simulated from the
 #: measured state at its start (a marginally stable axis drifts over a long open-loop run)
@@ -93,7 +93,7 @@ def fit_free_run(ds: Dataset, start: dict, *, objective: str = "nmse",
         CablelabError: a parameter of the model whose inverse-model value is not positive (a
             negative inertia or friction cannot start a physical simulation), or none to fit.
     """
-    from ...model import Param
+    from ...effects.base import Param
 
     params = []
     names = {"M": "inertia", "Fv": "viscous friction", "Fc": "Coulomb friction"}

@@ -1,5 +1,5 @@
 """The CDPR dataset: a contract bag read into arrays (:func:`load_arrays`) and the workbench
-:class:`~cablelab.model.Dataset` (output channels = the cable wrench W t, 6 channels, see
+:class:`~cablelab.dataset.Dataset` (output channels = the cable wrench W t, 6 channels, see
 :mod:`cablelab.plants.cdpr.effects`), and the checks of a bag before a fit.
 
 Bag topics (CONTRACT section 2): ``/cdpr/cable_tensions`` (dynamometers), ``/cdpr/joint_states``
@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...errors import CablelabError
-from ...model import Dataset
+from ...dataset import Dataset
 from ...plant_interface import DatasetOptions
 from ...rotations import quat_to_matrix, xyzw_to_wxyz
 from .geometry import cable_geometry, check_pulley_radius, wrench_matrix

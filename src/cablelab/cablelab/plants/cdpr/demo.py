@@ -181,10 +181,9 @@ def cdpr_analysis(out: Path, a, runs: tuple) -> PartResult:
 
     log("writing the report (cablelab report) ...")
     from ...report import build_report
-    rep = build_report(ds, base1, plant.candidates(desc), out / "report", folds=a.folds,
-                       title="CAROCA demo: dynamometers, Model I baseline")
-    steps = rep["steps"]                # the report's greedy waterfall
-    d1 = steps[0]                       # its first step is the diagnosis
+    d1 = diagnose(ds, base1, plant.candidates(desc), folds=a.folds, greedy_mode=True)
+    rep = build_report(ds, d1, out / "report", title="CAROCA demo: dynamometers, Model I baseline")
+    steps = d1.greedy                   # the report's greedy waterfall
 
     def err(s):
         return 100 * (s["mass"]["mean"] - TRUE_MASS) / TRUE_MASS
@@ -202,18 +201,18 @@ def cdpr_analysis(out: Path, a, runs: tuple) -> PartResult:
         ["max |z error| PD / PDFF (mm)",
          f"{'-' if ez_pd is None else f'{1000 * np.abs(ez_pd).max():.1f}'} / {1000 * np.abs(ez).max():.1f}",
          f"~{PAPER['pd_z']:.0f} / < {PAPER['pdff_z']:.0f}"],
-        ["diagnose, Model I + dynamometers: first effect", d1["ranking"][0]["effect"], "pulleys (sec. V-A)"],
+        ["diagnose, Model I + dynamometers: first effect", d1.ranking[0].effect, "pulleys (sec. V-A)"],
         ["diagnose, motor torques: first effect", d2.ranking[0].effect, "friction (eq. 15)"],
         ["waterfall, Model I + dynamometers (held-out NRMSE)",
-         " -> ".join([f"nominal {100 * steps[0]['error']:.1f} %"]
-                     + [f"{s['added']} {100 * s['error']:.1f} %" for s in steps[1:]]),
+         " -> ".join([f"nominal {100 * steps[0].error:.1f} %"]
+                     + [f"{s.added} {100 * s.error:.1f} %" for s in steps[1:]]),
          "pulleys, then m a (eq. 10)"],
         ["m_a of platform_inertia (kg, true 615)",
-         f"{steps[-1]['params']['m_a']:.1f}" if "m_a" in steps[-1]["params"] else "not added", "-"],
+         f"{steps[-1].params['m_a']:.1f}" if "m_a" in steps[-1].params else "not added", "-"],
     ]
-    page = cdpr_page(out, pdff, pd, rows, rep["index"])
-    return PartResult(rows=rows, bags=[b for b in (pdff, pd) if b is not None], report=rep["index"],
-                      page=page, first=d1["ranking"][0]["effect"], seconds=time.monotonic() - t0)
+    page = cdpr_page(out, pdff, pd, rows, rep.index)
+    return PartResult(rows=rows, bags=[b for b in (pdff, pd) if b is not None], report=rep.index,
+                      page=page, first=d1.ranking[0].effect, seconds=time.monotonic() - t0)
 
 
 

@@ -33,7 +33,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...model import Dataset, Effect, Param
+from ...dataset import Dataset
+from ...effects.base import Effect, Param
 from ...rotations import cross
 from ...effects import register
 from ...effects.base import Physical

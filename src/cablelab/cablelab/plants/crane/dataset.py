@@ -15,7 +15,7 @@ import numpy as np
 
 from ...conditioning import condition_motion
 from ...errors import CablelabError
-from ...model import STANDARD_GRAVITY, Dataset
+from ...dataset import STANDARD_GRAVITY, Dataset
 from ...plant_interface import DatasetOptions
 from .dynamics_generated import regressor
 from .model import JOINTS

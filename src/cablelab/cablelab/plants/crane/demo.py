@@ -171,7 +171,7 @@ def analyse(out: Path, bag_dir: Path, *, folds: int = 5) -> PartResult:
     from ...bags import open_bag
     from . import plant as C
     from ...report import build_report
-    from ...workbench import build_model, load
+    from ...workbench import build_model, diagnose, load
 
     t_start = time.monotonic()
     params = described_params()
@@ -184,15 +184,16 @@ def analyse(out: Path, bag_dir: Path, *, folds: int = 5) -> PartResult:
     plant, desc, ds = load(bag_dir, None, {})
     l_c = desc.crane.counterbalance.distance
     model = build_model(plant, desc, fixed={"l_c": l_c})   # 002 knew l_c: fixes the null direction
-    rep = build_report(ds, model, plant.candidates(desc), out / "report", folds=folds,
+    d = diagnose(ds, model, plant.candidates(desc), folds=folds, greedy_mode=True)
+    rep = build_report(ds, d, out / "report",
                        title="Boom crane demo: described crane, base tilt hidden (002 sec. 6.5)")
-    steps = rep["steps"]
-    ranking = steps[0]["ranking"]
-    tilt_step = next((s for s in steps if s["added"] == "base_tilt"), None)
+    steps = d.greedy
+    ranking = d.ranking
+    tilt_step = next((s for s in steps if s.added == "base_tilt"), None)
     K, g = params.first_moment, params.gravity
-    fitted = rest_torque(tilt_step["params"], K, g) if tilt_step else float("nan")
+    fitted = rest_torque(tilt_step.params, K, g) if tilt_step else float("nan")
     true_rest = rest_torque({"tilt_x": np.sin(tilt), "tilt_y": 0.0}, K, g)
-    final, nominal, nan = steps[-1]["params"], steps[0]["params"], float("nan")
+    final, nominal, nan = steps[-1].params, steps[0].params, float("nan")
     deg = np.degrees
     rows = [
         ["samples (100 Hz, lock-step over DDS)", f"{ds.n}", "-"],
@@ -205,12 +206,12 @@ def analyse(out: Path, bag_dir: Path, *, folds: int = 5) -> PartResult:
          f"{deg(off['rms_error_vs_ground_truth']['theta1']):.3f} / "
          f"{deg(off['rms_error_vs_ground_truth']['theta2']):.3f}", "-"],
         ["motion-capture dropouts handled", f"{off['conditioning'].get('dropouts', 0)}", "-"],
-        ["diagnose: first effect", ranking[0]["effect"], "base_tilt (sec. 6.5)"],
+        ["diagnose: first effect", ranking[0].effect, "base_tilt (sec. 6.5)"],
         ["held-out NRMSE nominal -> + first effect",
-         f"{100 * steps[0]['error']:.1f} % -> {100 * ranking[0]['error_after']:.1f} %", "-"],
+         f"{100 * steps[0].error:.1f} % -> {100 * ranking[0].error_after:.1f} %", "-"],
         ["slew torque at rest, fitted tilt (N m)", f"{fitted:+.3f} (sim {true_rest:+.3f})",
          f"{PAPER_REST_TORQUE:+.1f}"],
-        ["effects added by diagnose (waterfall)", " + ".join(s["added"] for s in steps[1:]) or "none",
+        ["effects added by diagnose (waterfall)", " + ".join(s.added for s in steps[1:]) or "none",
          "base_tilt"],
         ["payload m / boom m_b / counterbalance m_c (kg)",
          f"{final.get('m', nan):.3f} / {final.get('m_b', nan):.3f} / "
@@ -222,8 +223,8 @@ def analyse(out: Path, bag_dir: Path, *, folds: int = 5) -> PartResult:
          "sim 0.05 / 0.02; 002 sec. 6.2: negative"],
     ]
     page = crane_page(out / "report", bag_dir, rows, sw)
-    return PartResult(bags=[bag_dir], rows=rows, report=rep["index"], page=page,
-                      first=ranking[0]["effect"], seconds=time.monotonic() - t_start)
+    return PartResult(bags=[bag_dir], rows=rows, report=rep.index, page=page,
+                      first=ranking[0].effect, seconds=time.monotonic() - t_start)
 
 
 def run(out: Path, *, duration: float = 30.0, folds: int = 5, domain: int = 1) -> PartResult:

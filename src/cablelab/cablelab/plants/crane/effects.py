@@ -30,7 +30,8 @@ from typing import Mapping
 
 import numpy as np
 
-from ...model import Dataset, Effect, Param
+from ...dataset import Dataset
+from ...effects.base import Effect, Param
 from .model import PARAM_GROUPS
 from ...effects import register
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...excite import Exciter, Limits
-from ...model import STANDARD_GRAVITY, Dataset
+from ...dataset import STANDARD_GRAVITY, Dataset
 from .dataset import JOINTS
 from .topics import REFERENCE
 from .dynamics_generated import regressor

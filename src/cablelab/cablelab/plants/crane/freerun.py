@@ -14,7 +14,7 @@ import numpy as np
 
 from ...errors import CablelabError
 from ...fit.simulation import fit_free_run_windows, free_run_windows, window_length, window_starts
-from ...model import Dataset
+from ...dataset import Dataset
 from .kinematics import gimbal_rates_to_swing, swing_to_gimbal
 from .model import JOINTS, CraneParams
 
@@ -144,7 +144,7 @@ def fit_free_run(ds: Dataset, start: dict, *, objective: str = "nmse",
     eq. 3-7). Parameters of ``free`` with a positive start value are fitted within
     [start / 5, start * 5]; the others are held at their start value.
     """
-    from ...model import Param
+    from ...effects.base import Param
 
     params = [Param(k, "", float(start[k]), float(start[k]) / 5.0, float(start[k]) * 5.0)
               for k in free if float(start.get(k, 0.0)) > 0]

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...fit.linear import LinearFit, solve_linear
-from ...model import Param
+from ...effects.base import Param
 from .model import GROUP_UNITS, PARAM_GROUPS, regressor
 
 __all__ = ["FIX_002", "group_params", "stacked_regressor", "null_space", "identify_groups",

@@ -1,4 +1,4 @@
-"""Leg measurements as a workbench :class:`~cablelab.model.Dataset` (inverse model, hybrid-aware).
+"""Leg measurements as a workbench :class:`~cablelab.dataset.Dataset` (inverse model, hybrid-aware).
 
 The leg's equations (003 eq. 1, 23, 24) are linear in the parameters once the known forces are
 moved to one side. With s = contact (1 stance), f = 1 - s:
@@ -25,7 +25,7 @@ import numpy as np
 
 from ...conditioning import derivatives, lowpass
 from ...errors import CablelabError
-from ...model import Dataset
+from ...dataset import Dataset
 from ...plant_interface import DatasetOptions
 from . import topics
 from .description import leg_of

@@ -29,7 +29,7 @@ import numpy as np
 from ...conditioning import lowpass
 from ...errors import CablelabError
 from ...fit.simulation import fit_simulation
-from ...model import Param
+from ...effects.base import Param
 from .hybrid import STANCE, LegParams, input_force
 from .mjcf import build_mjcf
 from .sim import DT, LegSim

@@ -13,7 +13,8 @@ import numpy as np
 
 from ...conditioning import Conditioning, condition_motion
 from ...errors import CablelabError
-from ...model import KNOWN_OUTPUT, Dataset
+from ...dataset import Dataset
+from ...model import KNOWN_OUTPUT
 from ...plant_interface import DatasetOptions
 from .description import section_of
 from .inverse import inertial_columns, inverse_dynamics, point_mass_columns

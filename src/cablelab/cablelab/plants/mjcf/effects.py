@@ -10,7 +10,9 @@ import numpy as np
 from ...effects import register
 from ...effects.base import Physical
 from ...errors import CablelabError
-from ...model import KNOWN_OUTPUT, Dataset, Effect, Param
+from ...dataset import Dataset
+from ...effects.base import Effect, Param
+from ...model import KNOWN_OUTPUT
 
 
 def _payload(ds: Dataset) -> np.ndarray:

@@ -18,7 +18,7 @@ import mujoco
 import numpy as np
 
 from ...fit.simulation import fit_simulation
-from ...model import Param
+from ...effects.base import Param
 from .identify import Experiment, _stack
 from .params import VirtualParams
 from .reference import planar_bodies

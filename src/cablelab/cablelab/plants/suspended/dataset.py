@@ -1,4 +1,4 @@
-"""Bag -> :class:`cablelab.model.Dataset` for the workbench on ``suspended`` runs.
+"""Bag -> :class:`cablelab.dataset.Dataset` for the workbench on ``suspended`` runs.
 
 The workbench model is linear in its parameters (:mod:`cablelab.model`), so the platform
 motion is written as the swing equations of 000 eq. 1 reduced to one generalised coordinate per
@@ -29,7 +29,7 @@ import numpy as np
 
 from ...conditioning import condition_motion
 from ...errors import CablelabError
-from ...model import Dataset
+from ...dataset import Dataset
 from ...plant_interface import DatasetOptions
 from . import topics
 from .params import VirtualParams

@@ -45,7 +45,8 @@ import numpy as np
 
 from ...effects import register
 from ...effects.base import Physical
-from ...model import Dataset, Effect, Param
+from ...dataset import Dataset
+from ...effects.base import Effect, Param
 
 __all__ = ["SUSPENDED_EFFECTS", "BASELINE", "CANDIDATES"]
 

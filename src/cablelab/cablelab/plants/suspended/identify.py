@@ -35,7 +35,7 @@ import numpy as np
 from ...diagnose.identifiability import MIN_T, UNIDENTIFIABLE, confounding
 from ...errors import CablelabError
 from ...fit.simulation import SimulationFit, fit_simulation, objective_residual
-from ...model import Param
+from ...effects.base import Param
 from .mjcf import build_truth, build_virtual
 from .params import IDENTIFIED, VirtualParams
 from .sim import initial_state, simulate, truth_start
