@@ -64,7 +64,7 @@ def main() -> int:
     d = rank_candidates(Model("mjcf", ()), ds, cands)
     rows.append((f"diagnose over the {len(cands)} candidates", time.perf_counter() - t0))
     print(f"mjcf plant, 7-joint arm, {ds.n} samples ({a.seconds:g} s at {a.rate:g} Hz); "
-          f"top: {d.ranking[0]['effect']}")
+          f"top: {d.ranking[0].effect}")
     print(f"| {'step':<55} | {'s':>7} |")
     print(f"| {'-' * 55} | {'-' * 7} |")
     for name, s in rows:

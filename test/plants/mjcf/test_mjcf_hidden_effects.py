@@ -55,15 +55,15 @@ def test_hidden_effect_ranks_first_significant_and_recovered(bags, case):
     _, effect, truth, tol = CASES[case]
     d = _diagnose(bags[case])
     top = d.ranking[0]
-    assert top["effect"] == effect, [(r["effect"], r["error_after"]) for r in d.ranking]
-    assert top["significant"], top
+    assert top.effect == effect, [(r.effect, r.error_after) for r in d.ranking]
+    assert top.significant, top
     for name, value in truth.items():
-        assert top["params"][name] == pytest.approx(value, rel=tol), (name, top["params"])
+        assert top.params[name] == pytest.approx(value, rel=tol), (name, top.params)
 
 
 def test_payload_centre_of_mass_is_recovered(bags):
     d = _diagnose(bags["payload"])
-    p = d.ranking[0]["params"]
+    p = d.ranking[0].params
     assert p["com_x"] == pytest.approx(0.04, abs=0.005) and abs(p["com_y"]) < 0.005, p
 
 
@@ -112,8 +112,8 @@ def test_gantry_crane_payload_with_free_swing(tmp_path):
     assert not ds.y[:, 2:4].any()                 # unactuated: zero-force equations
     d = rank_candidates(workbench.build_model(plant, desc), ds, plant.candidates(desc))
     top = d.ranking[0]
-    assert top["effect"] == "payload_mass" and top["significant"], d.ranking[:2]
-    assert top["params"]["m"] == pytest.approx(20.0, rel=0.05)
+    assert top.effect == "payload_mass" and top.significant, d.ranking[:2]
+    assert top.params["m"] == pytest.approx(20.0, rel=0.05)
 
 
 def test_cable_camera_payload_from_measured_tensions(tmp_path):
@@ -130,10 +130,10 @@ def test_cable_camera_payload_from_measured_tensions(tmp_path):
     assert ds.channels == ("x", "y", "z") and not ds.signals["driven"].any()
     d = rank_candidates(workbench.build_model(plant, desc), ds, plant.candidates(desc))
     top = d.ranking[0]
-    assert top["effect"] == "payload_mass" and top["significant"], d.ranking[:2]
-    assert top["params"]["m"] == pytest.approx(1.5, rel=0.05)
-    gain = next(r for r in d.ranking if r["effect"] == "actuator_gain")
-    assert not gain["significant"]
+    assert top.effect == "payload_mass" and top.significant, d.ranking[:2]
+    assert top.params["m"] == pytest.approx(1.5, rel=0.05)
+    gain = next(r for r in d.ranking if r.effect == "actuator_gain")
+    assert not gain.significant
 
 
 def test_greedy_finds_two_hidden_effects_in_order(tmp_path):
@@ -145,8 +145,8 @@ def test_greedy_finds_two_hidden_effects_in_order(tmp_path):
     bag = write_bag(tmp_path / "two", ARM_XML, hidden, duration=12.0, seed=7, payload_body="tool")
     plant, desc, ds = workbench.load(bag)
     steps = greedy(workbench.build_model(plant, desc), ds, plant.candidates(desc), max_steps=3)
-    assert [s["added"] for s in steps[1:]] == ["payload_mass", "joint_viscous_friction"], \
-        [(s["added"], s["error"]) for s in steps]
-    final = steps[2]["params"]
+    assert [s.added for s in steps[1:]] == ["payload_mass", "joint_viscous_friction"], \
+        [(s.added, s.error) for s in steps]
+    final = steps[2].params
     assert final["m"] == pytest.approx(1.0, rel=0.05)
     assert final["Fv[elbow]"] == pytest.approx(0.4, rel=0.10)

@@ -46,7 +46,7 @@ def test_urdf_on_a_remapped_joint_states_topic(tmp_path):
     plant, d, ds = workbench.load(bag)
     assert ds.channels == ("j1", "j2")
     assert not any("l1.stl" in w for w in ds.signals["load_warnings"])   # URDF visuals: ignored
-    nrmse = workbench.compare(ds, workbench.build_model(plant, d))["channels"]
+    nrmse = workbench.compare(ds, workbench.build_model(plant, d)).channels
     assert all(m["nrmse"] < 0.02 for m in nrmse.values()), nrmse
 
 
@@ -113,7 +113,7 @@ def test_csv_import_onto_the_models_joints(tmp_path, capsys):
     capsys.readouterr()
     plant, d, ds = workbench.load(str(tmp_path / "bag"))
     assert d.mjcf.model == ARM3.read_text() and ds.channels == tuple(joints)
-    nrmse = workbench.compare(ds, workbench.build_model(plant, d))["channels"]
+    nrmse = workbench.compare(ds, workbench.build_model(plant, d)).channels
     assert all(m["nrmse"] < 0.02 for m in nrmse.values()), nrmse
 
 
