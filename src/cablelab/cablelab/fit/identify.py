@@ -494,10 +494,10 @@ class _OuterProblem:
             b = ((ds2.y - self.y_known)[self.valid] * self.w[None, :]).reshape(-1)
             return b - self.q @ (self.q.T @ b)
         ev = self.model.evaluate(self.ds, values)
-        a = (ev.phi[self.valid] * self.w[None, :, None]).reshape(-1, ev.phi.shape[2])
         b = (ev.lhs[self.valid] * self.w[None, :]).reshape(-1)
-        if a.shape[1] == 0:            # a model of known parts only (a delay alone)
+        if ev.phi.shape[2] == 0:       # a model of known parts only (a delay alone)
             return b
+        a = (ev.phi[self.valid] * self.w[None, :, None]).reshape(-1, ev.phi.shape[2])
         # normal equations on scaled columns: cheap for the few parameters of an outer search
         sc = np.linalg.norm(a, axis=0)
         sc = np.where(sc > 0, sc, 1.0)
