@@ -2,6 +2,7 @@
 inputs, the in-process CLI result. Fixtures using them are in conftest.py."""
 from __future__ import annotations
 
+import functools
 import os
 import subprocess
 import uuid
@@ -11,6 +12,19 @@ import numpy as np
 import pytest
 
 REPO = Path(__file__).resolve().parents[2]
+
+
+@functools.lru_cache(maxsize=None)
+def toy_plant_dir() -> Path:
+    """The toy plant (test/plants/toy_pendulum: the template plus its law) built once per process;
+    the directory holds ``pendulum_plant/``."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location(
+        "cablelab_toy_builder", REPO / "test" / "plants" / "toy_pendulum" / "toy.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module.toy_dir()
 EMPS = REPO / "bags" / "emps"
 CDPR = REPO / "bags" / "cdpr_m1_reference"
 

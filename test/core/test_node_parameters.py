@@ -17,12 +17,11 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from robust_helpers import REPO
+from robust_helpers import REPO, toy_plant_dir
 
 EXAMPLES = int(os.environ.get("CABLELAB_FUZZ_EXAMPLES", "40"))
 FUZZ = settings(max_examples=EXAMPLES, deadline=None, derandomize=not os.environ.get("CABLELAB_FUZZ_RANDOM"),
                 suppress_health_check=list(HealthCheck))
-TOY = REPO / "test" / "plants" / "toy_pendulum"
 
 
 def _toy_specs():
@@ -31,11 +30,11 @@ def _toy_specs():
     from cablelab import effects, registry
 
     before = dict(effects._REGISTRY)
-    sys.path.insert(0, str(TOY))
+    sys.path.insert(0, str(toy_plant_dir()))
     try:
         return importlib.import_module("pendulum_plant.nodes.sim").PARAMETERS
     finally:
-        sys.path.remove(str(TOY))
+        sys.path.remove(str(toy_plant_dir()))
         registry._REGISTRY.pop("pendulum", None)
         effects._REGISTRY.clear()
         effects._REGISTRY.update(before)

@@ -22,9 +22,9 @@ from cablelab.errors import CablelabError
 from cablelab.plant_interface import (OPTIONAL_HOOKS, REQUIRED_ATTRIBUTES, REQUIRED_METHODS,
                                       DatasetOptions, PlantInterface, cli_options, missing_members)
 from cablelab.registry import available_plants, get_plant, register_plant
+from robust_helpers import toy_plant_dir
 
 PLANTS = ("axis", "cdpr", "crane", "leg", "suspended")
-TOY = Path(__file__).resolve().parents[1] / "plants" / "toy_pendulum"
 
 
 def test_the_five_plants_are_found():
@@ -77,7 +77,7 @@ def test_toy_plant_outside_cablelab_satisfies_the_interface():
     code = ("import pendulum_plant; from cablelab.registry import get_plant; "
             "from cablelab.plant_interface import PlantInterface, missing_members; "
             "p = get_plant('pendulum'); print(isinstance(p, PlantInterface), missing_members(p))")
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [str(TOY), os.environ.get("PYTHONPATH")]))}
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [str(toy_plant_dir()), os.environ.get("PYTHONPATH")]))}
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env,
                          timeout=300)
     assert out.returncode == 0, out.stderr

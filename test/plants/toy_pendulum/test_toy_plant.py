@@ -1,4 +1,4 @@
-"""A plant written in one folder (``pendulum_plant/`` next to this file) is found through the
+"""A plant written in one folder (``cablelab new-plant pendulum`` plus its law, :mod:`toy`) is found through the
 ``cablelab.plants`` entry-point group and works end to end with no edit outside its folder:
 ``cable_sim_node --plant pendulum`` simulates it, ``cablelab record --plant pendulum`` records it,
 ``cablelab diagnose`` finds the hidden hinge damping and ``cablelab report`` renders the report.
@@ -15,7 +15,7 @@ from pathlib import Path
 
 import pytest
 
-HERE = Path(__file__).resolve().parent
+from toy import LAW, build, toy_dir
 DAMPING = 0.05  # N m s/rad, hidden from the nominal model
 
 
@@ -26,7 +26,7 @@ def plant_env(tmp_path: Path) -> dict:
     dist.mkdir(parents=True)
     (dist / "METADATA").write_text("Metadata-Version: 2.1\nName: toy-pendulum\nVersion: 0.1\n")
     (dist / "entry_points.txt").write_text("[cablelab.plants]\npendulum = pendulum_plant\n")
-    path = os.pathsep.join([str(HERE), str(site), os.environ.get("PYTHONPATH", "")])
+    path = os.pathsep.join([str(toy_dir()), str(site), os.environ.get("PYTHONPATH", "")])
     return {"PYTHONPATH": path.rstrip(os.pathsep)}
 
 
@@ -79,3 +79,21 @@ def test_toy_plant_simulated_recorded_diagnosed_reported(launcher, tmp_path):
     assert res.returncode == 0, res.stderr
     html = (report / "index.html").read_text()
     assert "joint_viscous_friction" in html and list(report.glob("*.png"))
+
+
+def test_toy_plant_is_the_template_plus_its_law_and_its_tests_pass(tmp_path):
+    """Every file of the law differs from what the template writes (the rest is the template's,
+    by construction), and the toy's own tests (the template's, with the pendulum's closed form:
+    equilibrium angle and small-oscillation period) pass on the built package."""
+    from cablelab.plant_template import plant_files
+
+    template = plant_files("pendulum")
+    law = [str(p.relative_to(LAW)) for p in LAW.rglob("*") if p.is_file() and "__pycache__" not in p.parts]
+    assert law and all(rel in template and (LAW / rel).read_text() != template[rel] for rel in law), law
+    out = build(tmp_path / "toy")
+    res = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", str(out)],
+                         capture_output=True, text=True, cwd=out, timeout=600,
+                         env={**os.environ, "PYTHONPATH": os.pathsep.join(
+                             p for p in (str(out), os.environ.get("PYTHONPATH", "")) if p)})
+    assert res.returncode == 0, res.stdout[-3000:] + res.stderr[-2000:]
+    assert " passed" in res.stdout and "failed" not in res.stdout
