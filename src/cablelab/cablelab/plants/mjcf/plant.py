@@ -64,4 +64,11 @@ PLANT = Plant(
     capabilities=frozenset({"joint_actuators"}),
     topic_names=_topic_names,
     channels=EXAMPLE_JOINTS,
+    markers=lambda bag, desc: _bag_markers(bag, desc),
 )
+
+
+def _bag_markers(bag, desc):
+    from .markers import bag_markers
+
+    return bag_markers(bag, desc)

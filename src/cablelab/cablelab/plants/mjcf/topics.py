@@ -12,6 +12,7 @@ TOPICS = {
     "effort_commands": ("/mjcf/effort_commands", "std_msgs/msg/Float64MultiArray"),
     "payload_estimate": ("/mjcf/payload_estimate", "geometry_msgs/msg/InertiaStamped"),
     "ground_truth_joint_states": ("/mjcf/ground_truth/joint_states", JOINT_STATE),
+    "markers": ("/mjcf/markers", "visualization_msgs/msg/MarkerArray"),   # 3D view (addition)
 }
 
 

@@ -5,8 +5,9 @@ controls of ``effort_commands`` (model actuator order; a stale or missing comman
 and publishes, each period, ``joint_states`` (every hinge/slide joint: position, velocity,
 effort = the actuators' generalised force on it), ``cable_tensions`` (the description's
 ``tendons``), ``ground_truth/joint_states``, ``/clock`` and ``/plant_description`` (the model
-inline). Topic names follow the description's ``mjcf.topics``. Without ``description`` it runs
-the shipped three-joint arm (``plants/mjcf/examples/arm3.xml``).
+inline), and the 3D view ``markers`` (the model's geoms and tendons, :mod:`..markers`) on a
+wall-clock timer. Topic names follow the description's ``mjcf.topics``. Without ``description``
+it runs the shipped three-joint arm (``plants/mjcf/examples/arm3.xml``).
 """
 from __future__ import annotations
 
@@ -20,10 +21,12 @@ from ....description import load_description
 from ....errors import CablelabError
 from ....ros import convert
 from ....ros.clock import ClockPublisher
-from ....ros.params import DESCRIPTION, START_GATE, Param, merge
+from ....ros.markers import start_markers
+from ....ros.params import DESCRIPTION, START_GATE, Param, markers_rate, merge
 from ....ros.plant_node import PlantNode
 from ....ros.qos import publisher_qos, stream_qos
 from ..description import section_of
+from ..markers import sim_markers
 from ..mjcf import names
 from ..sim import Hidden, MjcfSim
 from ..topics import topic
@@ -37,6 +40,7 @@ PARAMETERS = merge((
     Param("payload_mass", 0.0, "mass the simulated truth carries on mjcf.payload_body, at its "
           "centre of mass (not in the published description: what an estimator must find)", "kg",
           ge=0.0, le=1e6),
+    markers_rate("/mjcf/markers: the model's geoms and tendons, tendons coloured by tension"),
 ), START_GATE)
 
 
@@ -79,6 +83,8 @@ class MjcfSimNode(PlantNode):
                                  stream_qos())
         self.start_diagnostics()
         self.timer = self.create_timer(self.period, self.tick)
+        start_markers(self, topic(sec, "markers"), lambda: sim_markers(self.sim), lambda: self.sim.t,
+                      v.markers_rate)
         self.publish_state()
 
     def extend_status(self, level, msg, values):
