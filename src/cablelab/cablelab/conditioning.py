@@ -229,7 +229,7 @@ def condition_motion(t: np.ndarray, q: np.ndarray, effort: np.ndarray,
     if n0 < need:
         raise CablelabError(f"{source}: only {n0} samples, need at least {need} "
                             f"(2 x border {opts.border} + 10)")
-    from .diagnose.checks import check_raw_series
+    from .datachecks import check_raw_series
 
     check_raw_series(t, source, position=q, effort=effort)
     sig = [q, effort] + ([qd] if qd is not None else [])

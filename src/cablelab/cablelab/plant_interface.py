@@ -18,10 +18,14 @@ from typing import TYPE_CHECKING, Any, Callable, Mapping, Protocol, runtime_chec
 from .errors import CablelabError
 
 if TYPE_CHECKING:
-    from .bags import Bag
     from .conditioning import Conditioning
     from .dataset import Dataset
-    from .description import Description
+
+#: what a plant's hooks receive: a :class:`cablelab.bags.Bag` and a
+#: :class:`cablelab.description.Description` (named here, not imported: the registry that checks
+#: plants against this interface sits below the bag reader and the description loader)
+Bag = Any
+Description = Any
 
 #: the verbs that read a recorded run of a plant and build its dataset
 WORKBENCH_VERBS = ("compare", "diagnose", "identify", "report", "estimate", "excite")

@@ -227,7 +227,7 @@ def diagnose(ds: Dataset, model: Model, candidates: Sequence[str], *, folds: int
              quiet: bool = True) -> Diagnosis:
     """Rank the missing effects (CONTRACT section 5 ``diagnose``); with ``greedy_mode`` also the
     waterfall of significant effects added one at a time. ``.to_json()`` is the contract JSON."""
-    from .diagnose.checks import check_dataset
+    from .datachecks import check_dataset
 
     from .diagnose import fold_indices
 

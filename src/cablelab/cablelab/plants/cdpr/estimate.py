@@ -7,6 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...errors import CablelabError
+from ...registry import get_plant
 from .dataset import CdprArrays, dataset_from_arrays, load_arrays
 from .topics import JOINT_STATES as JOINTS, PAYLOAD_ESTIMATE as ESTIMATE
 from .estimation import mass_com, mass_com_batch
@@ -61,9 +62,8 @@ def estimate_arrays(arr: CdprArrays, description, effects=(), params: dict | Non
     from ...model import Model
 
     c = description.cdpr
-    from .plant import baseline
-
-    effs = tuple(baseline(description)) + tuple(e for e in effects if e not in baseline(description))
+    baseline = get_plant("cdpr").baseline(description)
+    effs = tuple(baseline) + tuple(e for e in effects if e not in baseline)
     Model("cdpr", effs)                                         # validates the ids
     params = dict(params or {})
     need = []

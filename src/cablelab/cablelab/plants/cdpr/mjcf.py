@@ -3,8 +3,6 @@ winches on their swivel axes, real pulleys when the description has a sheave rad
 platform and its payload (:class:`~cablelab.plants.cdpr.sim.CdprTruth` the true parameters)."""
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import mujoco
 import numpy as np
 
@@ -12,8 +10,6 @@ from ...description import Description
 from ...errors import CablelabError
 from .geometry import matrix_to_quat, swivel_reference
 
-if TYPE_CHECKING:
-    from .sim import CdprTruth
 
 __all__ = ["FRICTION_SOLIMP", "RUN_LENGTH", "build_mjcf", "model_xml"]
 
@@ -35,7 +31,7 @@ def _fmt(v) -> str:
     return " ".join(f"{float(x):.9g}" for x in np.ravel(v))
 
 
-def model_xml(desc: Description, truth: "CdprTruth") -> str:
+def model_xml(desc: Description, truth) -> str:
     """MJCF text of the CDPR (cable limits still open; :class:`CdprSim` closes them)."""
     if desc.cdpr is None:
         raise CablelabError("plant description: no 'cdpr' section")
@@ -107,7 +103,7 @@ def model_xml(desc: Description, truth: "CdprTruth") -> str:
 </mujoco>"""
 
 
-def build_mjcf(desc: Description, truth: "CdprTruth") -> mujoco.MjModel:
+def build_mjcf(desc: Description, truth) -> mujoco.MjModel:
     """The compiled MuJoCo CDPR of :func:`model_xml` (cable limits still open; :class:`CdprSim`
     closes them)."""
     return mujoco.MjModel.from_xml_string(model_xml(desc, truth))

@@ -2,18 +2,14 @@
 built from a :class:`~cablelab.plants.crane.sim.CraneTruth`."""
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import mujoco
 import numpy as np
 
-if TYPE_CHECKING:
-    from .sim import CraneTruth
 
 __all__ = ["build_mjcf", "gravity_in_base", "model_xml"]
 
 
-def gravity_in_base(truth: CraneTruth) -> np.ndarray:
+def gravity_in_base(truth) -> np.ndarray:
     """(3,) gravity vector in the (tilted) crane base frame, m/s^2: R(tilt)^T [0, 0, -g]."""
     ex, ey = (float(v) for v in truth.base_tilt)
     cx, sx, cy, sy = np.cos(ex), np.sin(ex), np.cos(ey), np.sin(ey)
@@ -26,7 +22,7 @@ def _f(x) -> str:
     return " ".join(repr(float(v)) for v in np.atleast_1d(x))
 
 
-def model_xml(truth: CraneTruth, kp=(0.0, 0.0, 0.0), kd=(0.0, 0.0, 0.0)) -> str:
+def model_xml(truth, kp=(0.0, 0.0, 0.0), kd=(0.0, 0.0, 0.0)) -> str:
     """MJCF text of the crane (see :mod:`cablelab.plants.crane.sim` for the tree)."""
     p = truth.params
     lb, lc = p.boom_length, p.counterbalance_distance
@@ -84,6 +80,6 @@ def model_xml(truth: CraneTruth, kp=(0.0, 0.0, 0.0), kd=(0.0, 0.0, 0.0)) -> str:
 """
 
 
-def build_mjcf(truth: CraneTruth, kp=(0.0, 0.0, 0.0), kd=(0.0, 0.0, 0.0)) -> mujoco.MjModel:
+def build_mjcf(truth, kp=(0.0, 0.0, 0.0), kd=(0.0, 0.0, 0.0)) -> mujoco.MjModel:
     """Compiled MuJoCo model of the crane (actuators: motors, or PD servos with gains kp, kd)."""
     return mujoco.MjModel.from_xml_string(model_xml(truth, kp, kd))

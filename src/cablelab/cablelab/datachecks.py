@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import CablelabError
+from .errors import CablelabError
 
 #: fewest usable (valid, moving) samples for a diagnosis
 MIN_SAMPLES = 500
