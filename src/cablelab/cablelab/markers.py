@@ -53,6 +53,13 @@ def line(ns: str, id: int, points, colour, width: float = 0.02) -> Marker:
                   points=pts)
 
 
+def stamp_parts(t) -> tuple[np.ndarray, np.ndarray]:
+    """(sec, nanosec) of times ``t`` (s), rounded to the nanosecond: a time a hair below a whole
+    second (0.005 added 400 times) is that second, not the second before with 0 ns."""
+    ns = np.round(np.asarray(t, dtype=float).reshape(-1) * 1e9).astype(np.int64)
+    return ns // 1_000_000_000, ns % 1_000_000_000
+
+
 def marker_array_cdr(markers: list[Marker], t: float, frame_id: str = "world") -> bytes:
     """The serialised visualization_msgs/MarkerArray (CDR, as on the wire and in a bag) of
     ``markers`` stamped ``t`` (s). Every marker is ADD with no lifetime (replaced by the next
@@ -68,8 +75,8 @@ def _message(markers: list[Marker], t: float, frame_id: str = "world"):
 
     ts = cdr.typestore()
     g = ts.types
-    sec = int(np.floor(t))
-    stamp = g["builtin_interfaces/msg/Time"](sec=sec, nanosec=int(round((t - sec) * 1e9)) % 1_000_000_000)
+    sec, nsec = stamp_parts([t])
+    stamp = g["builtin_interfaces/msg/Time"](sec=int(sec[0]), nanosec=int(nsec[0]))
 
     def colour(c):
         return g["std_msgs/msg/ColorRGBA"](r=float(c[0]), g=float(c[1]), b=float(c[2]), a=float(c[3]))
@@ -146,8 +153,7 @@ class MarkerEncoder:
         mat = np.empty((n, self.base.size), dtype=np.uint8)
         mat[:] = self.base
         vals = [self.values(f) for f in frames]
-        sec = np.floor(t)
-        nsec = np.round((t - sec) * 1e9) % 1_000_000_000
+        sec, nsec = stamp_parts(t)
         k = len(self.idx["sec"]) // 4
         for name, arr, dt in (("f8", np.array([v[0] for v in vals]), "<f8"),
                               ("f4", np.array([v[1] for v in vals]), "<f4"),
@@ -184,4 +190,5 @@ def write_markers(writer, topic: str, t, frames) -> None:
 
 
 __all__ = ["CUBE", "CYLINDER", "LINE_LIST", "LINE_STRIP", "MARKER_ARRAY", "Marker", "MarkerEncoder", "RATE_HZ", "SPHERE",
-           "SPHERE_LIST", "decimate_times", "line", "marker_array_cdr", "tension_colour", "write_markers"]
+           "SPHERE_LIST", "decimate_times", "line", "marker_array_cdr", "stamp_parts", "tension_colour",
+           "write_markers"]

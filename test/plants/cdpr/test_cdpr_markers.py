@@ -13,7 +13,7 @@ from hypothesis import given, settings, strategies as st
 from rosbags.typesys import Stores, get_typestore
 from scipy.spatial.transform import Rotation
 
-from cablelab.markers import LINE_STRIP, MarkerEncoder, marker_array_cdr
+from cablelab.markers import LINE_STRIP, Marker, MarkerEncoder, marker_array_cdr
 from cablelab.plants.cdpr.markers import cdpr_markers
 from cablelab.plants.cdpr.sim import default_description, default_description_path
 
@@ -121,3 +121,23 @@ def test_simulator_node_publishes_the_machine(launcher, tmp_path):
             np.testing.assert_allclose(cables[i + 1][0][0], A[i], atol=1e-12)
             np.testing.assert_allclose(cables[i + 1][0][1], gt.position[j] + rot.apply(B[i]), atol=1e-6)
     assert matched >= 10
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(1, 100_000), st.sampled_from([0.001, 0.002, 0.005, 0.01, 1.0 / 30.0]))
+def test_marker_stamps_are_the_time_to_the_nanosecond(k, dt):
+    """A simulator's clock is a sum of steps (k steps of dt: a hair below a whole second when
+    the steps add up to one): both serialisers stamp it with the time rounded to the nanosecond
+    (oracle: Python's exact integer arithmetic on the float), never a second early."""
+    from cablelab import cdr
+
+    t = 0.0
+    for _ in range(k % 2000):
+        t += dt
+    t += (k // 2000) * 1.0
+    ns = round(t * 1e9)
+    frame = [Marker(1, "box", 0)]
+    for data in (marker_array_cdr(frame, t), MarkerEncoder(frame).encode([t], [frame])[0]):
+        msg = cdr.typestore().deserialize_cdr(data, "visualization_msgs/msg/MarkerArray")
+        stamp = msg.markers[0].header.stamp
+        assert stamp.sec * 1_000_000_000 + stamp.nanosec == ns and 0 <= stamp.nanosec < 1_000_000_000

@@ -145,10 +145,10 @@ class RecorderNode(Node):
         if transient and any(i.qos_profile.durability == DurabilityPolicy.VOLATILE for i in infos):
             transient = False
         if (reliable, transient) != self.sub_qos[topic]:
-            # a volatile stream is normal for a third-party publisher (the recorder only asks
-            # for transient-local to get what it missed by matching late); anything else is
-            # less than the contract asks
-            log = (self.get_logger().info if reliable and topic != "/plant_description"
+            # a volatile stream is normal (a third-party driver, the simulators' keep-last-1 3D
+            # view: the recorder only asks for transient-local to get what it missed by matching
+            # late); anything else is less than the contract asks
+            log = (self.get_logger().debug if reliable and topic != "/plant_description"
                    else self.get_logger().warning)
             log(f"{topic}: a publisher offers {'best-effort' if not reliable else 'volatile'} "
                 "QoS; recording it with that QoS")
