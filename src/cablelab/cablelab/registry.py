@@ -14,6 +14,7 @@ from __future__ import annotations
 import importlib
 import importlib.util
 import pkgutil
+from typing import Callable
 
 from .errors import CablelabError
 from .plant_interface import Plant, PlantInterface, missing_members
@@ -24,6 +25,17 @@ ENTRY_POINT_GROUP = "cablelab.plants"
 BUILTIN_PACKAGE = "cablelab.plants"
 
 _REGISTRY: dict[str, PlantInterface] = {}
+
+
+def lazy_hook(module: str, name: str) -> Callable:
+    """A plant hook that imports ``module`` only when first called and calls its ``name`` (for
+    hooks whose module is heavy, e.g. the 3D markers with MuJoCo, not needed at registration)."""
+
+    def hook(*args, **kwargs):
+        return getattr(importlib.import_module(module), name)(*args, **kwargs)
+
+    hook.__qualname__ = f"{module}.{name}"
+    return hook
 
 
 def register_plant(plant: PlantInterface) -> PlantInterface:
@@ -119,5 +131,5 @@ def plant_module(name: str, module: str):
     return importlib.import_module(f"{plant.package}.{module}")
 
 
-__all__ = ["ENTRY_POINT_GROUP", "Plant", "PlantInterface", "available_plants", "get_plant", "plant_module",
-           "plant_packages", "register_plant"]
+__all__ = ["ENTRY_POINT_GROUP", "Plant", "PlantInterface", "available_plants", "get_plant", "lazy_hook",
+           "plant_module", "plant_packages", "register_plant"]

@@ -7,7 +7,7 @@ tries.
 """
 from __future__ import annotations
 
-from ...registry import Plant
+from ...registry import Plant, lazy_hook
 from . import topics
 from .dataset import JOINT_STATE, TOPIC, dataset
 from .description import parse_section
@@ -49,11 +49,5 @@ PLANT = Plant(
     capabilities=frozenset({"joint_actuators"}),
     channels=("joint",),
     topic_names=lambda desc: {TOPIC: ["joint"], topics.GROUND_TRUTH: ["joint"]},
-    markers=lambda bag, desc: _bag_markers(bag, desc),
+    markers=lazy_hook(f"{__package__}.markers", "bag_markers"),
 )
-
-
-def _bag_markers(bag, desc):
-    from .markers import bag_markers
-
-    return bag_markers(bag, desc)

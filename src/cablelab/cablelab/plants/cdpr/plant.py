@@ -8,7 +8,7 @@ estimate``), :mod:`.options` holds the plant's own options (``--tensions``, ``--
 """
 from __future__ import annotations
 
-from ...registry import Plant
+from ...registry import Plant, lazy_hook
 from . import topics
 from .dataset import CHANNELS, check_bag, dataset, remeasure
 from .topics import (CABLE_TENSIONS as TENSIONS, JOINT_STATE, JOINT_STATES as JOINTS,
@@ -52,15 +52,9 @@ PLANT = Plant(
     check_bag=check_bag,
     channels=CHANNELS,
     topic_names=lambda desc: _topic_names(desc),
-    markers=lambda bag, desc: _bag_markers(bag, desc),
+    markers=lazy_hook(f"{__package__}.markers", "bag_markers"),
     options_type=CdprOptions,
 )
-
-
-def _bag_markers(bag, desc):
-    from .markers import bag_markers
-
-    return bag_markers(bag, desc)
 
 
 def _topic_names(desc) -> dict:

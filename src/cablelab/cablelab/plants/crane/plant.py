@@ -11,7 +11,7 @@ Modules next to this one: :mod:`.kinematics` (boom tip, payload, exact swing ang
 """
 from __future__ import annotations
 
-from ...registry import Plant
+from ...registry import Plant, lazy_hook
 from . import topics
 from .dataset import JOINTS, check_bag, dataset
 from .topics import JOINT_STATE, JOINT_STATES, PAYLOAD_POSE, POSE, TIP_POSE
@@ -50,13 +50,7 @@ PLANT = Plant(
     estimate=estimate_bag,
     check_bag=check_bag,
     channels=JOINTS,
-    markers=lambda bag, desc: _bag_markers(bag, desc),
+    markers=lazy_hook(f"{__package__}.markers", "bag_markers"),
     topic_names=lambda desc: {JOINT_STATES: list(JOINTS), **{t: ["theta1", "theta2", "rope_length"] for t in
                                                           (topics.SWING_ESTIMATE, topics.SWING_TRUTH)}},
 )
-
-
-def _bag_markers(bag, desc):
-    from .markers import bag_markers
-
-    return bag_markers(bag, desc)

@@ -2,7 +2,7 @@
 :class:`Plant` record the registry holds."""
 from __future__ import annotations
 
-from ...registry import Plant
+from ...registry import Plant, lazy_hook
 from . import effects, topics
 from .dataset import check_bag, dataset
 from .description import parse_section
@@ -35,11 +35,5 @@ PLANT = Plant(
     topic_names=lambda desc: {topics.JOINT_STATES: ["body", "motor"], topics.CONTACT: ["contact"],
                               **{t: ["height", "phase", "apex_height", "grf"] for t in
                                  (topics.HOP_ESTIMATE, topics.GROUND_TRUTH)}},
-    markers=lambda bag, desc: _bag_markers(bag, desc),
+    markers=lazy_hook(f"{__package__}.markers", "bag_markers"),
 )
-
-
-def _bag_markers(bag, desc):
-    from .markers import bag_markers
-
-    return bag_markers(bag, desc)

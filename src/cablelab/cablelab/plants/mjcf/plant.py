@@ -6,7 +6,7 @@ time delay on the model's joints.
 """
 from __future__ import annotations
 
-from ...registry import Plant
+from ...registry import Plant, lazy_hook
 from .dataset import dataset
 from .description import dump_section, parse_section
 from .topics import TOPICS, contract_topics, topic
@@ -64,11 +64,5 @@ PLANT = Plant(
     capabilities=frozenset({"joint_actuators"}),
     topic_names=_topic_names,
     channels=EXAMPLE_JOINTS,
-    markers=lambda bag, desc: _bag_markers(bag, desc),
+    markers=lazy_hook(f"{__package__}.markers", "bag_markers"),
 )
-
-
-def _bag_markers(bag, desc):
-    from .markers import bag_markers
-
-    return bag_markers(bag, desc)

@@ -2,7 +2,7 @@
 and the :class:`Plant` record the registry holds."""
 from __future__ import annotations
 
-from ...registry import Plant
+from ...registry import Plant, lazy_hook
 from . import effects, topics
 from .dataset import CHANNELS as _CHANNELS, dataset
 from .description import parse_section
@@ -36,11 +36,5 @@ PLANT = Plant(
     channels=_CHANNELS,
     topic_names=lambda desc: {t: ["swing_x", "swing_y", "yaw", "r_x", "r_y"] for t in
                               (topics.SWING_ESTIMATE, topics.GROUND_TRUTH_SWING)},
-    markers=lambda bag, desc: _bag_markers(bag, desc),
+    markers=lazy_hook(f"{__package__}.markers", "bag_markers"),
 )
-
-
-def _bag_markers(bag, desc):
-    from .markers import bag_markers
-
-    return bag_markers(bag, desc)
