@@ -72,15 +72,15 @@ from __future__ import annotations
 
 from cablelab.registry import Plant
 
-from . import topics
+from . import effects, topics
 from .dataset import dataset
 from .description import dump_section, parse_section
 from .mjcf import JOINT
 
 
 def baseline(description) -> tuple[str, ...]:
-    """Effect ids of the nominal model (:mod:`.effects`)."""
-    return ("NAME_inertia",)
+    """Effect ids of the nominal model (:data:`.effects.NOMINAL`)."""
+    return effects.NOMINAL
 
 
 def candidates(description) -> tuple[str, ...]:
@@ -173,6 +173,9 @@ import numpy as np
 
 from cablelab.effects import register
 from cablelab.effects.base import Effect, Param
+
+#: the effect ids of the nominal model (the plant's ``baseline``)
+NOMINAL = ("NAME_inertia",)
 
 register(Effect(
     id="NAME_inertia", plants=("NAME",),

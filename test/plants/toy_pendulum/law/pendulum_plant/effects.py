@@ -7,6 +7,9 @@ import numpy as np
 from cablelab.effects import register
 from cablelab.effects.base import Effect, Param
 
+#: the effect ids of the nominal model (the plant's ``baseline``)
+NOMINAL = ("pendulum_inertia", "pendulum_gravity")
+
 register(Effect(
     id="pendulum_inertia", plants=("pendulum",),
     params=(Param("I", "kg m^2", 0.0, 0.0, np.inf, "inertia about the hinge"),),
