@@ -1,7 +1,9 @@
-"""The simulators of the axis, the leg and the suspended platform publish their 3D view (real
-processes over DDS): recorded beside the simulator's own truth topic, each MarkerArray draws the
-machine at the truth of its stamp (axis: the link's load at the true joint angle; leg: the body
-at the true height; suspended: CRANEbot's rope ending at the platform's attachment point)."""
+"""The simulators of the axis, the leg, the suspended platform and any MuJoCo model publish their
+3D view (real processes over DDS): recorded beside the simulator's own truth topic, each
+MarkerArray draws the machine at the truth of its stamp (axis: the link's load at the true joint
+angle; leg: the body at the true height; suspended: CRANEbot's rope ending at the platform's
+attachment point; mjcf, the four-cable camera robot: its carriage box at the true slide joints,
+at (0, 0, 3) m when they are 0)."""
 import sys
 import time
 
@@ -31,11 +33,18 @@ def _suspended(by, bag, j):
     return np.array([end.x, end.y, end.z]), pose.position[j]
 
 
+def _mjcf(by, bag, j):
+    xyz = bag.joint_state("/mjcf/ground_truth/joint_states", ["x", "y", "z"]).position[j]
+    p = by["geoms/box"].pose.position
+    return np.array([p.x, p.y, p.z]), np.array([0.0, 0.0, 3.0]) + xyz
+
+
 CASES = {
     "axis": ({"markers_rate": 30.0}, "/axis/ground_truth/joint_states", _axis),
     "leg": ({"rate": 200.0, "markers_rate": 30.0}, "/leg/ground_truth/state", _leg),
     "suspended": ({"variant": "cranebot", "start_swing_x": 0.2, "markers_rate": 30.0},
                   "/suspended/platform_pose", _suspended),
+    "mjcf": ({"rate": 100.0, "markers_rate": 30.0}, "/mjcf/ground_truth/joint_states", _mjcf),
 }
 
 
@@ -47,6 +56,13 @@ def test_simulator_publishes_the_machine_at_its_truth(plant, launcher, tmp_path)
     if plant == "axis":                       # a revolute axis with a gravity load (a 1 m link)
         (tmp_path / "axis.yaml").write_text(AXIS)
         params = {**params, "description": str(tmp_path / "axis.yaml")}
+    if plant == "mjcf":                       # the four-cable camera robot (spatial tendons)
+        from cablelab.plants.mjcf.examples import CABLECAM
+        from cablelab.plants.mjcf.sim import description_yaml
+
+        (tmp_path / "cam.yaml").write_text(description_yaml(
+            CABLECAM.read_text(), tendons=[f"cable_{i}" for i in range(1, 5)], payload_body="carriage"))
+        params = {**params, "description": str(tmp_path / "cam.yaml")}
     bag_dir = tmp_path / "markers"
     launcher.start("recorder", [sys.executable, "-m", "cablelab.cli", "record", "-o", bag_dir, "--quiet",
                                 "--topics", f"/{plant}/markers,{truth}"])
@@ -69,6 +85,8 @@ def test_simulator_publishes_the_machine_at_its_truth(plant, launcher, tmp_path)
         if abs(series.t[j] - stamp) > 1e-6:
             continue
         matched += 1
-        got, want = check({m.ns: m for m in msg.markers}, bag, j)
+        by = {m.ns: m for m in msg.markers}
+        by.update({f"{m.ns}/box": m for m in msg.markers if m.type == 1})     # (CUBE)
+        got, want = check(by, bag, j)
         np.testing.assert_allclose(got, want, atol=1e-6)
     assert matched >= 10

@@ -3,23 +3,19 @@
 Oracle: the four-cable camera robot's geometry in closed form. Its carriage (a box on three slide
 joints along world x, y, z, at (0, 0, 3) m when the joints are 0) is drawn at (x, y, 3 + z) of the
 recorded joints; each cable is drawn from its winch site (fixed in the XML) to the carriage's hook
-(the carriage's origin), over its pulley."""
+(the carriage's origin), over its pulley. (The simulator's live 3D view over DDS:
+test/core/test_sim_markers_live.py.)"""
 from __future__ import annotations
-
-import sys
-import time
 
 import numpy as np
 import pytest
-from rosbags.typesys import Stores, get_typestore
 
 from cablelab.bags import open_bag
 from cablelab.markers import CUBE, LINE_LIST
 from cablelab.plants.mjcf.examples import CABLECAM
-from cablelab.plants.mjcf.sim import Hidden, description_yaml, write_bag
+from cablelab.plants.mjcf.sim import Hidden, write_bag
 from cablelab.registry import get_plant
 
-TS = get_typestore(Stores.ROS2_JAZZY)
 CABLES = ["cable_1", "cable_2", "cable_3", "cable_4"]
 WINCH = np.array([[-6, -4, 0.2], [6, -4, 0.2], [6, 4, 0.2], [-6, 4, 0.2]], float)
 START = np.array([0.0, 0.0, 3.0])
@@ -75,37 +71,3 @@ def test_cables_coloured_by_the_recorded_tensions(cam_bag):
     red = np.array([m.colour[0] for m in cables])
     order = np.argsort(tension)
     assert np.all(np.diff(red[order]) >= -1e-12), (tension, red)
-
-
-def test_simulator_publishes_the_model_live(launcher, tmp_path):
-    """``cable_sim_node --plant mjcf`` publishes ``/mjcf/markers`` (real processes over DDS): each
-    array draws the carriage at the simulator's true joints of its stamp."""
-    desc = tmp_path / "cam.yaml"
-    desc.write_text(description_yaml(CABLECAM.read_text(), tendons=CABLES, payload_body="carriage"))
-    bag_dir = tmp_path / "markers"
-    launcher.start("recorder", [sys.executable, "-m", "cablelab.cli", "record", "-o", bag_dir, "--quiet",
-                                "--topics", "/mjcf/markers,/mjcf/ground_truth/joint_states"])
-    launcher.node("sim", "cable_sim_node", "mjcf", {"description": str(desc), "rate": 100.0,
-                                                    "markers_rate": 30.0, "wait_for_subscribers": 1})
-    deadline = time.monotonic() + 15
-    while launcher.procs["sim"].alive() and time.monotonic() < deadline:
-        time.sleep(0.5)
-    time.sleep(1.0)
-    launcher.stop_all()
-    bag = open_bag(bag_dir)
-    truth = bag.joint_state("/mjcf/ground_truth/joint_states", ["x", "y", "z"])
-    _, raws = bag.raw("/mjcf/markers")
-    assert len(raws) >= 20
-    matched = 0
-    for raw in raws:
-        msg = TS.deserialize_cdr(raw, "visualization_msgs/msg/MarkerArray")
-        assert all(m.header.frame_id == "world" for m in msg.markers)
-        stamp = msg.markers[0].header.stamp.sec + 1e-9 * msg.markers[0].header.stamp.nanosec
-        j = int(np.argmin(np.abs(truth.t - stamp)))
-        if abs(truth.t[j] - stamp) > 1e-6:
-            continue
-        box = [m for m in msg.markers if m.ns == "geoms" and m.type == 1]
-        p = box[0].pose.position
-        np.testing.assert_allclose([p.x, p.y, p.z], START + truth.position[j], atol=1e-6)
-        matched += 1
-    assert matched >= 10
