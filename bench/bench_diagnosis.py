@@ -31,7 +31,7 @@ from collections import Counter
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from diagnosis_cases import TRUE_PARAM, draw_case, simulate, write_bag  # noqa: E402
+from diagnosis_cases import TRUE_PARAM, draw_case, write_bag  # noqa: E402
 from harness import Bench  # noqa: E402
 from cases_common import rel_param_error  # noqa: E402
 
