@@ -50,7 +50,7 @@ def run(args) -> int:
     from ..atomic import atomic_output, check_target
     from ..bagcheck import check_bag
     from ..bags import open_bag
-    from ..model import parse_effect_list
+    from ..effect_spec import parse_effect_list
     from ..plant_interface import DatasetOptions
     from ..registry import available_plants, get_plant
     from ..workbench import load_bag_description
