@@ -122,6 +122,9 @@ def sysid_fit(xml: str, t, q, effort, joints, *, payload_body: str | None = None
     start = time.perf_counter()
     model0 = spec.compile()
     dt = float(model0.opt.timestep)
+    if abs(float(np.median(np.diff(t))) - dt) > 1e-3 * dt:
+        raise ValueError(f"the record is sampled every {np.median(np.diff(t)):g} s, the model steps "
+                         f"{dt:g} s: rollouts pair one sample with one step")
     qd = initial_velocity(q, dt)
     n = max(2, int(round(window / dt)))
     inits, ctrls, sens = [], [], []
@@ -130,11 +133,14 @@ def sysid_fit(xml: str, t, q, effort, joints, *, payload_body: str | None = None
         s0[0] = t[k]
         inits.append(s0)
         ctrls.append(sysid.TimeSeries(t[k:k + n], effort[k:k + n]))
-        # a rollout's position sensor holds the state a step starts from, stamped at its end
-        sens.append(sysid.TimeSeries.from_names(t[k:k + n] + dt, q[k:k + n], model0))
+        # step i's position sensor holds the state the step starts from, q[k + i]; sysid drops
+        # the first measured row and pairs the rest with the n - 1 steps
+        sens.append(sysid.TimeSeries.from_names(t[k:k + n], q[k - 1:k + n - 1], model0))
     seqs = sysid.ModelSequences("record", spec, [f"w{i}" for i in range(len(inits))], inits,
                                 ctrls, sens)
-    residual_fn = sysid.build_residual_fn(models_sequences=[seqs])
+    # the samples are the model's steps already: no resampling (resampling a window whose stamps
+    # span 249.0000001 steps stretches it to 251 samples and shifts the controls by up to a step)
+    residual_fn = sysid.build_residual_fn(models_sequences=[seqs], resample_true=False)
     evals = [0]
 
     def counted(x, p, **kw):
