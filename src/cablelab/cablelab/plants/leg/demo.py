@@ -37,7 +37,6 @@ def run(out_dir: Path, quick: bool = False) -> dict:
 
     from ...description import load_description
     from ...workbench import build_model, diagnose, load
-    from . import LEG  # noqa: F401  (plant registered)
     from .description import leg_of
     from .hybrid import LegParams
     from .identify import apex_errors, record_from_trajectory, simulate_strides, stride_segments
