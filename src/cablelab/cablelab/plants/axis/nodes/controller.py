@@ -29,6 +29,7 @@ from ....ros import convert
 from ....ros.params import Param
 from ....ros.plant_node import PlantNode
 from ....ros.qos import publisher_qos, stream_qos
+from ....ros.reference import ReferencePlayer, reference_bag_param
 
 
 PARAMETERS = (
@@ -43,8 +44,7 @@ PARAMETERS = (
     Param("frequency", 0.5, "frequency of the built-in sine", "Hz", gt=0.0, le=1e3),
     Param("offset", 0.0, "offset of the built-in sine", "m or rad", ge=-1e3, le=1e3),
     Param("reference_timeout", 0.5, "a reference older than this is stale", "s wall", gt=0.0),
-    Param("reference_bag", "", "a reference bag written by `cablelab excite`: played from the first "
-          "joint state on and published on /axis/reference (overrides reference_source)"),
+    reference_bag_param(topics.REFERENCE),
 )
 
 
@@ -60,11 +60,10 @@ class AxisController(PlantNode):
         self.amplitude = v.amplitude
         self.frequency = v.frequency
         self.offset = v.offset
-        self.play = self.t0 = None
+        self.player = None
         if v.reference_bag:
-            from ....excite import read_reference
-
-            self.play, self.source = read_reference(v.reference_bag, topics.REFERENCE, ["joint"]), "bag"
+            self.player = ReferencePlayer.from_bag(self, v.reference_bag, topics.REFERENCE, ["joint"])
+            self.source = "bag"
         self.ref = None  # (q, qd, qdd) from the topic
         self.inputs.add("joint_states", timeout=0.5, length=1)
         self.inputs.add("reference", timeout=v.reference_timeout, length=1,
@@ -72,7 +71,7 @@ class AxisController(PlantNode):
 
         self.pub_cmd = self.create_publisher(Float64MultiArray, topics.EFFORT_COMMAND, publisher_qos())
         self.pub_ref = self.create_publisher(JointTrajectory, topics.REFERENCE, publisher_qos()) \
-            if self.source in ("sine", "bag") else None
+            if self.source == "sine" else None
         self.create_subscription(JointState, topics.JOINT_STATES, self.on_state, stream_qos())
         if self.source == "topic":
             self.create_subscription(JointTrajectory, topics.REFERENCE, self.on_reference, stream_qos())
@@ -100,12 +99,11 @@ class AxisController(PlantNode):
             return
         if qd is None or qd.size != q.size or not np.isfinite(qd).all():
             qd = np.zeros_like(q)
-        if self.source in ("sine", "bag"):
-            if self.play is not None:
-                self.t0 = t if self.t0 is None else self.t0
-            q_ref, qd_ref, qdd_ref = (float(np.ravel(v)[0]) for v in (
-                self.play(t - self.t0) if self.play is not None else
-                sine_reference(t, self.amplitude, self.frequency, self.offset)))
+        if self.player is not None:
+            q_ref, qd_ref, qdd_ref = (float(x[0]) for x in self.player(t, q))
+        elif self.source == "sine":
+            q_ref, qd_ref, qdd_ref = (float(v) for v in sine_reference(t, self.amplitude, self.frequency,
+                                                                        self.offset))
             self.pub_ref.publish(convert.joint_trajectory_msg(t, ["joint"], [q_ref], [qd_ref], [qdd_ref]))
         elif self.ref is not None and self.inputs.fresh("reference", now):
             q_ref, qd_ref, qdd_ref = self.ref
