@@ -169,24 +169,25 @@ def dataset_from_arrays(t, pos, quat_wxyz, desc_section, description=None, optio
     return _without_rests(ds, rest)
 
 
-#: fewest moving samples for which a record is cut to its moving span (5 folds of 50 and a margin)
-MIN_MOVING = 300
-
-
 def _without_rests(ds: Dataset, rest: np.ndarray) -> Dataset:
     """The record cut to its moving span (a platform that dry friction stopped stays stopped:
     the tail would make whole cross-validation folds of stiction and noise) and the rests inside
     it marked not valid (not fitted, not scored, the same for every candidate); the share left
-    out is kept as the signal ``rest_share``."""
-    if not rest.any():
-        return ds.replace(signals={**ds.signals, "rest_share": 0.0})
+    out is kept as the signal ``rest_share``. A moving span shorter than the samples a diagnosis
+    needs (:data:`cablelab.datachecks.MIN_SAMPLES`) keeps the first rest samples after it, valid,
+    up to that count."""
+    from ...datachecks import MIN_SAMPLES
+
     moving = np.flatnonzero(~rest)
-    if moving.size < MIN_MOVING:
+    if not rest.any() or moving.size == 0:
         return ds.replace(signals={**ds.signals, "rest_share": 0.0})
-    span = np.arange(moving[0], moving[-1] + 1)
+    first, last = int(moving[0]), int(moving[-1]) + 1
+    end = min(max(last, first + MIN_SAMPLES), ds.n)
+    span = np.arange(first, end)
     out = ds.subset(span)
-    return out.replace(valid=out.valid & ~rest[span],
-                       signals={**out.signals, "rest_share": float(rest.mean())})
+    inside = rest[span] & (span < last)
+    return out.replace(valid=out.valid & ~inside,
+                       signals={**out.signals, "rest_share": 1.0 - float(np.sum(out.valid & ~inside)) / ds.n})
 
 
 def radial_mass(p: VirtualParams) -> float:
