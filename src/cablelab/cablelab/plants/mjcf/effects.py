@@ -139,16 +139,17 @@ def _moving_bodies(model) -> list[int]:
 
 def _link_columns(ds: Dataset) -> np.ndarray:
     """(N, C, 10 n_bodies) columns of every moving body's standard inertial parameters
-    (:func:`.inverse.inertial_columns`), computed once per dataset from its q, qd, qdd."""
+    (:func:`.inverse.body_columns`), computed once per dataset from its q, qd, qdd (one inverse
+    dynamics pass for all bodies)."""
     if LINK_COLUMNS not in ds.signals:
         from .description import section_of
-        from .inverse import inertial_columns, inverse_dynamics
+        from .inverse import body_columns, inverse_record
 
         model = section_of(ds.description).compiled(ds.gravity)
         q, qd, qdd = (ds.require_signal(k) for k in ("q", "qd", "qdd"))
-        base = inverse_dynamics(model, q, qd, qdd)
+        rec = inverse_record(model, q, qd, qdd)
         ds.signals[LINK_COLUMNS] = np.concatenate(
-            [inertial_columns(model, b, q, qd, qdd, base=base) for b in _moving_bodies(model)], axis=2)
+            [body_columns(model, rec, b) for b in _moving_bodies(model)], axis=2)
     return ds.signals[LINK_COLUMNS]
 
 
