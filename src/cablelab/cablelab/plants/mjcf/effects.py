@@ -43,8 +43,8 @@ PAYLOAD_MASS = register(Effect(
             Param("mcz", "kg m", 0.0, -np.inf, np.inf, "its first moment about the body's centre of mass, z")),
     explanation="an unknown payload on payload_body: the arm carries more mass than its model",
     signature="residual follows the gravity and inertia load of the payload body",
-    reference="CONTRACT sec. 4 (mjcf); columns: mj_inverse differences in the body's standard "
-              "inertial parameters",
+    reference="CONTRACT sec. 4 (mjcf); columns: MuJoCo's Newton-Euler terms (cdof, cvel, cacc) per "
+              "standard inertial parameter of the body, equal to mj_inverse differences",
     regressor=_payload,
     physical=_payload_physical,
 ))
