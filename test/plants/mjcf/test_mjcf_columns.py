@@ -23,7 +23,8 @@ TOOL = 4
 @pytest.fixture(scope="module")
 def tool_columns():
     model, _ = load_model(ARM_XML)
-    return model, inverse_dynamics(model, Q, QD, QDD), body_columns(model, inverse_record(model, Q, QD, QDD), TOOL)
+    cols = body_columns(model, inverse_record(model, Q, QD, QDD), TOOL)
+    return model, inverse_dynamics(model, Q, QD, QDD), cols
 
 
 _INERTIAL_FIELDS = ("body_mass", "body_ipos", "body_inertia", "body_iquat", "body_sameframe")
