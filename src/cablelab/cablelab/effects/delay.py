@@ -4,8 +4,9 @@ Convention: the effort the model computes from the motion at time t appears in t
 at t + tau, i.e. ``y_meas(t) = y_model(t - tau)``. The effect evaluates the model on the motion
 signals shifted to ``t - tau`` (linear interpolation of every time-indexed signal, actuator
 velocity and map; a signal is interpolated when first read, :class:`ShiftedSignals`); samples
-whose shifted time leaves the record or crosses a gap of the time axis are marked invalid. The measurement itself is never interpolated: interpolating a noisy signal
-at a fractional shift averages neighbouring samples and would "explain" white noise as a delay.
+whose shifted time leaves the record or crosses a gap of the time axis are marked invalid. The
+measurement itself is never interpolated: interpolating a noisy signal at a fractional shift
+averages neighbouring samples and would "explain" white noise as a delay.
 When a plant's output channels are raw measurements mapped through a motion-dependent matrix
 (the CDPR's wrench ``W(pose(t)) t_meas(t)``), shifting the motion alone would also shift that
 map: the plant's ``remeasure`` hook (:class:`cablelab.registry.Plant`) then keeps the raw
