@@ -259,12 +259,16 @@ class MjcfSim:
         self._mujoco.mj_step(self.model, self.data, nstep=n)
 
     def state(self):
-        """``(t, q (nv,), qd (nv,), effort (nv,) = qfrc_actuator, tension (n_tendons,))``: the
-        tension of a measured tendon is the pull of the actuators on it (N, >= 0 when pulling)."""
+        """``(t, q (nv,), qd (nv,), effort (nv,), tension (n_tendons,))``: ``effort`` is the
+        generalised force of the joint actuators (what a joint's own motor current measures; the
+        tendon actuators' pull reaches the joints through the measured tensions, so it is not
+        counted twice); the tension of a measured tendon is the pull of the actuators on it (N,
+        >= 0 when pulling)."""
         m, d = self.model, self.data
+        on_joint = m.actuator_trntype == 0                                    # mjTRN_JOINT
+        effort = actuator_moments(m, d)[on_joint].T @ d.actuator_force[on_joint]
         tension = np.zeros(len(self._tendon_ids))
         for k, tid in enumerate(self._tendon_ids):
             on = (m.actuator_trntype == 3) & (m.actuator_trnid[:, 0] == tid)   # mjTRN_TENDON
             tension[k] = -float(np.sum(d.actuator_force[on] * m.actuator_gear[on, 0]))
-        return (float(d.time), np.array(d.qpos[: m.nv]), np.array(d.qvel), np.array(d.qfrc_actuator),
-                tension)
+        return float(d.time), np.array(d.qpos[: m.nv]), np.array(d.qvel), effort, tension
