@@ -130,3 +130,31 @@ def test_batch_over_two_mjcf_bags_writes_table_and_index_with_both(tmp_path):
     index = (out / "index.html").read_text(encoding="utf-8")
     for n in names:
         assert n in index
+
+
+def test_demo_part_on_the_arm_bag_links_what_it_names(tmp_path):
+    """The mjcf part of ``./run demo`` on the shipped arm bag: the diagnosis names the README's
+    effect first, the identified mass is within 10 % of the README's, and the demo index built
+    from the part links its page, its ``cablelab report`` and its bag as the other parts do
+    (``check_index_links`` of test/core/test_demo.py)."""
+    import argparse
+    import importlib.util
+
+    from cablelab import demo
+    from cablelab.plants.mjcf.demo import DEMO
+
+    spec = importlib.util.spec_from_file_location(
+        "demo_index_links", Path(__file__).resolve().parents[2] / "core" / "test_demo.py")
+    links = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(links)
+    a = argparse.Namespace(mjcf_bags="arm3_payload", folds=3, quick=True)
+    out = tmp_path / "mjcf"
+    res = DEMO.analyse(out, a, DEMO.record(out, a))
+    _, effect, params = CLAIMS["arm3_payload"]
+    assert res.first == effect
+    identified = dict(r[:2] for r in res.rows)["arm3_payload: identified"]
+    m = float(re.match(r"m = ([-\d.]+)", identified)[1])
+    assert m == pytest.approx(params["m"], rel=0.10)
+    index = demo.index_page(tmp_path, {DEMO.title: res})
+    kinds = {text.split()[0] for _, text in links.check_index_links(index)}
+    assert kinds == {"demo", "diagnosis", "bag"}
