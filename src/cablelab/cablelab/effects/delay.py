@@ -13,7 +13,7 @@ measurement unshifted and re-forms ``y = W(pose(t - tau)) t_meas(t)``, the wrenc
 tensions exert at the pose they belong to (the measured tensions are not interpolated either).
 tau < 0 means the measurement leads the motion (typical when the "effort" is a controller
 command). tau is found by a bounded outer search around the linear least squares (separable least
-squares, see :mod:`cablelab.fit.identify`).
+squares, see :mod:`cablelab.fit.identification`).
 """
 from __future__ import annotations
 
