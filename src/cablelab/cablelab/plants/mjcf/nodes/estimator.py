@@ -1,29 +1,25 @@
 """Live payload estimator of any MuJoCo model: ``payload_estimator --plant mjcf``.
 
 Takes the machine from ``/plant_description`` (or ``-p description:=FILE``), then listens to
-its ``joint_states`` (names as in the model, remapping of ``mjcf.topics`` honoured) and, every
-``publish_every`` messages, fits the payload on ``mjcf.payload_body`` over the last ``window``
-seconds (:func:`..estimation.payload_estimate`: MuJoCo's inverse dynamics and its payload
-columns) and publishes ``payload_estimate`` (geometry_msgs/InertiaStamped: ``m``, ``com`` in
-the payload body's frame). A message whose names, lengths or values do not fit the model is
-rejected and counted on /diagnostics.
+its ``joint_states`` (names as in the model, remapping of ``mjcf.topics`` honoured) and, when the
+description names measured ``tendons``, to ``cable_tensions``; every ``publish_every`` joint
+states it fits the payload on ``mjcf.payload_body`` over the last ``window`` seconds
+(:class:`..live.PayloadWindow`: tensions paired with the joint states by stamp, MuJoCo's inverse
+dynamics and its payload columns) and publishes ``payload_estimate``
+(geometry_msgs/InertiaStamped: ``m``, ``com`` in the payload body's frame). A message whose
+names, lengths or values do not fit the model is rejected and counted on /diagnostics.
 """
 from __future__ import annotations
-
-import time
-from collections import deque
 
 import numpy as np
 from geometry_msgs.msg import InertiaStamped
 from sensor_msgs.msg import JointState
 
-from ....errors import CablelabError
 from ....ros import convert
 from ....ros.params import DESCRIPTION, Param
 from ....ros.plant_node import PlantNode
 from ....ros.qos import catch_up_qos, publisher_qos
-from ..estimation import payload_estimate
-from ..mjcf import actuated_joints, dof_joints
+from ..live import PayloadWindow
 from ..topics import topic
 
 PARAMETERS = (
@@ -37,69 +33,53 @@ PARAMETERS = (
 class MjcfEstimator(PlantNode):
     def __init__(self):
         super().__init__("payload_estimator")
-        v = self.declare_params(PARAMETERS)
-        self.window, self.every = v.window, v.publish_every
-        self.joints: list[str] = []
-        self.buf: deque = deque()
-        self.count = 0
-        self.last = None
-        self.problem = ""
-        self.pub = None
-        self.listen_for_description(v.description)
+        self.v = self.declare_params(PARAMETERS)
+        self.win: PayloadWindow | None = None
+        self.listen_for_description(self.v.description)
         self.start_diagnostics()
 
     def set_description(self, desc) -> None:
         sec = getattr(desc, "mjcf", None)
-        if sec is None or not sec.payload_body or self.pub is not None:
-            if sec is None or not sec.payload_body:
-                self.description_problem = "the description names no mjcf.payload_body"
+        if sec is None or not sec.payload_body:
+            self.description_problem = "the description names no mjcf.payload_body"
+            return
+        if self.win is not None:
             return
         super().set_description(desc)
-        model = sec.compiled()
-        self.joints = dof_joints(model)
-        self.driven = np.array([j in set(sec.joints or actuated_joints(model)) for j in self.joints])
-        self.inputs.add("joint_states", timeout=0.5, length=2 * len(self.joints))
+        self.win = w = PayloadWindow(desc, self.v.window, self.v.publish_every)
+        self.inputs.add("joint_states", timeout=0.5, length=2 * len(w.joints))
         self.pub = self.create_publisher(InertiaStamped, topic(sec, "payload_estimate"), publisher_qos())
         self.create_subscription(JointState, topic(sec, "joint_states"), self.on_state, catch_up_qos())
+        if w.tendons:
+            self.inputs.add("cable_tensions", timeout=0.5, length=len(w.tendons))
+            self.create_subscription(JointState, topic(sec, "cable_tensions"), self.on_tension, catch_up_qos())
 
     def extend_status(self, level, msg, values):
-        values["samples in window"] = str(len(self.buf))
-        if self.last is not None:
-            values["payload mass kg"] = f"{self.last.m:.6g}"
-        if self.problem:
-            values["last fit"] = self.problem
+        if self.win is not None:
+            values["samples in window"] = str(len(self.win.states))
+            if self.win.last is not None:
+                values["payload mass kg"] = f"{self.win.last.m:.6g}"
+            level, msg = self.win.skips.warn(level, msg)
         return level, msg, values
+
+    def on_tension(self, msg: JointState) -> None:
+        t, names, _q, _qd, eff = convert.joint_state_arrays(msg)
+        ok = names is not None and eff is not None and set(self.win.tendons) <= set(names) \
+            and len(names) == eff.size
+        ten = np.array([eff[names.index(x)] for x in self.win.tendons]) if ok else None
+        if self.accept("cable_tensions", ten):
+            self.win.tension(t, ten)
 
     def on_state(self, msg: JointState) -> None:
         t, names, q, _qd, eff = convert.joint_state_arrays(msg)
-        ok = names is not None and list(names) == self.joints and q is not None and eff is not None \
-            and q.size == len(self.joints) and eff.size == len(self.joints)
-        both = np.concatenate([q, np.where(self.driven, eff, 0.0)]) if ok else None
-        if not self.inputs.accept("joint_states", both, time.monotonic()):
+        n, w = len(self.win.joints), self.win
+        ok = names == w.joints and q is not None and eff is not None and q.size == n and eff.size == n
+        if not self.accept("joint_states", np.concatenate([q, np.where(w.driven, eff, 0.0)]) if ok else None):
             return
-        if self.buf and not t > self.buf[-1][0]:
-            return                                     # repeated or older stamp
-        self.buf.append((t, q.copy(), np.where(self.driven, eff, 0.0)))
-        while self.buf and self.buf[-1][0] - self.buf[0][0] > self.window:
-            self.buf.popleft()
-        self.count += 1
-        if self.count % self.every == 0:
-            self.estimate()
-
-    def estimate(self) -> None:
-        t = np.array([b[0] for b in self.buf])
-        if len(t) < 60 or t[-1] - t[0] < 0.5 * self.window:
-            return
-        q = np.array([b[1] for b in self.buf])
-        eff = np.array([b[2] for b in self.buf])
-        try:
-            est = payload_estimate(t, q, eff, self.description, driven=self.driven)
-        except CablelabError as exc:
-            self.problem = " ".join(str(exc).split())
-            return
-        self.problem, self.last = "", est
-        self.pub.publish(convert.inertia_msg(float(t[-1]), est.m, est.com,
-                                             frame_id=self.description.mjcf.payload_body))
+        est = w.state(t, q, eff)
+        if est is not None:
+            sec = self.description.mjcf
+            self.pub.publish(convert.inertia_msg(w.last_t, est.m, est.com, frame_id=sec.payload_body))
 
 
 def make_node() -> PlantNode:
