@@ -64,3 +64,12 @@ def test_without_a_payload_body_the_window_says_so(cam):
     desc = load_description(description_yaml(text(CABLECAM), tendons=CABLES))
     with pytest.raises(Exception, match="payload_body"):
         PayloadWindow(desc, 3.0, 10)
+
+
+def test_measured_tendons_without_tensions_is_a_one_line_error(cam):
+    desc, t, q, eff, ten = cam
+    with pytest.raises(Exception, match=r"measures tendons cable_1.*need their tensions") as e:
+        payload_estimate(t, q, eff, desc)
+    assert "\n" not in str(e.value)
+    with pytest.raises(Exception, match=r"got \(.*, 3\)"):
+        payload_estimate(t, q, eff, desc, tension=ten[:, :3])

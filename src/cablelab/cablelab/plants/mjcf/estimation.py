@@ -30,11 +30,16 @@ def payload_estimate(t, q, effort, description, *, tension=None, driven=None,
     the body's own centre of mass (minimum-norm solution).
 
     Raises:
-        CablelabError: no ``payload_body`` in the description, or too few usable samples.
+        CablelabError: no ``payload_body`` in the description, the tensions of its measured
+            ``tendons`` missing or of the wrong shape, or too few usable samples.
     """
     sec = description.mjcf
     if sec is None or not sec.payload_body:
         raise CablelabError("payload estimate: the description names no mjcf.payload_body")
+    if sec.tendons and (tension is None or np.shape(tension) != (len(t), len(sec.tendons))):
+        raise CablelabError(f"payload estimate: the description measures tendons "
+                            f"{', '.join(sec.tendons)}: need their tensions, shape ({len(t)}, "
+                            f"{len(sec.tendons)}), got {None if tension is None else np.shape(tension)}")
     ds = dataset_from_arrays(t, q, effort, description, DatasetOptions(Conditioning(border=border)),
                              tension=tension, driven=driven)
     ok = ds.valid
