@@ -46,4 +46,8 @@ def test_fourier_basis_is_the_series():
         assert x[:, j] == pytest.approx(w * raw, abs=1e-12)
         # derivatives: against the numerical derivative of the position
         assert xd[5:-5, j] == pytest.approx(np.gradient(x[:, j], t)[5:-5], abs=2e-3)
-        assert xdd[5:-5, j] == pytest.approx(np.gradient(xd[:, j], t)[5:-5], abs=2e-3)
+        # (away from the window's corners at 2 s and 18 s, where the jerk jumps and the
+        # central difference of xd is off by O(dt))
+        smooth = (np.abs(t - 2.0) > 0.01) & (np.abs(t - 18.0) > 0.01)
+        smooth[:5] = smooth[-5:] = False
+        assert xdd[smooth, j] == pytest.approx(np.gradient(xd[:, j], t)[smooth], abs=2e-3)
