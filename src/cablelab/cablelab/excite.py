@@ -37,13 +37,18 @@ RANGE_MARGIN = 0.9
 
 @dataclass(frozen=True)
 class Limits:
-    """The machine's limits per joint (SI): position range, speed, acceleration."""
+    """The machine's limits per joint (SI): position range, speed, acceleration; ``constraint``
+    (optional) ``fn(q, qd, qdd) -> [violation lines]`` for what per-joint ranges cannot say (the
+    CDPR's cables between their minimum and maximum tension). A plant with a constraint chooses
+    its box, speeds and accelerations so that every motion inside them satisfies it (checked on
+    the designed reference)."""
 
     joints: tuple
     lower: np.ndarray
     upper: np.ndarray
     speed: np.ndarray
     accel: np.ndarray
+    constraint: Callable | None = None
 
     def check(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, tol: float = 1e-9) -> list[str]:
         """Violations (one line each) of a motion (N, n) against the limits; empty if none."""
@@ -56,6 +61,8 @@ class Limits:
                 out.append(f"{name}: speed {np.abs(qd[:, j]).max():.4g} above {self.speed[j]:.4g}")
             if np.abs(qdd[:, j]).max() > self.accel[j] * (1 + 1e-6) + tol:
                 out.append(f"{name}: acceleration {np.abs(qdd[:, j]).max():.4g} above {self.accel[j]:.4g}")
+        if self.constraint is not None:
+            out.extend(self.constraint(q, qd, qdd))
         return out
 
 
@@ -67,9 +74,12 @@ class Exciter:
         limits: ``fn(description) -> Limits``.
         motion_dataset: ``fn(t, q, qd, qdd, description) -> Dataset``: the dataset the plant's
             effects see for a motion that follows the reference exactly (outputs zero).
-        reference_topic: the plant's ``reference`` topic (trajectory_msgs/JointTrajectory).
+        reference_topic: the plant's ``reference`` topic.
         base_hz: lowest frequency of the Fourier series; harmonics: number of harmonics.
         rate_hz: sample rate of the written reference.
+        trajectory: ``"joint"`` (trajectory_msgs/JointTrajectory of the limits' joints) or
+            ``"pose"`` (trajectory_msgs/MultiDOFJointTrajectory of a level platform: the joints
+            are its x, y, z).
     """
 
     limits: Callable
@@ -78,6 +88,7 @@ class Exciter:
     base_hz: float = 0.05
     harmonics: int = 5
     rate_hz: float = 100.0
+    trajectory: str = "joint"
 
 
 _EXCITERS: dict[str, Exciter] = {}
@@ -351,6 +362,9 @@ def design(plant_name: str, desc, params: Sequence[str], *, duration: float = 60
     coef = best.x.reshape(shape)
     t_out = np.arange(0.0, duration + 0.5 / ex.rate_hz, 1.0 / ex.rate_hz)
     q, qd, qdd = scaled_motion(coef, t_out, lim, ex.base_hz, duration)
+    bad = lim.check(q, qd, qdd)
+    if bad:   # a plant whose box does not guarantee its constraint: refuse, never write it
+        raise CablelabError(f"designed reference breaks the machine's limits: {bad[0]}")
     after = condition(model, ex.motion_dataset(t_out, q, qd, qdd, desc), params)
     before = condition(model, before_ds, params) if before_ds is not None else None
     return Design(t_out, q, qd, qdd, lim, tuple(params), before, after, model,
@@ -367,22 +381,34 @@ def write_reference(path, d: Design, exciter: Exciter, description_yaml: str | N
     with BagWriter(path, overwrite=overwrite) as w:
         if description_yaml:
             w.write_description(description_yaml)
-        w.write_joint_trajectory(exciter.reference_topic, d.t, list(d.limits.joints), d.q, d.qd, d.qdd)
+        if exciter.trajectory == "pose":
+            level = np.tile([0.0, 0.0, 0.0, 1.0], (len(d.t), 1))           # x, y, z, w
+            w.write_multidof_trajectory(exciter.reference_topic, d.t, d.q, level, d.qd, None, d.qdd)
+        else:
+            w.write_joint_trajectory(exciter.reference_topic, d.t, list(d.limits.joints), d.q, d.qd,
+                                     d.qdd)
 
 
 def read_reference(path, topic: str, joints: Sequence[str]):
     """``fn(t) -> (q, qd, qdd)`` (N, n) interpolating a reference bag written by
-    :func:`write_reference` (held at its last point after the end): what a controller plays."""
+    :func:`write_reference` (held at its last point after the end): what a controller plays.
+    A pose reference (MultiDOFJointTrajectory) gives the platform's x, y, z (``joints`` unused)."""
     from .bags import open_bag
 
     bag = open_bag(path)
     if not bag.has(topic):
         raise CablelabError(f"{path}: no {topic} in the reference bag (topics: "
                             f"{', '.join(sorted(bag.topics)) or 'none'})")
-    tr = bag.joint_trajectory(topic, list(joints))
-    tt = tr.t - tr.t[0]
-    cols = [np.asarray(a, float) if a is not None else np.zeros_like(tr.positions)
-            for a in (tr.positions, tr.velocities, tr.accelerations)]
+    if bag.topics[topic].endswith("MultiDOFJointTrajectory"):     # a platform pose: x, y, z
+        tr = bag.multidof_trajectory(topic)
+        tt = tr.t - tr.t[0]
+        cols = [np.nan_to_num(np.asarray(a, float)) for a in
+                (tr.position, tr.linear_velocity, tr.linear_acceleration)]
+    else:
+        tr = bag.joint_trajectory(topic, list(joints))
+        tt = tr.t - tr.t[0]
+        cols = [np.asarray(a, float) if a is not None else np.zeros_like(tr.positions)
+                for a in (tr.positions, tr.velocities, tr.accelerations)]
 
     def fn(t):
         t = np.atleast_1d(np.asarray(t, float))
