@@ -3,7 +3,8 @@
     ./run python bench/bench_excite.py
 
 Prints wall and CPU seconds of :func:`cablelab.excite.design` (target: < 30 s wall for a 60 s
-excitation) and the condition numbers before (a recording that holds the luff still) and after.
+excitation) and the condition numbers before (crane: a recording that holds the luff still; CDPR:
+a slow sway at one pose; mjcf arm3: the base turning alone) and after.
 """
 from __future__ import annotations
 
@@ -36,14 +37,49 @@ def main() -> int:
                                                      effort_noise=(0.05, 0.05, 0.1)), 30.0,
                                           reference=_slew_only), desc)
         _, dsc, ds = load(Path(d) / "b")
+    cases = [("crane", dsc, params, ds) for params in (["OF[luff]", "m_c"], ["OF[hoist]", "m"])]
+    cases += [_cdpr_case(), _mjcf_case()]
     print("| plant | params | duration | wall s | CPU s | condition before | after |")
     print("| --- | --- | --- | --- | --- | --- | --- |")
-    for params in (["OF[luff]", "m_c"], ["OF[hoist]", "m"]):
+    for plant, dsc, params, before in cases:
         w0, c0 = time.monotonic(), time.process_time()
-        r = design("crane", dsc, params, duration=60.0, before_ds=ds)
-        print(f"| crane | {','.join(params)} | 60 s | {time.monotonic() - w0:.1f} | "
+        r = design(plant, dsc, params, duration=60.0, before_ds=before)
+        shown = ",".join(params) if len(params) < 4 else f"{params[0]}..{params[-1]} ({len(params)})"
+        print(f"| {plant} | {shown} | 60 s | {time.monotonic() - w0:.1f} | "
               f"{time.process_time() - c0:.1f} | {r.condition_before:.3g} | {r.condition_after:.3g} |")
     return 0
+
+
+def _cdpr_case():
+    """CDPR: dynamometer offsets vs mass and centre of mass, before = a slow 5 cm sway at one
+    pose (the exact motion's dataset, :func:`cablelab.plants.cdpr.excite.motion_dataset`)."""
+    from cablelab.excite import get_exciter
+    from cablelab.plants.cdpr.sim import default_description
+
+    desc = default_description()
+    t = np.arange(0.0, 30.0, 0.05)
+    w = 2 * np.pi / 30.0
+    q, qd, qdd = np.zeros((len(t), 3)), np.zeros((len(t), 3)), np.zeros((len(t), 3))
+    q[:, 2] = 0.9
+    q[:, 0], qd[:, 0], qdd[:, 0] = 0.05 * (1 - np.cos(w * t)), 0.05 * w * np.sin(w * t), 0.05 * w * w * np.cos(w * t)
+    before = get_exciter("cdpr").motion_dataset(t, q, qd, qdd, desc)
+    return "cdpr", desc, [f"b[winch_{i}]" for i in range(1, 9)] + ["m", "mx", "my"], before
+
+
+def _mjcf_case():
+    """mjcf arm3 example: payload mass vs shoulder torque offset, before = the base turning alone."""
+    import cablelab.plants.mjcf as mjcf_pkg
+    from cablelab.description import load_description
+    from cablelab.excite import get_exciter
+    from cablelab.plants.mjcf.sim import description_yaml
+
+    xml = (Path(mjcf_pkg.__file__).parent / "examples" / "arm3.xml").read_text()
+    desc = load_description(description_yaml(xml, payload_body="tool"))
+    t = np.arange(0.0, 30.0, 0.05)
+    q, qd, qdd = np.zeros((len(t), 3)), np.zeros((len(t), 3)), np.zeros((len(t), 3))
+    q[:, 0], q[:, 1], q[:, 2] = np.sin(0.5 * t), 0.3, -0.5
+    qd[:, 0], qdd[:, 0] = 0.5 * np.cos(0.5 * t), -0.25 * np.sin(0.5 * t)
+    return "mjcf", desc, ["m", "OF[shoulder]"], get_exciter("mjcf").motion_dataset(t, q, qd, qdd, desc)
 
 
 if __name__ == "__main__":
