@@ -40,11 +40,6 @@ without real-time privileges, in one run.
      "rate_sweep": [{"rate_hz", "bare_timer_missed", "control_loop_missed", "p99_ms",
                      "realtime_factor", "seconds"}, ...]}
 
-``--executor events`` runs the three node processes with rclpy's C++ ``EventsExecutor``
-instead of ``FastExecutor`` (node parameter ``events_executor``; the JSON's ``placement`` says
-so): the comparison of the two executors is two runs of ``--skip-offline --skip-floor
---skip-control-loop --skip-sweep``, one with each.
-
 Run it on a quiet machine: ``./run python bench/bench_realtime.py --seconds 60 --json`` (the
 10-minute soak: ``--seconds 600``). ``--py-spy PATH`` samples the three node processes with
 py-spy and prints each one's share of samples by innermost function (where the time goes);
@@ -187,9 +182,6 @@ def main(argv=None) -> int:
                                    "DEFAULT); default: what cablelab.ros.launch sets")
     bench.parser.add_argument("--py-spy", default=None, metavar="PATH",
                               help="py-spy executable: sample each node and print where its time goes")
-    bench.parser.add_argument("--executor", choices=("fast", "events"), default="fast",
-                              help="executor of the three node processes: cablelab's FastExecutor (fast) or "
-                                   "rclpy's C++ EventsExecutor (events)")
     bench.parser.add_argument("--skip-floor", action="store_true", help="no bare timer / C rcl pair")
     bench.parser.add_argument("--skip-control-loop", action="store_true", help="no control_loop process")
     bench.parser.add_argument("--skip-three-process", action="store_true", help="no three-process loop")
@@ -239,9 +231,6 @@ def main(argv=None) -> int:
         if args.transports:
             env["FASTDDS_BUILTIN_TRANSPORTS"] = args.transports
         extra = json.loads(args.node_params) if args.node_params else {}
-        if args.executor == "events":
-            for node in ("sim", "estimator", "controller"):
-                extra.setdefault(node, {})["events_executor"] = True
         r = closed_loop(args.seconds, bench.log, env, args.py_spy, args.pin, extra or None, args.idle_estimator)
         out["three_process"] = {"rate_hz": r["rate_hz"], "seconds": r["seconds"],
                               "realtime_factor": r["realtime_factor"], "missed_cycles": r["missed_cycles"],
@@ -291,8 +280,6 @@ def main(argv=None) -> int:
             where += f", node parameters {args.node_params}"
         prio = "SCHED_FIFO (node parameter rt_priority)" if c["rt_priority"] else "no RT priority"
         pair = out.get("floor", {}).get("c_rcl_pair_missed")
-        if args.executor == "events":
-            prio += ", rclpy EventsExecutor"
         rows += [dict(case=f"closed loop 1 kHz, 3 processes, {prio}, {where}, {c['seconds']:.0f} s steady state",
                       value=c["realtime_factor"], unit="x real time", target=">= 0.99"),
                  dict(case="missed cycles (steps braked, late or with a stale command, + dropped)",

@@ -231,18 +231,13 @@ def supports(node) -> bool:
     return not (list(node.clients) or list(node.guards))
 
 
-def executor_for(node, fast: bool = True, events: bool = False):
-    """The executor a node's ``executor_factory`` hook returns: rclpy's C++
-    ``rclpy.experimental.EventsExecutor`` when ``events`` (callbacks driven by rmw's event
-    callbacks, timers by its own timer thread; :func:`poll`-ed subscriptions are then serviced
-    like the others), else :class:`FastExecutor` when ``fast`` and the node :func:`supports` it,
-    else rclpy's SingleThreadedExecutor."""
+def executor_for(node, fast: bool = True):
+    """The executor a node's ``executor_factory`` hook returns: :class:`FastExecutor` when
+    ``fast`` and the node :func:`supports` it, else rclpy's SingleThreadedExecutor. (rclpy's C++
+    ``EventsExecutor`` was measured against FastExecutor in the three-process 1 kHz loop and lost
+    in missed cycles and in every node's CPU per step: docs/benchmarks.md, "Real time".)"""
     from rclpy.executors import SingleThreadedExecutor
 
-    if events:
-        from rclpy.experimental import EventsExecutor
-
-        return EventsExecutor(context=node.context)
     return FastExecutor() if fast and supports(node) else SingleThreadedExecutor()
 
 

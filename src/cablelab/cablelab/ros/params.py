@@ -270,7 +270,6 @@ def executor_params(fast_default: bool = True) -> tuple:
     return (
         Param("fast_executor", fast_default, "spin with cablelab.ros.fastspin.FastExecutor (false: "
               "rclpy's SingleThreadedExecutor)"),
-        Param("events_executor", False, "spin with rclpy's C++ EventsExecutor instead (for comparison)"),
         Param("rt_priority", 0, "SCHED_FIFO priority of the node's threads (0 = normal scheduling; "
               "needs the privilege)", ge=0, le=99),
         Param("cpu_affinity", [-1], "CPU numbers the node's threads run on ([-1] = any)", ge=-1),

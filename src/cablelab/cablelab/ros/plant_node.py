@@ -91,7 +91,6 @@ class PlantNode(Node):
 
     def use_fast_executor(self, default: bool = True) -> None:
         """Parameters ``fast_executor`` (spin with :class:`~cablelab.ros.fastspin.FastExecutor`),
-        ``events_executor`` (spin with rclpy's C++ ``EventsExecutor`` instead, for comparison),
         ``rt_priority`` (SCHED_FIFO priority, 0 = off; needs the privilege), and the placement a
         deployment gives a 1 kHz loop without privileges: ``cpu_affinity`` (CPU numbers the
         node's threads run on, [-1] = any), ``niceness`` (0-19: lower priority for a node off
@@ -106,7 +105,6 @@ class PlantNode(Node):
 
         v = self.declare_params(executor_params(default))
         self.fast = bool(v.fast_executor)
-        self.events = bool(v.events_executor)
         cpus = [int(c) for c in v.cpu_affinity if int(c) >= 0]
         if cpus:
             self.get_logger().info(f"cpu_affinity: {set_cpu_affinity(cpus)}")
@@ -126,7 +124,7 @@ class PlantNode(Node):
         """The executor :func:`cablelab.ros.runner.run_node` spins this node with."""
         from .fastspin import executor_for
 
-        return executor_for(self, self.fast, getattr(self, "events", False))
+        return executor_for(self, self.fast)
 
     # ------------------------------------------------------------------ description
     def listen_for_description(self, text: str = "") -> None:
