@@ -77,6 +77,8 @@ class Exciter:
         reference_topic: the plant's ``reference`` topic.
         base_hz: lowest frequency of the Fourier series; harmonics: number of harmonics.
         rate_hz: sample rate of the written reference.
+        grid: samples per period of the highest harmonic on the design grid (the cost's); fewer
+            for a plant whose dataset is costly per sample.
         trajectory: ``"joint"`` (trajectory_msgs/JointTrajectory of the limits' joints) or
             ``"pose"`` (trajectory_msgs/MultiDOFJointTrajectory of a level platform: the joints
             are its x, y, z).
@@ -88,6 +90,7 @@ class Exciter:
     base_hz: float = 0.05
     harmonics: int = 5
     rate_hz: float = 100.0
+    grid: float = 10.0
     trajectory: str = "joint"
 
 
@@ -224,10 +227,15 @@ def model_for(plant, desc, params: Sequence[str], ds) -> tuple:
         eff = get_effect(eid, plant.name)
         for p in list(eff.columns(ds)) + list(eff.nonlinear):
             known.setdefault(p.name, eid)
+    nonlinear = {p.name for eid in known.values() for p in get_effect(eid, plant.name).nonlinear}
     for name in params:
         if name not in known:
             raise CablelabError(f"--params {name!r}: no parameter of that name for plant {plant.name} "
                                 f"(parameters: {', '.join(sorted(known))})")
+        if name in nonlinear:
+            raise CablelabError(f"--params {name!r}: a nonlinear parameter of {known[name]} (no regressor "
+                                f"column whose information the design could condition); name linear "
+                                f"parameters")
         if known[name] not in base and known[name] not in owners:
             owners.append(known[name])
     return Model(plant.name, tuple(base + owners)), tuple(known[n] for n in params)
@@ -332,8 +340,8 @@ def design(plant_name: str, desc, params: Sequence[str], *, duration: float = 60
     lim = ex.limits(desc)
     n_j, h = len(lim.joints), ex.harmonics
     shape = (n_j, 2, h)
-    # design grid: 10 samples per period of the highest harmonic
-    fs = 10.0 * ex.base_hz * h
+    # design grid: ex.grid (10) samples per period of the highest harmonic
+    fs = ex.grid * ex.base_hz * h
     t = np.arange(0.0, duration, 1.0 / fs)
     probe = ex.motion_dataset(t, *scaled_motion(np.ones(shape), t, lim, ex.base_hz, duration), desc)
     model, _ = model_for(plant, desc, params, probe)

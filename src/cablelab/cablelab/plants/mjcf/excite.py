@@ -8,9 +8,11 @@ the actuators' ``ctrlrange`` (times the gear) or ``forcerange`` and the joint's
 ``actuatorfrcrange``: the designed motion's inverse dynamics must stay inside them (the
 :class:`~cablelab.excite.Limits` constraint; a design that breaks one is refused).
 
-The dataset is the one :func:`.dataset.dataset_from_arrays` builds, for a motion that follows
-the reference exactly (no conditioning: q, qd, qdd are the designed ones): MuJoCo's inverse
-dynamics as the known output, the payload body's columns, the tendon Jacobians.
+The design grid has 5 samples per period of the highest harmonic (the crane's and the CDPR's 10):
+each sample costs eleven MuJoCo inverse-dynamics passes (the model's and the payload body's ten
+inertial columns). The dataset is the one :func:`.dataset.dataset_from_arrays` builds, for a
+motion that follows the reference exactly (no conditioning: q, qd, qdd are the designed ones):
+MuJoCo's inverse dynamics as the known output, the payload body's columns, the tendon Jacobians.
 """
 from __future__ import annotations
 
@@ -126,4 +128,4 @@ def motion_dataset(t, q, qd, qdd, description) -> Dataset:
 
 #: the mjcf plant's experiment design (``cablelab excite``), registered by the package
 EXCITER = Exciter(limits=excite_limits, motion_dataset=motion_dataset,
-                  reference_topic=TOPICS["reference"][0], base_hz=0.1, harmonics=5)
+                  reference_topic=TOPICS["reference"][0], base_hz=0.1, harmonics=5, grid=5.0)
