@@ -40,13 +40,13 @@ def test_loop_commands_equal_the_controller_node_on_a_recorded_stream(ros_contex
     loop_node = CdprControlLoop()
     ctl = CdprController()
     from_loop, from_node = [], []
-    loop_node.pub_cmd.publish = _capture(from_loop, Float64MultiArray)
+    loop_node.out.pub_cmd.publish = _capture(from_loop, Float64MultiArray)
     from sensor_msgs.msg import JointState
     from trajectory_msgs.msg import MultiDOFJointTrajectory
     js, tens, refs = [], [], []
-    loop_node.pub_js.publish = _capture(js, JointState)
-    loop_node.pub_ten.publish = _capture(tens, JointState)
-    loop_node.pub_ref.publish = _capture(refs, MultiDOFJointTrajectory)
+    loop_node.out.pub_js.publish = _capture(js, JointState)
+    loop_node.out.pub_ten.publish = _capture(tens, JointState)
+    loop_node.out.pub_ref.publish = _capture(refs, MultiDOFJointTrajectory)
     ctl.pub_cmd.publish = _capture(from_node, Float64MultiArray)
     ctl.polled = []                 # callbacks alone, no DDS
     loop_node.take_every = 10 ** 9  # estimates are fed by hand below, at the same points for both
@@ -317,7 +317,7 @@ def test_loop_survives_any_estimate(ros_context):
     from cablelab.ros import convert
 
     node = CdprControlLoop()
-    node.pub_cmd.publish = node.pub_js.publish = node.pub_ten.publish = node.pub_ref.publish = lambda m: None
+    node.out.pub_cmd.publish = node.out.pub_js.publish = node.out.pub_ten.publish = node.out.pub_ref.publish = lambda m: None
     node.loop.start()
     anchors = node.description.cdpr.anchor_points[:, :2]
     num = st.one_of(st.floats(allow_nan=True, allow_infinity=True), st.sampled_from([0.0, -615.0, 615.0, 1e300]))

@@ -46,23 +46,24 @@ def test_adapters_survive_bad_input(ros_context):
         # simulator: bad commands rejected; without a command the brakes hold the platform
         for bad in ([nan] * 8, [1.0] * 7, []):
             sim.on_command(Float64MultiArray(data=bad))
-        assert sim.u is None and sim.inputs.inputs["effort_commands"].rejected == 3
+        assert sim.stepper.u is None and sim.inputs.inputs["effort_commands"].rejected == 3
         p0 = sim.sim.truth_pose()[0].copy()
         for _ in range(100):
             sim.step_once()
-        assert np.linalg.norm(sim.sim.truth_pose()[0] - p0) < 0.02 and sim.fallbacks == 100
+        assert np.linalg.norm(sim.sim.truth_pose()[0] - p0) < 0.02 and sim.stepper.fallbacks == 100
 
         # the tabulated reference equals the s-curve, also long after the trajectory ended
         from cablelab.plants.cdpr.trajectory import pick_and_place
-        for tq in (0.5, 1.0 + 12.345, sim.settle + 60.0 / sim.speed + 0.5, 300.0, 10000.0):
-            tr = pick_and_place(np.array([max(0.0, tq - sim.settle) * sim.speed]))
-            got = sim.reference(tq)
+        table = sim.stepper.reference
+        for tq in (0.5, 1.0 + 12.345, table.settle + 60.0 / table.speed + 0.5, 300.0, 10000.0):
+            tr = pick_and_place(np.array([max(0.0, tq - table.settle) * table.speed]))
+            got = table.at(tq)
             np.testing.assert_allclose(got[0], tr.position[0], atol=1e-12)
-            np.testing.assert_allclose(got[1], tr.velocity[0] * sim.speed, atol=1e-12)
-            np.testing.assert_allclose(got[2], tr.acceleration[0] * sim.speed ** 2, atol=1e-12)
+            np.testing.assert_allclose(got[1], tr.velocity[0] * table.speed, atol=1e-12)
+            np.testing.assert_allclose(got[2], tr.acceleration[0] * table.speed ** 2, atol=1e-12)
         ms, t = sim.sim.measure(), sim.sim.time
         names = [f"cable_{i}" for i in range(1, 9)]
-        ref = convert.multidof_msg(t, sim.reference(t)[0], [0, 0, 0, 1.0], [0, 0, 0], None, [0, 0, 0], None)
+        ref = convert.multidof_msg(t, table.at(t)[0], [0, 0, 0, 1.0], [0, 0, 0], None, [0, 0, 0], None)
         # estimator: no description yet -> nothing; then good sample -> one estimate
         est.on_reference(ref)
         est.on_tensions(convert.joint_state_msg(t, names, None, None, ms["tension"]))
@@ -115,14 +116,14 @@ def test_adapters_survive_bad_input(ros_context):
         ctl.on_estimate(convert.inertia_msg(t, 615.0, [0.06, 0.0, nan]))
         ctl.on_estimate(convert.inertia_msg(t, 1e6, [0.0, 0.0, 0.0]))       # implausible: rejected
         ctl.on_state(js)
-        assert ctl.estimates_rejected == 1 and ctl.controller.mass == pytest.approx(615.0)
+        assert ctl.stream.estimates_rejected == 1 and ctl.controller.mass == pytest.approx(615.0)
         heavy = np.array(sent[-1].data)
         assert np.all(heavy > nominal)       # more mass -> more torque on every winch
         # every command keeps the cables taut (floor) and is finite
         assert all(np.all(np.isfinite(s.data)) and min(s.data) > 0 for s in sent)
         # the command names the state it answers; the simulator reads it (lock-step matching)
         sim.on_command(sent[-1])
-        assert sim.u_stamp == pytest.approx(t, abs=1e-9) and np.array_equal(sim.u, heavy)
+        assert sim.stepper.u_stamp == pytest.approx(t, abs=1e-9) and np.array_equal(sim.stepper.u, heavy)
     finally:
         for n in (sim, est, ctl):
             n.destroy_node()
@@ -249,10 +250,10 @@ def test_controller_prepares_ahead_and_estimator_batches(ros_context):
         got = np.array([m.data for m in sent])
         np.testing.assert_allclose(got, np.array(want), rtol=1e-12, atol=1e-9)
         # every command but the first and the one after the new estimate used prepared terms
-        assert ctl.prepared_used == 10 and ctl.status()[2]["commands prepared ahead"] == "10"
+        assert ctl.stream.prepared_used == 10 and ctl.status()[2]["commands prepared ahead"] == "10"
 
         # estimator, batch mode: one estimate per poll, of the newest tension sample
-        est.poll_period = 0.01
+        est.stream.batch = True
         names = [f"cable_{i}" for i in range(1, 9)]
         ten = rng.uniform(2000, 4000, (3, 8))
         for k in range(3):

@@ -62,6 +62,15 @@ def joint_state_arrays(msg: JointState):
             _arr(msg.effort))
 
 
+def named_positions(msg: JointState, names) -> np.ndarray | None:
+    """Positions of the joints ``names`` in a JointState (any order, other joints ignored), or
+    None when one is missing or the names and positions differ in number."""
+    _, got, q, _, _ = joint_state_arrays(msg)
+    if q is None or not set(names) <= set(got) or len(got) != q.size:
+        return None
+    return np.array([q[got.index(n)] for n in names])
+
+
 def float_array_msg(data) -> Float64MultiArray:
     """std_msgs/Float64MultiArray with an empty layout (ros2_control forward-command style)."""
     msg = Float64MultiArray()
@@ -165,6 +174,16 @@ def joint_trajectory_point(msg: JointTrajectory):
         return t, list(msg.joint_names), None, None, None
     pt = msg.points[0]
     return t, list(msg.joint_names), _arr(pt.positions), _arr(pt.velocities), _arr(pt.accelerations)
+
+
+def reference_point(msg: JointTrajectory, joints=None):
+    """``(q, qd, qdd)`` of a reference's first point, velocities and accelerations that are
+    missing or of another length than the positions as zeros; None when it has no positions or
+    (``joints`` given) names other joints."""
+    _, names, q, qd, qdd = joint_trajectory_point(msg)
+    if q is None or (joints is not None and names != list(joints)):
+        return None
+    return (q,) + tuple(x if x is not None and x.size == q.size else np.zeros_like(q) for x in (qd, qdd))
 
 
 def multidof_msg(t: float, position, quaternion, linear_velocity=None, angular_velocity=None,

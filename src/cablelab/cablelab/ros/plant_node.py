@@ -20,6 +20,7 @@ from ..errors import CablelabError
 from . import convert
 from .diagnostics import Diagnostics
 from .inputs import InputMonitor
+from .lockstep import ADVANCE, FREE, RESEND
 from .qos import DESCRIPTION_QOS
 
 PROBE_REPEAT = 5.0  # s wall: the start gate's probe state is published again (see waiting_for_subscribers)
@@ -126,6 +127,31 @@ class PlantNode(Node):
 
         return executor_for(self, self.fast)
 
+    # ------------------------------------------------------------------ inputs
+    def accept(self, name: str, values) -> bool:
+        """:meth:`InputMonitor.accept <cablelab.ros.inputs.InputMonitor.accept>` at the present
+        wall time: True if ``values`` of input ``name`` are usable (else counted as rejected)."""
+        return self.inputs.accept(name, values, time.monotonic())
+
+    def decode(self, name: str, decode, msg):
+        """``decode(msg)`` (e.g. :func:`~cablelab.ros.rawmsg.joint_state_arrays` of raw bytes), or
+        None with the message counted as rejected on input ``name`` when it is not one
+        (``ValueError``)."""
+        try:
+            return decode(msg)
+        except ValueError:
+            self.accept(name, None)
+            return None
+
+    def take_command(self, name: str, msg, lock=None):
+        """The values of a ``Float64MultiArray`` command on input ``name`` when usable (checked by
+        the input monitor) and, with a :class:`~cablelab.ros.lockstep.LockStep`, answering the
+        last published state (an answer to an earlier one is counted and ignored); else None."""
+        values = convert.float_array(msg)
+        if not self.accept(name, values) or (lock is not None and not lock.offer(convert.command_stamp(msg))):
+            return None
+        return values
+
     # ------------------------------------------------------------------ description
     def listen_for_description(self, text: str = "") -> None:
         """Subscribe to ``/plant_description`` (transient local); ``text`` (a ``description``
@@ -207,6 +233,18 @@ class PlantNode(Node):
             self.wait_subs = 0
             return False
         return True
+
+    def may_step(self, lock, publisher, republish, every: float = 0.5) -> str | None:
+        """A simulator's timer: the start gate (:meth:`waiting_for_subscribers` on ``publisher``),
+        then the lock-step ``lock``: its ADVANCE (the answer to the last state is here) or FREE
+        (real-time rules) when the simulation steps now, None while it waits (on RESEND the last
+        state is published again with ``republish()``: the controller may have missed it)."""
+        if self.waiting_for_subscribers(publisher, lock.published_at, republish, every):
+            return None
+        step = lock.poll(time.monotonic())
+        if step == RESEND:
+            republish()
+        return step if step in (ADVANCE, FREE) else None
 
     def all_acknowledged(self) -> bool:
         """Whether every matched reliable subscriber acknowledged every sample this node

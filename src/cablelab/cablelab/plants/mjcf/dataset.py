@@ -80,6 +80,9 @@ def dataset_from_arrays(t, q, effort, description, options: DatasetOptions | Non
     q_raw = np.asarray(q, float).reshape(len(t), -1)
     floor = np.array([0.0 if qd is not None else speed_resolution(position_quantum(q_raw[:, k]), c["cutoff_hz"])
                       for k in range(q_raw.shape[1])])
+    if not driven.any():   # no drive, no drive friction to leave its zero-speed zone out for (the
+        # platform joints of a cable robot, moved by its measured tensions, rest one at a time)
+        return ds.replace(signals={**ds.signals, "zero_speed_zone": np.zeros(0), "rest_share": 0.0})
     return exclude_zero_speed(ds, floor=floor)
 
 

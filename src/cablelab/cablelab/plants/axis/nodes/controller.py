@@ -81,16 +81,14 @@ class AxisController(PlantNode):
             self.inertia = float(desc.axis.inertia)
 
     def on_reference(self, msg: JointTrajectory) -> None:
-        _, _, q, qd, qdd = convert.joint_trajectory_point(msg)
-        if self.inputs.accept("reference", q, time.monotonic()):
-            zero = np.zeros(1)
-            self.ref = (float(q[0]), float((qd if qd is not None else zero)[0]),
-                        float((qdd if qdd is not None else zero)[0]))
+        ref = convert.reference_point(msg)
+        if self.accept("reference", None if ref is None else ref[0]):
+            self.ref = tuple(float(x[0]) for x in ref)
 
     def on_state(self, msg: JointState) -> None:
         t, _names, q, qd, _eff = convert.joint_state_arrays(msg)
         now = time.monotonic()
-        if not self.inputs.accept("joint_states", q, now):
+        if not self.accept("joint_states", q):
             return
         if qd is None or qd.size != q.size or not np.isfinite(qd).all():
             qd = np.zeros_like(q)

@@ -12,7 +12,6 @@ ROS parameters: :data:`PARAMETERS` (``payload_estimator --plant axis --help``).
 """
 from __future__ import annotations
 
-import time
 
 import numpy as np
 from sensor_msgs.msg import JointState
@@ -66,7 +65,7 @@ class AxisEstimator(PlantNode):
         t, _names, q, qd, eff = convert.joint_state_arrays(msg)
         one = q is not None and eff is not None and q.size == 1 and eff.size == 1
         both = np.concatenate([q, eff]) if one else None     # one position and one effort
-        if not self.inputs.accept("joint_states", both, time.monotonic()):
+        if not self.accept("joint_states", both):
             return
         if qd is None or qd.size != 1:
             qd = np.array([np.nan])

@@ -28,7 +28,7 @@ from ....description import load_description
 from ..sim import AxisSim, AxisTruth
 from ....ros import convert
 from ....ros.clock import ClockPublisher
-from ....ros.lockstep import ADVANCE, FREE, RESEND, LockStep
+from ....ros.lockstep import FREE, LockStep
 from ....ros.markers import start_markers
 from ....ros.params import DESCRIPTION, START_GATE, Param, markers_rate, merge
 from ....ros.plant_node import PlantNode
@@ -69,7 +69,6 @@ class AxisSimNode(PlantNode):
         self.resend = v.lockstep_resend
         self.lock = LockStep(v.lockstep, wait_first=True, resend=self.resend)
         self.start_gate()
-        self.last_publish = time.monotonic()
         self.sim = AxisSim(self.description, truth)
         self.u = 0.0
         self.inputs.add("effort_command", timeout=v.command_timeout, length=1)
@@ -93,30 +92,22 @@ class AxisSimNode(PlantNode):
         return level, msg, values
 
     def on_command(self, msg: Float64MultiArray) -> None:
-        values = convert.float_array(msg)
-        if not self.inputs.accept("effort_command", values, time.monotonic()):
-            return
-        if self.lock.offer(convert.command_stamp(msg)):  # False: answers an earlier state
+        values = self.take_command("effort_command", msg, self.lock)
+        if values is not None:
             self.u = float(values[0])
 
     def tick(self) -> None:
-        now = time.monotonic()
-        if self.waiting_for_subscribers(self.pub_js, self.last_publish, self.publish_state, self.resend):
+        step = self.may_step(self.lock, self.pub_js, self.publish_state, self.resend)
+        if step is None:
             return
-        step = self.lock.poll(now)
-        if step not in (ADVANCE, FREE):
-            if step == RESEND:
-                self.publish_state()  # the controller may have missed it (not connected yet)
-            return
-        if step == FREE and not self.inputs.fresh("effort_command", now):
+        if step == FREE and not self.inputs.fresh("effort_command", time.monotonic()):
             self.u = 0.0  # no (fresh) command: the drive is switched off
         self.sim.advance(self.u, 1.0 / self.rate)
         self.publish_state()
 
     def publish_state(self) -> None:
-        self.last_publish = time.monotonic()
         t, q, qd = self.sim.state()
-        self.lock.published(t, self.last_publish)
+        self.lock.published(t)
         self.clock.publish(t)
         self.pub_js.publish(convert.joint_state_msg(t, ["joint"], [q], [qd], [self.sim.measured_effort(self.u)]))
         self.pub_truth.publish(convert.joint_state_msg(t, ["joint"], [q], [qd], [self.u]))

@@ -22,32 +22,26 @@ description)``).
 """
 from __future__ import annotations
 
-import numpy as np
-from geometry_msgs.msg import InertiaStamped, PoseStamped
-from rosgraph_msgs.msg import Clock
-from sensor_msgs.msg import JointState
-from std_msgs.msg import Float64MultiArray
-from trajectory_msgs.msg import MultiDOFJointTrajectory
+from geometry_msgs.msg import InertiaStamped
 
 from ....description import load_description
 from ....errors import CablelabError
 from ....hardware import DriverStub, load_hardware_class
 from ....ros import convert
 from ....ros.control_loop import LOOP_PARAMETERS, ControlLoopNode
-from ....ros.params import Param, executor_params, merge
 from ....ros.fastspin import take_newest
-from ....ros.qos import publisher_qos, stream_qos
-from ....ros.rawmsg import CommandTemplate, RawTemplate
-from ....rotations import wxyz_to_xyzw
+from ....ros.params import Param, executor_params, merge
+from ....ros.qos import stream_qos
 from .. import topics
-from ..control import PdffConfig
 from ..hardware import SimulatedCdpr
-from ..live import ControllerConfig, LiveController
+from ..live import LiveController
 from ..loop import ReferenceLaw
 from ..sim import default_description_path
+from ..streams import controller_config
 from ..trajectory import ReferenceTable
 from . import controller as _controller
 from . import sim as _sim
+from .outputs import CdprOutputs
 
 __all__ = ["CdprControlLoop", "make_node", "PARAMETERS"]
 
@@ -78,35 +72,21 @@ class CdprControlLoop(ControlLoopNode):
         if c is None:
             raise CablelabError("control_loop --plant cdpr: the description has no cdpr section")
         self.n = len(c.cables)
-        gains = PdffConfig(kp=v.kp, kd=v.kd, coulomb=v.coulomb, viscous=v.viscous,
-                           min_tension=v.min_tension, preload=v.preload, max_torque=v.max_torque)
-        self.estimate_timeout = v.estimate_timeout
-        nominal = v.nominal_mass or c.platform_mass or 366.0
-        cfg = ControllerConfig(feedforward=v.feedforward, nominal_mass=nominal,
-                               estimate_timeout=self.estimate_timeout, gains=gains, model=v.model)
-        speed, settle = v.trajectory_speed, v.settle
-        self.reference = ReferenceTable(self.rate, settle, speed)
-        self.law = ReferenceLaw(LiveController(c, desc.gravity, cfg), self.reference.at)
+        self.reference = ReferenceTable(self.rate, v.settle, v.trajectory_speed)
+        self.law = ReferenceLaw(LiveController(c, desc.gravity, controller_config(v, c.platform_mass)),
+                                self.reference.at)
         self.extras_every = v.extras_every
         self.hardware = hardware = self._hardware(v.hardware, desc)
         self.simulated = isinstance(hardware, SimulatedCdpr)
         self.estimates_rejected = 0
 
-        q = publisher_qos()
-        self.pub_js = self.create_publisher(JointState, topics.JOINT_STATES, q)
-        self.pub_ten = self.create_publisher(JointState, topics.CABLE_TENSIONS, q)
-        self.pub_ref = self.create_publisher(MultiDOFJointTrajectory, topics.REFERENCE, q)
-        self.pub_cmd = self.create_publisher(Float64MultiArray, topics.EFFORT_COMMANDS, q)
-        self.pub_pose = self.create_publisher(PoseStamped, topics.PLATFORM_POSE, q)
-        self.pub_clock = self.create_publisher(Clock, "/clock", publisher_qos())
-        if self.simulated:
-            self.pub_tpose = self.create_publisher(PoseStamped, topics.GROUND_TRUTH_POSE, q)
-            self.pub_tpay = self.create_publisher(InertiaStamped, topics.GROUND_TRUTH_PAYLOAD, q)
+        self.out = CdprOutputs(self, self.n, truth=self.simulated, commands=True)
+        if self.simulated:                  # the true moving mass and CoM do not change
+            self.out.payload(hardware.sim.truth.total_mass, hardware.sim.truth.total_com)
         self.publish_description(desc)
-        self._templates()
         # the estimate waits in a keep-last-1 queue that no executor watches; the loop takes it
         # after a write (take_inputs), never waiting for it
-        self.inputs.add("payload_estimate", timeout=self.estimate_timeout, length=1, required=False)
+        self.inputs.add("payload_estimate", timeout=v.estimate_timeout, length=1, required=False)
         self.est_sub = self.create_subscription(InertiaStamped, topics.PAYLOAD_ESTIMATE, self.on_estimate,
                                                 stream_qos(1))
         self.setup_loop(hardware, self.law)
@@ -119,70 +99,27 @@ class CdprControlLoop(ControlLoopNode):
         cls = DriverStub if spec == "stub" else load_hardware_class(spec)
         return cls(names, desc)
 
-    def _templates(self) -> None:
-        """Pre-serialised messages: each period patches stamps and numbers only."""
-        z, z3 = np.zeros(self.n), np.zeros(3)
-        self.t_js = RawTemplate(convert.joint_state_msg(0.0, [f"winch_{i}" for i in range(1, self.n + 1)], z, z, z))
-        self.t_ten = RawTemplate(convert.joint_state_msg(0.0, [f"cable_{i}" for i in range(1, self.n + 1)],
-                                                         z, None, z))
-        self.t_ref = RawTemplate(convert.multidof_msg(0.0, z3, [0.0, 0.0, 0.0, 1.0], z3, None, z3, None))
-        r = self.t_ref
-        self._ref_views = (r.vector("points[0].transforms[0].translation"),
-                           r.vector("points[0].velocities[0].linear"),
-                           r.vector("points[0].accelerations[0].linear"))
-        self.t_cmd = CommandTemplate("winch")
-        self.t_clock = RawTemplate(convert.clock_msg(0.0))
-        self.t_pose = RawTemplate(convert.pose_msg(0.0, z3, [0.0, 0.0, 0.0, 1.0]))
-        self.t_tpose = RawTemplate(convert.pose_msg(0.0, z3, [0.0, 0.0, 0.0, 1.0]))
-        self.t_tpay = RawTemplate(convert.inertia_msg(0.0, 0.0, z3))
-        if self.simulated:                  # the true moving mass and CoM do not change
-            self.t_tpay["inertia.m"][0] = self.hardware.sim.truth.total_mass
-            self.t_tpay.vector("inertia.com")[:] = self.hardware.sim.truth.total_com
-
     # ------------------------------------------------------------------ the loop's hooks
     def publish_cycle(self, state, command) -> None:
-        t = state.t
-        ref = self.t_ref                        # the reference of the state's stamp, before it
-        for view, value in zip(self._ref_views, self.reference.at(t)):
-            view[:] = value
-        ref.stamp(t)
-        self.pub_ref.publish(ref.data())
-        js = self.t_js
-        js.stamp(t)
-        js["position"][:] = state.position
-        js["velocity"][:] = state.velocity
-        js["effort"][:] = state.effort
-        self.pub_js.publish(js.data())
-        extra = state.extra
+        t, extra, out = state.t, state.extra, self.out
+        out.reference(t, *self.reference.at(t))       # the reference of the state's stamp, before it
+        out.joints(t, state.position, state.velocity, state.effort)
         if "tension" in extra:
-            ten = self.t_ten
-            ten.stamp(t)
-            ten["effort"][:] = extra["tension"]
-            if "cable_length" in extra:
-                ten["position"][:] = extra["cable_length"]
-            self.pub_ten.publish(ten.data())
+            out.tensions(t, extra["tension"], extra.get("cable_length"))
         if command is not None:
-            self.pub_cmd.publish(self.t_cmd.data(command, t))
+            out.command(t, command)
         if self._cycle % self.extras_every == 0:
-            self.t_clock.stamp(t, "clock")
-            self.pub_clock.publish(self.t_clock.data())
-            if "position" in extra and "quat" in extra:
-                self._pose(self.t_pose, t, extra["position"], extra["quat"])
-                self.pub_pose.publish(self.t_pose.data())
-            if self.simulated:          # the truth read with the state (not now: another thread may publish)
-                self._pose(self.t_tpose, t, extra["true_position"], extra["true_quat"])
-                self.pub_tpose.publish(self.t_tpose.data())
-                self.t_tpay.stamp(t)
-                self.pub_tpay.publish(self.t_tpay.data())
+            pose = (extra["position"], extra["quat"]) if "position" in extra and "quat" in extra else None
+            # the truth read with the state (not now: another thread may publish)
+            truth = (extra["true_position"], extra["true_quat"]) if self.simulated else None
+            out.extras(t, pose, truth)
 
     def take_inputs(self) -> None:
         take_newest(self.est_sub)
 
     def on_estimate(self, msg: InertiaStamped) -> None:
-        import time
-
         t, m, com = convert.inertia_arrays(msg)
-        if not self.inputs.accept("payload_estimate", [m], time.monotonic()):
+        if not self.accept("payload_estimate", [m]):
             return
         if not self.law.estimate(t, m, com[:2]):
             self.estimates_rejected += 1
@@ -202,12 +139,6 @@ class CdprControlLoop(ControlLoopNode):
             values["sim time s"] = f"{self.hardware.sim.time:.3f}"
             values["brake steps"] = str(self.hardware.braked)
         return level, msg, values
-
-    @staticmethod
-    def _pose(tpl: RawTemplate, t: float, position, quat_wxyz) -> None:
-        tpl.stamp(t)
-        tpl.vector("pose.position")[:] = position
-        tpl.vector("pose.orientation", "xyzw")[:] = wxyz_to_xyzw(quat_wxyz)
 
 
 def make_node() -> CdprControlLoop:

@@ -16,24 +16,23 @@ subscribed (``/cdpr/cable_tensions`` or ``/cdpr/joint_states``).
 from __future__ import annotations
 
 import time
+from functools import partial
 
-import numpy as np
 from geometry_msgs.msg import InertiaStamped, PoseStamped
 from sensor_msgs.msg import JointState
 from trajectory_msgs.msg import MultiDOFJointTrajectory
 
 from .. import topics
-from ..live import EstimatorConfig, LiveEstimator
-from ....ros import convert
-from ....rotations import xyzw_to_wxyz
-from ....ros.inputs import ERROR, WARN
+from ..streams import EstimateStream, estimator_config
+from ....ros import convert, rawmsg
 from ....ros.fastspin import drain, poll
-from ....stamped import StampedBuffer
+from ....ros.inputs import ERROR, WARN
 from ....ros.params import Param, executor_params, merge
 from ....ros.plant_node import PlantNode
 from ....ros.qos import publisher_qos, stream_qos
-from ....ros import rawmsg
 from ....ros.rawmsg import RawReader, RawTemplate
+from ....ros.status import Latency, add_problem
+from ....rotations import xyzw_to_wxyz
 
 
 PARAMETERS = merge((
@@ -65,195 +64,113 @@ class CdprPayloadEstimator(PlantNode):
     def __init__(self):
         super().__init__("payload_estimator", start_parameter_services=False)  # smaller wait set
         v = self.declare_params(PARAMETERS)
-        self.config = EstimatorConfig(
-            model=v.model, tensions=v.tensions, pose=v.pose, platform_inertia=v.platform_inertia,
-            coulomb=v.coulomb, viscous=v.viscous, stale_after=v.stale_after,
-            pulley_radius=v.pulley_radius if v.pulley_radius > 0 else None)
-        timeout = v.input_timeout
-        self.estimator = None
-        self.poses = StampedBuffer()    # t -> (position, quat wxyz, acceleration); may run ahead
-        self.motor = None       # (t, velocity, effort)
+        self.config = estimator_config(v)
+        # batch mode (poll_period > 0): the inputs wake nobody; a timer takes what queued every
+        # poll_period s and estimates the newest tension sample, one estimate per period. The
+        # tension queue keeps only that newest sample (keep-last 1: the samples in between are
+        # overwritten inside DDS, never decoded in Python) and the pose queue the stamps around
+        # it (the newest tension's and a reference lead of two periods)
+        self.stream = EstimateStream(self.config, batch=v.poll_period > 0)
         self.published = 0
-        self.skipped = 0
-        self.last_problem = ""
-        self.last_skip = -1e9     # wall time of the last skipped sample
-        self.latency = []       # processing times, s (for the benchmark)
-        self.readers = {"joints": RawReader(JointState), "reference": RawReader(MultiDOFJointTrajectory)}
-        self.inputs.add("tensions", timeout=timeout)
-        self.inputs.add("pose", timeout=timeout)
-        if self.config.tensions == "motor":
-            self.inputs.add("joint_states", timeout=timeout)
-        q = stream_qos(1000)     # deep queue: a busy moment delays samples instead of dropping them
+        self.latency = Latency()
+        motor = self.config.tensions == "motor"
+        for name in ("tensions", "pose") + (("joint_states",) if motor else ()):
+            self.inputs.add(name, timeout=v.input_timeout)
         self.pub = self.create_publisher(InertiaStamped, topics.PAYLOAD_ESTIMATE, publisher_qos())
         self.keep_first_description = True   # the first valid description configures the law
         self.listen_for_description(v.description)
-        # batch mode: the inputs wake nobody; a timer takes what queued every poll_period s and
-        # estimates the newest tension sample, one estimate per period. The tension queue keeps
-        # only that newest sample (keep-last 1: the samples in between are overwritten inside
-        # DDS, never decoded in Python) and the pose queue the stamps around it (the newest
-        # tension's and a reference lead of two periods)
-        self.poll_period = v.poll_period
-        q_pose, q_tension = (stream_qos(4), stream_qos(1)) if self.poll_period > 0 else (q, q)
+        q = stream_qos(1000)     # deep queue: a busy moment delays samples instead of dropping them
+        q_pose, q_tension = (stream_qos(4), stream_qos(1)) if self.stream.batch else (q, q)
         # the pose first: when both wait in one wake-up, a tension sample meets the pose of its
         # stamp (FastExecutor and rclpy's executor take ready topics in creation order)
-        if self.config.pose == "desired":
-            subs = [self.create_subscription(MultiDOFJointTrajectory, topics.REFERENCE, self.on_reference,
-                                             q_pose, raw=True)]
-        else:
-            subs = [self.create_subscription(PoseStamped, topics.PLATFORM_POSE, self.on_pose, q_pose)]
-        if self.config.tensions == "motor":        # (1 kHz of traffic nobody reads otherwise)
-            subs.append(self.create_subscription(JointState, topics.JOINT_STATES, self.on_joints, q_tension,
-                                                 raw=True))
-        else:
-            subs.append(self.create_subscription(JointState, topics.CABLE_TENSIONS, self.on_tensions, q_tension,
-                                                 raw=True))
-        self.newest = None          # (t, m, com) not published yet (batch mode)
-        self.batch_newest = None    # (t, tensions) of the newest input sample of the period (batch mode)
-        if self.poll_period > 0:
-            for sub in subs:
-                poll(self, sub)
-            self.polled = subs
-            self.create_timer(self.poll_period, self.on_poll)
+        sub = self.create_subscription
+        subs = [sub(MultiDOFJointTrajectory, topics.REFERENCE, self.on_reference, q_pose, raw=True)
+                if self.config.pose == "desired" else sub(PoseStamped, topics.PLATFORM_POSE, self.on_pose, q_pose)]
+        subs.append(sub(JointState, topics.JOINT_STATES, self.on_joints, q_tension, raw=True) if motor else
+                    sub(JointState, topics.CABLE_TENSIONS, self.on_tensions, q_tension, raw=True))
+        self.polled = subs if self.stream.batch else []      # (1 kHz of traffic nobody reads otherwise)
+        for s in self.polled:
+            poll(self, s)
+        if self.stream.batch:
+            self.create_timer(v.poll_period, self.on_poll)
         self.use_fast_executor()
         self.t_est = RawTemplate(convert.inertia_msg(0.0, 0.0, [0.0, 0.0, float("nan")]))
-        self._est_m, self._est_com = self.t_est["inertia.m"], self.t_est.vector("inertia.com")
+        self.readers = {"joints": RawReader(JointState), "reference": RawReader(MultiDOFJointTrajectory)}
         self.start_diagnostics()
 
-    # ------------------------------------------------------------------ inputs
     def set_description(self, desc) -> None:
-        if desc.cdpr is None:
-            self.last_problem = "plant description has no cdpr section"
-            return
-        super().set_description(desc)
-        self.estimator = LiveEstimator(desc.cdpr, desc.gravity, self.config)
-        n = len(desc.cdpr.cables)
-        self.inputs.set_length("tensions", n)
-        if "joint_states" in self.inputs.inputs:
-            self.inputs.set_length("joint_states", n)
+        self.stream.describe(desc.cdpr, desc.gravity)
+        if desc.cdpr is not None:
+            super().set_description(desc)
+            for name in ("tensions", "joint_states"):
+                if name in self.inputs.inputs:
+                    self.inputs.set_length(name, len(desc.cdpr.cables))
 
     def on_reference(self, msg: MultiDOFJointTrajectory) -> None:
         """A reference sample (MultiDOFJointTrajectory or its serialised bytes)."""
-        try:
-            r = rawmsg.multidof_arrays(msg, self.readers["reference"])   # position None when empty
-        except ValueError:
-            self.inputs.accept("pose", None, time.monotonic())          # not a message: rejected
-            return
-        if self.inputs.accept("pose", r["position"], time.monotonic()):
-            self.poses.push(r["t"], (r["position"], xyzw_to_wxyz(r["quaternion"]), r["linear_acceleration"]))
+        r = self.decode("pose", partial(rawmsg.multidof_arrays, reader=self.readers["reference"]), msg)
+        if r is not None and self.accept("pose", r["position"]):       # (position None when empty)
+            self.stream.pose(r["t"], r["position"], xyzw_to_wxyz(r["quaternion"]), r["linear_acceleration"])
 
     def on_pose(self, msg: PoseStamped) -> None:
         t, pos, q = convert.pose_arrays(msg)
-        if self.inputs.accept("pose", pos, time.monotonic()):
-            self.poses.push(t, (pos, xyzw_to_wxyz(q), None))
+        if self.accept("pose", pos):
+            self.stream.pose(t, pos, xyzw_to_wxyz(q))
 
-    def _joint_state(self, msg):
-        """(t, names, q, qd, effort) of a JointState or its bytes; None for bytes that are not one."""
-        try:
-            return rawmsg.joint_state_arrays(msg, self.readers["joints"])
-        except ValueError:
-            return None
+    def _joint_state(self, name: str, msg):
+        return self.decode(name, partial(rawmsg.joint_state_arrays, reader=self.readers["joints"]), msg)
 
     def on_joints(self, msg: JointState) -> None:
         if self.config.tensions != "motor":
             return
-        js = self._joint_state(msg)
-        if js is None:
-            self.inputs.accept("joint_states", None, time.monotonic())
-            return
-        t, _names, _q, qd, eff = js
-        if self.inputs.accept("joint_states", eff, time.monotonic()) and qd is not None:
-            self.motor = (t, qd, eff)
-            self.sample(t, None)
+        js = self._joint_state("joint_states", msg)
+        if js is not None and self.accept("joint_states", js[4]) and js[3] is not None:
+            self.estimate(js[0], motor=(js[3], js[4]))
 
     def on_tensions(self, msg: JointState) -> None:
         if self.config.tensions != "dynamometer":
             return
-        js = self._joint_state(msg)
-        if js is None:
-            self.inputs.accept("tensions", None, time.monotonic())
-            return
-        t, _names, _q, _qd, eff = js
-        self.inputs.accept("tensions", eff, time.monotonic())
-        self.sample(t, eff)
+        js = self._joint_state("tensions", msg)
+        if js is not None:
+            self.accept("tensions", js[4])
+            self.estimate(js[0], js[4])
 
-    def sample(self, t: float, tensions) -> None:
-        """A new input sample: estimated at once, or in batch mode kept as the newest of the
-        period (:meth:`on_poll` estimates that one: the estimate is per sample, 001 eq. 13, so
-        the newest sample alone gives the estimate the period publishes)."""
-        if self.poll_period > 0:
-            self.batch_newest = (t, tensions)
-        else:
-            self.estimate(t, tensions)
-
-    # ------------------------------------------------------------------ estimate
-    def estimate(self, t: float, tensions) -> None:
-        """One estimate at stamp t; nothing is published unless every check passes."""
+    def estimate(self, t: float, tensions=None, motor=None) -> None:
+        """One sample: estimated and published at once (batch: kept for :meth:`on_poll`)."""
         t0 = time.perf_counter()
-        if self.estimator is None:
-            self.skipped += 1
-            self.last_skip = time.monotonic()
-            self.last_problem = "waiting for /plant_description"
-            return
-        if not self.poses:
-            self.skipped += 1
-            self.last_skip = time.monotonic()
-            self.last_problem = f"no {self.config.pose} pose yet"
-            return
-        tp, (pos, quat, acc) = self.poses.at(t)
-        kw = {"tensions": tensions}
-        times = {"pose": tp}
-        if self.config.tensions == "motor":
-            _, qd, eff = self.motor
-            kw = {"effort": eff, "motor_velocity": qd}
-        res = self.estimator.update(t, position=pos, quat=quat, acceleration=acc, input_times=times, **kw)
-        if res is None:
-            self.skipped += 1
-            self.last_skip = time.monotonic()
-            self.last_problem = self.estimator.status[-1][1]
-            return
-        m, com = res
-        if self.poll_period > 0:
-            self.newest = (t, m, com)                          # published by on_poll
-        else:
-            self.publish_estimate(t, m, com)
-        self.latency.append(time.perf_counter() - t0)
-        if len(self.latency) > 100000:
-            del self.latency[:50000]
-
-    def publish_estimate(self, t: float, m: float, com) -> None:
-        self.t_est.stamp(t)                                    # pre-serialised InertiaStamped
-        self._est_m[0] = m
-        self._est_com[:2] = com[:2]
-        self.pub.publish(self.t_est.data())
-        self.published += 1
+        self.publish_estimate(self.stream.sample(t, tensions, motor), t0)
 
     def on_poll(self) -> None:
         """Batch mode: take every queued sample (each one checked by the input monitor), estimate
         the newest and publish it."""
         drain(*self.polled)
-        if self.batch_newest is not None:
-            self.estimate(*self.batch_newest)
-            self.batch_newest = None
-        if self.newest is not None:
-            self.publish_estimate(*self.newest)
-            self.newest = None
+        t0 = time.perf_counter()
+        self.publish_estimate(self.stream.poll(), t0)
+
+    def publish_estimate(self, est, t0: float) -> None:
+        if est is None:
+            return
+        t, m, com = est
+        self.t_est.stamp(t)                                    # pre-serialised InertiaStamped
+        self.t_est["inertia.m"][0] = m
+        self.t_est.vector("inertia.com")[:2] = com[:2]
+        self.pub.publish(self.t_est.data())
+        self.published += 1
+        self.latency.since(t0)
 
     def extend_status(self, level, msg, values):
-        est_status = self.estimator.status if self.estimator is not None else [(ERROR, self.last_problem)]
+        skips, est = self.stream.skips, self.stream.estimator
+        est_status = est.status if est is not None else [(ERROR, skips.last_problem)]
         worst = max((s[0] for s in est_status), default=0)
         if worst > 0:
-            level = max(level, worst)
-            msg = est_status[-1][1] if msg == "ok" else f"{msg}; {est_status[-1][1]}"
-        elif time.monotonic() - self.last_skip < 2.0 and self.last_problem and level == 0:
-            level, msg = WARN, f"skipped samples ({self.last_problem})"
-        values.update({"published": str(self.published), "skipped": str(self.skipped),
-                       "last problem": self.last_problem or "none",
+            level, msg = add_problem(level, msg, worst, est_status[-1][1])
+        elif skips.is_recent() and level == 0:
+            level, msg = WARN, f"skipped samples ({skips.last_problem})"
+        values.update({"published": str(self.published), "skipped": str(skips.skipped),
+                       "last problem": skips.last_problem or "none",
                        "model": self.config.model, "tensions": self.config.tensions,
                        "pose": self.config.pose})
-        if self.latency:
-            lat = np.asarray(self.latency[-1000:])
-            values["latency p99 ms"] = f"{1000 * np.percentile(lat, 99):.3f}"
-        return level, msg, values
+        return level, msg, self.latency.report(values)
 
 
 def make_node() -> PlantNode:

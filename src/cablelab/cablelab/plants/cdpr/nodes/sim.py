@@ -22,29 +22,25 @@ from __future__ import annotations
 import time
 
 import numpy as np
-from geometry_msgs.msg import InertiaStamped, PoseStamped
-from rosgraph_msgs.msg import Clock
-from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
-from trajectory_msgs.msg import MultiDOFJointTrajectory
 
 from ....description import load_description
 from ....errors import CablelabError
-from .. import topics
-from ..trajectory import ReferenceTable, pick_and_place
-from ....ros import convert
-from ....rotations import wxyz_to_xyzw
-from ....ros.inputs import WARN
+from ....ros import rawmsg
 from ....ros.fastspin import poll, take_newest
+from ....ros.inputs import WARN
 from ....ros.markers import start_markers
 from ....ros.params import DESCRIPTION, START_GATE, Param, executor_params, markers_rate, merge
 from ....ros.plant_node import PlantNode
-from ....ros.qos import publisher_qos, stream_qos
-from ....ros import rawmsg
-from ....ros.rawmsg import RawTemplate
+from ....ros.qos import stream_qos
+from ....ros.status import Latency, add_problem
+from .. import topics
 from ..geometry import check_pulley_radius
-from ..hardware import WinchBrakes
-from ..sim import CdprSim, default_description_path, truth_from_parameters
+from ..hardware import SimulatedCdpr
+from ..sim import default_description_path, truth_from_parameters
+from ..stepping import SimStepper
+from ..trajectory import ReferenceTable, pick_and_place
+from .outputs import CdprOutputs
 
 
 PARAMETERS = merge((
@@ -101,87 +97,42 @@ class CdprSimNode(PlantNode):
             raise CablelabError("cable_sim_node --plant cdpr: the description has no cdpr section")
         self.n = len(c.cables)
         truth = truth_from_parameters(self.get_name(), v, self.n, v.rate)
-        self.rate = v.rate
-        self.real_time = v.real_time
-        self.publish_reference = v.publish_reference
-        self.publish_pose = v.publish_pose
-        self.speed = v.trajectory_speed
-        self.settle = v.settle
-        self.duration = v.duration
+        self.rate, self.real_time, self.publish_pose = v.rate, v.real_time, v.publish_pose
         self.extras_every = v.extras_every
-        self.mass_change = v.mass_change
-        self.mass_change_time = v.mass_change_time
-        # real time: the reference two steps ahead goes out right after the state (off the
-        # state -> command critical path; the consumers look it up by stamp, and a controller
-        # prepares the reference terms of the next stamp while the plant steps)
-        lead = v.reference_lead
-        self.reference_lead = (2.0 / self.rate if self.real_time else 0.0) if lead < 0 else lead
-        self._ref_sent = None
         self.start_gate()
-        self.command_timeout = v.command_timeout
-        self.lockstep_timeout = v.lockstep_timeout
         start = pick_and_place(np.array([0.0])).position[0]
         check_pulley_radius(c.exit_points, c.anchor_points, start[None], None, c.pulley_radius,
                             c.swivel_axes, f"{self.get_name()}: description cdpr.pulley_radius")
-        self.sim = CdprSim(self.description, truth, start)
-        self.nstep = max(1, int(round(1.0 / (self.rate * self.sim.truth.timestep))))
-        # winch brakes: lock each motor angle where it was when the commands stopped, holding the
-        # last torque that carried the load (stiff PD about the locked angle)
-        self.brakes = WinchBrakes(self.sim)
-        self.u = None
-        self.commands = 0           # good commands received
-        self.commands_at_pub = 0    # ... when the last state was published (lock-step)
-        self.u_stamp = None         # stamp of the state the last command answers, if it says
-        self.fallbacks = 0
-        self.fallbacks_running = 0  # ... after the first command (not the start-up wait)
-        self.slack_steps = 0
-        # real-time misses (what bench/bench_realtime.py sums as missed cycles): steps run one or
-        # more periods after they were due, steps dropped when too far behind, and steps that had
-        # to apply a command answering an older state (the controller did not answer in time)
-        self.late_steps = 0
-        self.dropped_steps = 0
-        self.stale_command_steps = 0
-        self.missed_steps = 0       # steps with any of: late, braked, stale command (each once)
-        self.command_age = [0, 0, 0]   # steps whose command answers the state 1, 2, >= 3 periods back
-        self.latency = []           # wall time of one step (physics + publishing), s
-        self.k = 0
-        self.done = False
-        # the robot is switched on hanging on its locked winch brakes at A: settle that first, so
-        # the first published state already carries the load (sim time restarts at 0)
-        for _ in range(int(round(0.5 / self.sim.truth.timestep))):
-            self.sim.step(self.brake(), 1)
-        self.sim.data.time = 0.0
-        self.brakes.release()
-        self.inputs.add("effort_commands", timeout=self.command_timeout, length=self.n)
-        self._last_pub_wall = time.monotonic()
-        self._wall0 = None          # wall time of sim time 0 (real-time mode)
-
-        q, pq = stream_qos(), publisher_qos()
-        self.pub_js = self.create_publisher(JointState, topics.JOINT_STATES, pq)
-        self.pub_ten = self.create_publisher(JointState, topics.CABLE_TENSIONS, pq)
-        self.pub_pose = self.create_publisher(PoseStamped, topics.PLATFORM_POSE, pq)
-        self.pub_ref = self.create_publisher(MultiDOFJointTrajectory, topics.REFERENCE, pq)
-        self.pub_tpose = self.create_publisher(PoseStamped, topics.GROUND_TRUTH_POSE, pq)
-        self.pub_tpay = self.create_publisher(InertiaStamped, topics.GROUND_TRUTH_PAYLOAD, pq)
-        self.pub_clock = self.create_publisher(Clock, "/clock", publisher_qos())
+        self.stepper = SimStepper(
+            SimulatedCdpr(self.description, truth, self.rate, start), self.rate, self.real_time,
+            v.lockstep_timeout, ReferenceTable(self.rate, v.settle, v.trajectory_speed),
+            v.reference_lead if v.publish_reference else None, v.duration, v.mass_change,
+            v.mass_change_time, self.mass_changed)
+        self.sim = self.stepper.sim
+        self.latency = Latency()
+        self.inputs.add("effort_commands", timeout=v.command_timeout, length=self.n)
+        self.out = CdprOutputs(self, self.n, truth=True)
+        self.out.payload(self.sim.truth.total_mass, self.sim.truth.total_com)
         self.publish_description(self.description)
         if not self.real_time and v.rt_priority > 0:
             self.get_logger().warning("rt_priority ignored: lock-step mode runs as fast as possible")
         self.use_fast_executor()
-        self._templates()
         # real time: the commands wait queued until the step that applies them takes the newest
         # (one wake-up per step, the timer's; a keep-last-1 queue, so one take); lock-step: a
         # command wakes the node (it is the trigger)
         cmd = self.create_subscription(Float64MultiArray, topics.EFFORT_COMMANDS, self.on_command,
-                                       stream_qos(1) if self.real_time else q, raw=True)
+                                       stream_qos(1) if self.real_time else stream_qos(), raw=True)
         self.polled = [cmd] if self.real_time else []
         for sub in self.polled:
             poll(self, sub)
         self.start_diagnostics()
         self.timer = self.create_timer(1.0 / self.rate if self.real_time else 0.0002, self.tick)
-        start_markers(self, topics.MARKERS, self._marker_frame, lambda: self.sim.time,
-                      v.markers_rate)
+        start_markers(self, topics.MARKERS, self._marker_frame, lambda: self.sim.time, v.markers_rate)
         self.publish_state()
+
+    @property
+    def done(self) -> bool:
+        return self.stepper.done
 
     def _marker_frame(self):
         """The 3D view: the platform at its true pose, the cables coloured by their true tension."""
@@ -191,44 +142,12 @@ class CdprSimNode(PlantNode):
         p, q = self.sim.truth_pose()
         return cdpr_markers(self.description, p, quat_to_matrix(q), self.sim.truth_state()["tension"])
 
-
-    def _templates(self) -> None:
-        """Pre-serialised messages (fixed names and lengths): each step patches the numbers."""
-        z, z3 = np.zeros(self.n), np.zeros(3)
-        self.t_js = RawTemplate(convert.joint_state_msg(0.0, [f"winch_{i}" for i in range(1, self.n + 1)],
-                                                        z, z, z))
-        self.t_ten = RawTemplate(convert.joint_state_msg(0.0, [f"cable_{i}" for i in range(1, self.n + 1)],
-                                                         z, None, z))
-        self.t_ref = RawTemplate(convert.multidof_msg(0.0, z3, [0.0, 0.0, 0.0, 1.0], z3, None, z3, None))
-        self.t_clock = RawTemplate(convert.clock_msg(0.0))
-        self.t_pose = RawTemplate(convert.pose_msg(0.0, z3, [0.0, 0.0, 0.0, 1.0]))
-        self.t_tpose = RawTemplate(convert.pose_msg(0.0, z3, [0.0, 0.0, 0.0, 1.0]))
-        self.t_tpay = RawTemplate(convert.inertia_msg(0.0, 0.0, z3))
-        self.t_tpay["inertia.m"][0] = self.sim.truth.total_mass
-        self.t_tpay.vector("inertia.com")[:] = self.sim.truth.total_com
-        r = self.t_ref
-        self._ref_views = (r.vector("points[0].transforms[0].translation"),
-                           r.vector("points[0].velocities[0].linear"),
-                           r.vector("points[0].accelerations[0].linear"))
-
-    # ------------------------------------------------------------------ callbacks
     def extend_status(self, level, msg, values):
-        st = self.sim.truth_state()
-        slack = [str(i + 1) for i in np.flatnonzero(st["slack"])]
-        values.update({"sim time s": f"{self.sim.time:.3f}", "brake (fallback) steps": str(self.fallbacks),
-                       "brake steps after the first command": str(self.fallbacks_running),
-                       "slack cable steps": str(self.slack_steps), "mode": "real time" if self.real_time
-                       else "as fast as possible (lock-step)",
-                       "late steps": str(self.late_steps), "dropped steps": str(self.dropped_steps),
-                       "stale command steps": str(self.stale_command_steps),
-                       "missed steps": str(self.missed_steps),
-                       "command age 1/2/3+ periods": "/".join(str(a) for a in self.command_age)})
-        if self.latency:
-            values["latency p99 ms"] = f"{1000 * np.percentile(np.asarray(self.latency[-1000:]), 99):.3f}"
+        values.update(self.stepper.values())
+        self.latency.report(values)
+        slack = [str(i + 1) for i in np.flatnonzero(self.sim.truth_state()["slack"])]
         if slack:
-            level = max(level, WARN)
-            extra = "slack cable(s) " + ", ".join(slack)
-            msg = extra if msg == "ok" else f"{msg}; {extra}"
+            level, msg = add_problem(level, msg, WARN, "slack cable(s) " + ", ".join(slack))
         return level, msg, values
 
     def on_command(self, msg: Float64MultiArray) -> None:
@@ -238,23 +157,18 @@ class CdprSimNode(PlantNode):
             values, stamp = rawmsg.command_arrays(msg)
         except ValueError:
             values, stamp = None, None          # not a command: rejected and counted below
-        if self.inputs.accept("effort_commands", values, time.monotonic()):
-            self.u = values.copy()
-            self.commands += 1
-            self.u_stamp = stamp
+        if self.accept("effort_commands", values):
+            self.stepper.command(values, stamp)
 
-    def reference(self, t: float):
-        """Desired pose/twist/acceleration of the s-curve at sim time t (held at A while
-        settling, at A after the return): :class:`~cablelab.plants.cdpr.trajectory.ReferenceTable`."""
-        if getattr(self, "_ref_table", None) is None:
-            self._ref_table = ReferenceTable(self.rate, self.settle, self.speed)
-        return self._ref_table.at(t)
+    def mass_changed(self, kg: float) -> None:
+        self.out.payload(self.sim.truth.total_mass, self.sim.truth.total_com)
+        self.get_logger().info(f"{kg:g} kg put on the platform at t = {self.sim.time:.3f} s")
 
     def tick(self) -> None:
         """Timer: lock-step, one step when answered; real time, as many steps as the wall clock
         says are due (catching up after a late timer, at most 20 at once)."""
-        if self.k == 0 and self.wait_subs:
-            if self.waiting_for_subscribers(self.pub_js, self._last_pub_wall, self.publish_state):
+        if self.stepper.k == 0 and self.wait_subs:
+            if self.waiting_for_subscribers(self.out.pub_js, self.stepper.last_publish, self.publish_state):
                 return
             self.publish_state()
         if not self.real_time:
@@ -262,126 +176,33 @@ class CdprSimNode(PlantNode):
             return
         for sub in self.polled:
             take_newest(sub)
-        now = time.monotonic()
-        if self._wall0 is None:
-            self._wall0 = now - self.k / self.rate
-        due = int((now - self._wall0) * self.rate) - self.k
-        if self.commands and due > 1:
-            self.late_steps += min(due, 20) - 1        # ran at least one period after they were due
-        if due > 19:                                   # far behind: do not try to catch up forever
-            if self.commands:
-                self.dropped_steps += due - 20
-            self._wall0 = now - self.k / self.rate
-            due = 20
-        for i in range(max(0, due)):
+        for i in range(self.stepper.due(time.monotonic())):
             self.step_once(late=i > 0)       # the first is on time (within its period), the rest late
             if self.done:
                 return
 
     def step_once(self, late: bool = False) -> None:
         t0 = time.perf_counter()
-        missed = late
         now = time.monotonic()
-        if not self.real_time:
-            if self.u_stamp is not None:      # the controller says which state it answers
-                answered = abs(self.u_stamp - self.sim.time) < 1e-6
-            else:
-                answered = self.commands > self.commands_at_pub
-            if not answered and now - self._last_pub_wall < self.lockstep_timeout:
-                return                                  # lock-step: wait for the controller
-            fresh = answered and self.u is not None     # an answer is fresh however late it came
-        else:
-            fresh = self.u is not None and self.inputs.fresh("effort_commands", now)
-        if not fresh:
-            for _ in range(self.nstep):        # brakes act continuously: every physics step
-                self.sim.step(self.brake(), 1)
-            self.fallbacks += 1
-            if self.commands:
-                self.fallbacks_running += 1
-                missed = True
-        else:
-            self.brakes.release()
-            if self.real_time and self.u_stamp is not None:
-                age = int(round((self.sim.time - self.u_stamp) * self.rate))   # 0: the last state
-                self.command_age[min(max(age, 0), 2)] += 1
-                if age > 0:
-                    self.stale_command_steps += 1       # the answer to the last state is not here
-                    missed = True
-            self.sim.step(self.u, self.nstep)
-        self.k += 1
-        if self.mass_change and 0 <= self.mass_change_time <= self.sim.time:
-            self.sim.add_mass(self.mass_change)
-            self.t_tpay["inertia.m"][0] = self.sim.truth.total_mass
-            self.t_tpay.vector("inertia.com")[:] = self.sim.truth.total_com
-            self.get_logger().info(f"{self.mass_change:g} kg put on the platform at t = {self.sim.time:.3f} s")
-            self.mass_change = 0.0
-        if missed and self.commands and self.real_time:
-            self.missed_steps += 1
-        if self.sim.slack().any():
-            self.slack_steps += 1
-        self.publish_state()
-        self.latency.append(time.perf_counter() - t0)
-        if len(self.latency) > 100000:
-            del self.latency[:50000]
-        if self.duration and self.sim.time >= self.duration:
-            self.done = True
-
-    def brake(self) -> np.ndarray:
-        """Torques of the locked winch brakes (the plant's own safety behaviour)."""
-        return self.brakes.torque(self.u)
+        if self.stepper.step(now, self.inputs.fresh("effort_commands", now), late):
+            self.publish_state()
+            self.latency.since(t0)
 
     def publish_state(self) -> None:
-        """One sample of every output topic, from the pre-serialised templates (same bytes as
-        the convert.* messages, built without an rclpy message object per sample)."""
-        sim, t = self.sim, self.sim.time
+        """One sample of every output topic (the reference of each stamp before its state, or
+        ahead of it after the state; /clock, pose and truth every ``extras_every`` steps)."""
+        sim, out, t = self.sim, self.out, self.sim.time
         ms = sim.measure()
-        extra = self.k % self.extras_every == 0          # /clock, pose and truth: maybe decimated
-        lead = self.reference_lead
-        if self.publish_reference and not lead:
-            self._publish_reference(t)                 # before the state of its stamp
-        elif self.publish_reference and self._ref_sent is None:
-            for i in range(int(round(lead * self.rate))):   # start: every stamp up to the lead
-                self._publish_reference(t + i / self.rate)
-        js = self.t_js
-        js.stamp(t)
-        js["position"][:] = ms["motor_angle"]
-        js["velocity"][:] = ms["motor_velocity"]
-        js["effort"][:] = ms["motor_torque"]
-        self.pub_js.publish(js.data())
-        ten = self.t_ten
-        ten.stamp(t)
-        ten["position"][:] = ms["cable_length"]
-        ten["effort"][:] = ms["tension"]
-        self.pub_ten.publish(ten.data())
-        if self.publish_reference and lead:
-            self._publish_reference(t + lead)          # ahead: waits for the next state
-        if extra:                                      # after the state: off the controller's path
-            self.t_clock.stamp(t, "clock")
-            self.pub_clock.publish(self.t_clock.data())
-            if self.publish_pose:
-                self._pose(self.t_pose, t, ms["position"], ms["quat"])
-                self.pub_pose.publish(self.t_pose.data())
-            tp, tq = sim.truth_pose()
-            self._pose(self.t_tpose, t, tp, tq)
-            self.pub_tpose.publish(self.t_tpose.data())
-            self.t_tpay.stamp(t)
-            self.pub_tpay.publish(self.t_tpay.data())
-        self._last_pub_wall = time.monotonic()
-        self.commands_at_pub = self.commands
-
-    def _publish_reference(self, t: float) -> None:
-        pos, vel, acc = self.reference(t)
-        tr, tv, ta = self._ref_views
-        tr[:], tv[:], ta[:] = pos, vel, acc
-        self.t_ref.stamp(t)
-        self.pub_ref.publish(self.t_ref.data())
-        self._ref_sent = t
-
-    @staticmethod
-    def _pose(tpl: RawTemplate, t: float, position, quat_wxyz) -> None:
-        tpl.stamp(t)
-        tpl.vector("pose.position")[:] = position
-        tpl.vector("pose.orientation", "xyzw")[:] = wxyz_to_xyzw(quat_wxyz)
+        before, after = self.stepper.reference_stamps(t)
+        for tr in before + [None] + after:
+            if tr is None:
+                out.joints(t, ms["motor_angle"], ms["motor_velocity"], ms["motor_torque"])
+                out.tensions(t, ms["tension"], ms["cable_length"])
+            else:
+                out.reference(tr, *self.stepper.reference.at(tr))
+        if self.stepper.k % self.extras_every == 0:     # after the state: off the controller's path
+            out.extras(t, (ms["position"], ms["quat"]) if self.publish_pose else None, sim.truth_pose())
+        self.stepper.published(time.monotonic())
 
 
 def make_node() -> PlantNode:

@@ -34,6 +34,8 @@ from ....ros.inputs import WARN
 from ....ros.params import Param
 from ....ros.plant_node import PlantNode
 from ....ros.qos import publisher_qos, stream_qos
+from ....ros.status import add_problem
+from ....ros.reference import ReferencePlayer, reference_bag_param
 
 
 PARAMETERS = (
@@ -50,8 +52,7 @@ PARAMETERS = (
     Param("excitation_seed", 0, "seed of the built-in multi-sine excitation", ge=0),
     Param("reference_timeout", 0.5, "a reference older than this is stale: the crane is held",
           "s wall", gt=0.0),
-    Param("reference_bag", "", "a reference bag written by `cablelab excite`: played from the first "
-          "joint state on and published on /crane/reference (overrides reference_source)"),
+    reference_bag_param(topics.REFERENCE),
 )
 
 
@@ -63,25 +64,21 @@ class CraneController(PlantNode):
         self.feedforward = v.feedforward
         self.inertias = {"slew_inertia": v.slew_inertia, "luff_inertia": v.luff_inertia}
         self.params = None
-        self.source = v.reference_source
-        self.seed = v.excitation_seed
-        self.play = None
+        self.source = "bag" if v.reference_bag else v.reference_source
         if v.reference_bag:
-            from ....excite import read_reference
-
-            self.play = read_reference(v.reference_bag, topics.REFERENCE, JOINTS)
-            self.source = "bag"
+            self.player = ReferencePlayer.from_bag(self, v.reference_bag, topics.REFERENCE, JOINTS)
+        elif self.source == "excitation":
+            seed = v.excitation_seed
+            self.player = ReferencePlayer(self, topics.REFERENCE, JOINTS,
+                                          lambda t, q0: reference_trajectory(t, q0=tuple(q0), seed=seed))
         self.ref = None
         self.swing = None
         self.fallbacks = 0
-        self.t0 = None
         self.inputs.add("joint_states", timeout=0.5, length=3)
         self.inputs.add("reference", timeout=v.reference_timeout, length=3,
                         required=self.source == "topic")
         self.inputs.add("swing_estimate", timeout=0.5, length=2, required=False)
         self.pub_cmd = self.create_publisher(Float64MultiArray, topics.EFFORT_COMMANDS, publisher_qos())
-        self.pub_ref = self.create_publisher(JointTrajectory, topics.REFERENCE, publisher_qos()) \
-            if self.source in ("excitation", "bag") else None
         self.create_subscription(JointState, topics.JOINT_STATES, self.on_state, stream_qos())
         self.create_subscription(JointState, topics.SWING_ESTIMATE, self.on_swing, stream_qos())
         if self.source == "topic":
@@ -92,8 +89,7 @@ class CraneController(PlantNode):
     def extend_status(self, level, msg, values):
         values["fallback (hold) commands"] = str(self.fallbacks)
         if self.params is None:
-            level = max(level, WARN)
-            msg = "waiting for /plant_description" if msg == "ok" else msg + "; waiting for /plant_description"
+            level, msg = add_problem(level, msg, WARN, "waiting for /plant_description")
         return level, msg, values
 
     def set_description(self, desc) -> None:
@@ -104,23 +100,14 @@ class CraneController(PlantNode):
         self.params = CraneParams.from_description(desc, **self.inertias)
 
     def on_swing(self, msg: JointState) -> None:
-        _, names, q, _, _ = convert.joint_state_arrays(msg)
-        if q is not None and {"theta1", "theta2"} <= set(names) and len(names) == q.size:
-            vals = [q[names.index("theta1")], q[names.index("theta2")]]
-            if self.inputs.accept("swing_estimate", vals, time.monotonic()):
-                self.swing = np.array(vals)
-        else:
-            self.inputs.accept("swing_estimate", None, time.monotonic())
+        swing = convert.named_positions(msg, ("theta1", "theta2"))
+        if self.accept("swing_estimate", swing):
+            self.swing = swing
 
     def on_reference(self, msg: JointTrajectory) -> None:
-        _, names, q, qd, qdd = convert.joint_trajectory_point(msg)
-        if q is None or list(names) != list(JOINTS):
-            self.inputs.accept("reference", None, time.monotonic())
-            return
-        if self.inputs.accept("reference", q, time.monotonic()):
-            z = np.zeros(3)
-            self.ref = (q, qd if qd is not None and qd.size == 3 else z,
-                        qdd if qdd is not None and qdd.size == 3 else z)
+        ref = convert.reference_point(msg, JOINTS)
+        if self.accept("reference", None if ref is None else ref[0]):
+            self.ref = ref
 
     def on_state(self, msg: JointState) -> None:
         t, names, q, qd, _ = convert.joint_state_arrays(msg)
@@ -134,12 +121,7 @@ class CraneController(PlantNode):
             qd = np.zeros(3)
         swing = self.swing[None] if self.swing is not None and self.inputs.fresh("swing_estimate", now) else None
         if self.source in ("excitation", "bag"):
-            if self.t0 is None:
-                self.t0 = t
-            r = self.play(np.array([t - self.t0])) if self.play is not None else \
-                reference_trajectory(np.array([t - self.t0]), q0=tuple(self._q0(q)), seed=self.seed)
-            ref = tuple(x[0] for x in r)
-            self.pub_ref.publish(convert.joint_trajectory_msg(t, JOINTS, *ref))
+            ref = self.player(t, q)
         elif self.ref is not None and self.inputs.fresh("reference", now):
             ref = self.ref
         else:
@@ -150,11 +132,6 @@ class CraneController(PlantNode):
         u = control_law(q[None], qd[None], ref[0][None], ref[1][None], ref[2][None], self.params,
                         self.gains, swing, self.feedforward)[0]
         self.pub_cmd.publish(convert.command_msg(u, stamp=t, label="joints"))
-
-    def _q0(self, q):
-        if not hasattr(self, "_start"):
-            self._start = np.array(q, dtype=float)
-        return self._start
 
 
 def make_node() -> PlantNode:

@@ -11,17 +11,15 @@ ROS parameters: :data:`PARAMETERS` (``payload_estimator --plant crane --help``).
 """
 from __future__ import annotations
 
-import time
-from collections import deque
-
-import numpy as np
 from geometry_msgs.msg import PoseStamped
 from sensor_msgs.msg import JointState
 
 from .. import topics
+from ..posepairs import PosePairs
 from ..swing import SwingTracker
 from ....ros import convert
 from ....ros.inputs import WARN
+from ....ros.status import add_problem
 from ....ros.params import Param
 from ....ros.plant_node import PlantNode
 from ....ros.qos import catch_up_qos, publisher_qos
@@ -43,15 +41,9 @@ class CraneSwingEstimator(PlantNode):
         super().__init__("payload_estimator")
         v = self.declare_params(PARAMETERS)
         self.tracker = SwingTracker(tau=v.velocity_tau)
-        self.slews = deque(maxlen=400)      # (stamp, slew angle) of /crane/joint_states
-        self.pending = deque(maxlen=100)    # pose pairs waiting for the slew angle of their stamp
-        self.tip = None  # (t, position)
-        self.unpaired = 0
-        self.unsynced = 0
-        self.max_wait = v.max_wait
-        pose_timeout = v.pose_timeout
-        self.inputs.add("boom_tip_pose", timeout=pose_timeout, length=3)
-        self.inputs.add("payload_pose", timeout=pose_timeout, length=3)
+        self.pairs = PosePairs(v.max_wait)
+        self.inputs.add("boom_tip_pose", timeout=v.pose_timeout, length=3)
+        self.inputs.add("payload_pose", timeout=v.pose_timeout, length=3)
         self.inputs.add("slew", timeout=v.slew_timeout, length=1)
         self.pub = self.create_publisher(JointState, topics.SWING_ESTIMATE, publisher_qos())
         self.create_subscription(JointState, topics.JOINT_STATES, self.on_joints, catch_up_qos())
@@ -61,63 +53,39 @@ class CraneSwingEstimator(PlantNode):
 
     def extend_status(self, level, msg, values):
         c = self.tracker.counts
-        for k, v in c.items():
-            values[f"samples {k}"] = str(v)
-        values["unpaired poses"] = str(self.unpaired)
-        values["poses without a synchronous slew angle"] = str(self.unsynced)
+        values.update({f"samples {k}": str(v) for k, v in c.items()})
+        values["unpaired poses"] = str(self.pairs.unpaired)
+        values["poses without a synchronous slew angle"] = str(self.pairs.unsynced)
         if c["dropout"] or c["frozen"] or c["irregular"]:
-            level = max(level, WARN)
-            extra = (f"{c['dropout']} motion-capture dropouts, {c['frozen']} frozen stamps, "
-                     f"{c['irregular']} irregular periods")
-            msg = extra if msg == "ok" else f"{msg}; {extra}"
+            level, msg = add_problem(level, msg, WARN, f"{c['dropout']} motion-capture dropouts, "
+                                     f"{c['frozen']} frozen stamps, {c['irregular']} irregular periods")
         return level, msg, values
 
     def on_joints(self, msg: JointState) -> None:
         t, names, q, _qd, _eff = convert.joint_state_arrays(msg)
         if q is None or "slew" not in names or len(names) != q.size:
-            self.inputs.accept("slew", None, time.monotonic())
+            self.accept("slew", None)
             return
         val = q[names.index("slew")]
-        if self.inputs.accept("slew", [val], time.monotonic()) and np.isfinite(t):
-            if not self.slews or t > self.slews[-1][0]:
-                self.slews.append((t, float(val)))
+        if self.accept("slew", [val]):
+            self.pairs.slew(t, val)
             self.process()
 
     def on_tip(self, msg: PoseStamped) -> None:
         t, pos, _ = convert.pose_arrays(msg)
-        self.inputs.accept("boom_tip_pose", pos, time.monotonic())   # NaN is counted as rejected
-        self.tip = (t, pos)
+        self.accept("boom_tip_pose", pos)   # NaN is counted as rejected
+        self.pairs.tip_pose(t, pos)
 
     def on_payload(self, msg: PoseStamped) -> None:
         t, pos, _ = convert.pose_arrays(msg)
-        self.inputs.accept("payload_pose", pos, time.monotonic())
-        if self.tip is None or abs(self.tip[0] - t) > 1e-6:
-            self.unpaired += 1
-            return
-        self.pending.append((t, self.tip[1], pos))
+        self.accept("payload_pose", pos)
+        self.pairs.payload_pose(t, pos)
         self.process()
 
-    def slew_at(self, t: float) -> float | None:
-        """Slew angle at stamp t (interpolated in the buffer; None if not yet received)."""
-        if not self.slews or self.slews[-1][0] < t - 1e-9:
-            return None
-        ts = np.array([s[0] for s in self.slews])
-        vs = np.unwrap(np.array([s[1] for s in self.slews]))
-        return float(np.interp(t, ts, vs))
-
     def process(self) -> None:
-        """Estimate every pending pose pair whose slew angle is known (in stamp order); a pair
-        waiting longer than ``max_wait`` (s of stamps) uses the latest slew angle (counted)."""
-        while self.pending:
-            t, tip, pay = self.pending[0]
-            slew = self.slew_at(t)
-            if slew is None:
-                newest = self.pending[-1][0]
-                if newest - t < self.max_wait or not self.slews:
-                    return
-                slew = self.slews[-1][1]
-                self.unsynced += 1
-            self.pending.popleft()
+        """Estimate every pose pair whose slew angle is known (:meth:`PosePairs.ready
+        <cablelab.plants.crane.posepairs.PosePairs.ready>`) and publish the estimates."""
+        for t, tip, pay, slew in self.pairs.ready():
             status, x, v = self.tracker.update(t, tip, pay, slew)
             if x is not None:
                 self.pub.publish(convert.joint_state_msg(t, NAMES, x, v))

@@ -38,10 +38,12 @@ from ..control import LIVE_GAINS, hold_command
 from ..model import JOINTS, CraneParams
 from ....ros.markers import start_markers
 from ....ros import convert
-from ....ros.lockstep import ADVANCE, FREE, LockStep
+from ....ros.lockstep import ADVANCE, LockStep
 from ....ros.params import DESCRIPTION, START_GATE, Param, markers_rate, merge
 from ....ros.plant_node import PlantNode
+from ....ros.inputs import ERROR
 from ....ros.qos import publisher_qos, stream_qos
+from ....ros.status import add_problem
 from ..sim import CraneSim, CraneTruth
 
 DEFAULT_DESCRIPTION = os.path.join(os.path.dirname(os.path.dirname(__file__)), "data", "crane.yaml")
@@ -96,7 +98,6 @@ class CraneSimNode(PlantNode):
         self.rate = v.rate
         self.lock = LockStep(v.lockstep, wait_first=False, timeout=v.lockstep_timeout)
         self.start_gate()
-        self.published_at = time.monotonic()
         self.sim = CraneSim(truth, q0)
         self.u = None
         self.fallbacks = 0
@@ -122,25 +123,21 @@ class CraneSimNode(PlantNode):
         values["stale answers ignored (lock-step)"] = str(self.lock.stale_answers)
         values["simulation resets"] = str(self.sim.resets)
         if self.sim.resets:
-            level = 2
-            extra = f"simulation diverged {self.sim.resets} times (restored at rest): commands too large?"
-            msg = extra if msg == "ok" else f"{msg}; {extra}"
+            level, msg = add_problem(level, msg, ERROR, f"simulation diverged {self.sim.resets} times "
+                                     "(restored at rest): commands too large?")
         return level, msg, values
 
     def on_command(self, msg: Float64MultiArray) -> None:
-        values = convert.float_array(msg)
-        if not self.inputs.accept("effort_commands", values, time.monotonic()):
-            return
-        if self.lock.offer(convert.command_stamp(msg)):  # False: answers an earlier state
+        values = self.take_command("effort_commands", msg, self.lock)
+        if values is not None:
             self.u = values.copy()       # (never applied late; lock-step starts with the next)
 
     def tick(self) -> None:
-        now = time.monotonic()
-        if self.waiting_for_subscribers(self.pub_js, self.published_at, self.publish_state):
-            return
-        step = self.lock.poll(now)   # no answer for lockstep_timeout s: FREE (hold) until commands flow
-        if step not in (ADVANCE, FREE):
+        # no answer for lockstep_timeout s: FREE (hold) until commands flow
+        step = self.may_step(self.lock, self.pub_js, self.publish_state)
+        if step is None:
             return  # wait for the controller's answer to the last state
+        now = time.monotonic()
         if step == ADVANCE:
             u = self.u  # the answer to the last state, however late it came
         elif (self.u is None or not self.inputs.fresh("effort_commands", now)
@@ -155,9 +152,8 @@ class CraneSimNode(PlantNode):
         self.publish_state()
 
     def publish_state(self) -> None:
-        self.published_at = time.monotonic()
         t, q, qd = self.sim.state()
-        self.lock.published(t, self.published_at)
+        self.lock.published(t)
         m = self.sim.measurement()
         self.pub_clock.publish(convert.clock_msg(t))
         self.pub_js.publish(convert.joint_state_msg(t, JOINTS, m["joints"], m["joint_rates"], m["effort"]))

@@ -58,7 +58,7 @@ class LegControllerNode(PlantNode):
 
     def on_reference(self, msg: JointTrajectory) -> None:
         _, _, pos, _, _ = convert.joint_trajectory_point(msg)
-        if pos is not None and self.inputs.accept("reference", pos, time.monotonic()):
+        if pos is not None and self.accept("reference", pos):
             self.ctl.h_des = float(np.asarray(pos).ravel()[0])
 
     def on_estimate(self, msg: JointState) -> None:

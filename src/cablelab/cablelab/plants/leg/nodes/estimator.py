@@ -54,12 +54,12 @@ class LegEstimatorNode(PlantNode):
 
     def on_contact(self, msg: JointState) -> None:
         _, _, pos, _, _ = convert.joint_state_arrays(msg)
-        if self.inputs.accept("contact", pos, time.monotonic()):
+        if self.accept("contact", pos):
             self.contact = float(pos[0])
 
     def on_state(self, msg: JointState) -> None:
         t, names, pos, _, eff = convert.joint_state_arrays(msg)
-        if pos is None or "body" not in names or not self.inputs.accept("joint_states", pos, time.monotonic()):
+        if pos is None or "body" not in names or not self.accept("joint_states", pos):
             self.est.dropouts += 1
             return
         z = float(pos[names.index("body")])

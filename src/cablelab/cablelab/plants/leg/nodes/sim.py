@@ -70,8 +70,8 @@ class LegSimNode(PlantNode):
         return level, msg or "ok", values
 
     def on_command(self, msg: Float64MultiArray) -> None:
-        values = convert.float_array(msg)
-        if self.inputs.accept("effort_commands", values, time.monotonic()):
+        values = self.take_command("effort_commands", msg)
+        if values is not None:
             self.tau = float(values[0])
 
     def tick(self) -> None:

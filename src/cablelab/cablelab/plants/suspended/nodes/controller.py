@@ -73,7 +73,7 @@ class SuspendedController(PlantNode):
 
     def on_pose(self, msg: PoseStamped) -> None:
         t, pos, qx = convert.pose_arrays(msg)
-        if self.inputs.accept("platform_pose", pos, time.monotonic()) and np.all(np.isfinite(qx)):
+        if self.accept("platform_pose", pos) and np.all(np.isfinite(qx)):
             self.R = quat_to_matrix(xyzw_to_wxyz(qx / np.linalg.norm(qx)))
             self.pose_t = t
             if self.pending is not None and t >= self.pending[0] - 1e-9:
@@ -92,7 +92,7 @@ class SuspendedController(PlantNode):
     def on_joints(self, msg: JointState) -> None:
         t, names, q, qd, _ = convert.joint_state_arrays(msg)
         ok = q is not None and qd is not None and names == self.names and len(q) == len(names)
-        if not self.inputs.accept("joint_states", q if ok else None, time.monotonic()) or not ok \
+        if not self.accept("joint_states", q if ok else None) or not ok \
                 or not np.all(np.isfinite(qd)):
             return
         self.pending = None

@@ -10,7 +10,6 @@ ROS parameters: :data:`PARAMETERS` (``payload_estimator --plant suspended --help
 from __future__ import annotations
 
 import math
-import time
 
 import numpy as np
 from geometry_msgs.msg import PoseStamped
@@ -24,6 +23,7 @@ from ....ros.inputs import WARN
 from ....ros.params import Param, executor_params, merge
 from ....ros.plant_node import PlantNode
 from ....ros.qos import catch_up_qos, publisher_qos
+from ....ros.status import add_problem
 
 PARAMETERS = merge((
     Param("suspension_point", [float(x) for x in parameter_set("licas").S], "suspension point "
@@ -68,21 +68,19 @@ class SuspendedSwingEstimator(PlantNode):
             self.inputs.add("imu", timeout=self.imu_timeout, length=7, required=False)
         t, qx, gyro, _ = convert.imu_arrays(msg)
         ok = qx is not None and gyro is not None
-        if self.inputs.accept("imu", np.r_[qx, gyro] if ok else None, time.monotonic()) and ok:
+        if self.accept("imu", np.r_[qx, gyro] if ok else None) and ok:
             self.est.imu(t, qx[[3, 0, 1, 2]], gyro)
 
     def extend_status(self, level, msg, values):
         values["yaw from IMU"] = str(self.imu_used)
         values["held samples"] = str(self.rejected)
         if self.rejected:
-            level = max(level, WARN)
-            extra = f"{self.rejected} pose samples held ({self.last_problem})"
-            msg = extra if msg == "ok" else f"{msg}; {extra}"
+            level, msg = add_problem(level, msg, WARN, f"{self.rejected} pose samples held ({self.last_problem})")
         return level, msg, values
 
     def on_pose(self, msg: PoseStamped) -> None:
         t, pos, quat_xyzw = convert.pose_arrays(msg)
-        self.inputs.accept("platform_pose", pos, time.monotonic())
+        self.accept("platform_pose", pos)
         q = quat_xyzw[[3, 0, 1, 2]] if quat_xyzw is not None and len(quat_xyzw) == 4 else quat_xyzw
         s = self.est.step(t, pos, q)
         self.imu_used += s.source == "imu"

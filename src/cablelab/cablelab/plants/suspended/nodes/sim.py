@@ -38,7 +38,7 @@ from ....description import load_description
 from ....errors import CablelabError
 from ....ros import convert
 from ....ros.clock import ClockPublisher
-from ....ros.lockstep import ADVANCE, FREE, RESEND, LockStep
+from ....ros.lockstep import FREE, LockStep
 from ....ros.markers import start_markers
 from ....ros.params import START_GATE, Param, executor_params, markers_rate, merge
 from ....ros.plant_node import PlantNode
@@ -123,24 +123,17 @@ class SuspendedSimNode(PlantNode):
             self.sim.hold(ref[0])
 
     def on_effort(self, msg: Float64MultiArray) -> None:
-        u = convert.float_array(msg)
-        if self.inputs.accept("effort_commands", u, time.monotonic()) and \
-                self.lock.offer(convert.command_stamp(msg)):     # False: answers an earlier state
+        u = self.take_command("effort_commands", msg, self.lock)
+        if u is not None:
             self.sim.hold(u)
             if self.lock.enabled:
                 self.advance()        # lock-step: the answer is here, step at once
 
     def tick(self) -> None:
-        now = time.monotonic()
-        if self.waiting_for_subscribers(self.pub_js, self.lock.published_at, self.publish_state,
-                                        max(self.lock.resend, 0.5)):
+        step = self.may_step(self.lock, self.pub_js, self.publish_state, max(self.lock.resend, 0.5))
+        if step is None:
             return
-        step = self.lock.poll(now)
-        if step == RESEND:
-            self.publish_state()      # the controller may have missed it (not connected yet)
-        if step not in (ADVANCE, FREE):
-            return
-        if self.motors and step == FREE and not self.inputs.fresh("effort_commands", now):
+        if self.motors and step == FREE and not self.inputs.fresh("effort_commands", time.monotonic()):
             self.sim.hold(0.0)        # stale command: no torque (reported)
         self.advance()
 

@@ -1,0 +1,91 @@
+"""The CDPR's state topics as pre-serialised messages (:class:`cablelab.ros.rawmsg.RawTemplate`),
+published by the simulator node and the control loop: each sample patches stamps and numbers."""
+from __future__ import annotations
+
+import numpy as np
+from geometry_msgs.msg import InertiaStamped, PoseStamped
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import JointState
+from std_msgs.msg import Float64MultiArray
+from trajectory_msgs.msg import MultiDOFJointTrajectory
+
+from ....ros import convert
+from ....ros.qos import publisher_qos
+from ....ros.rawmsg import CommandTemplate, RawTemplate
+from ....rotations import wxyz_to_xyzw
+from .. import topics
+
+
+def fill_pose(tpl: RawTemplate, t: float, position, quat_wxyz) -> RawTemplate:
+    tpl.stamp(t)
+    tpl.vector("pose.position")[:] = position
+    tpl.vector("pose.orientation", "xyzw")[:] = wxyz_to_xyzw(quat_wxyz)
+    return tpl
+
+
+class CdprOutputs:
+    """Publishers and templates of ``n`` winches: joint states, cable tensions, reference, /clock,
+    measured pose, ground truth (``truth``) and effort commands (``commands``)."""
+
+    def __init__(self, node, n: int, truth: bool = True, commands: bool = False):
+        q = publisher_qos()
+        make = node.create_publisher
+        self.pub_js, self.pub_ten = make(JointState, topics.JOINT_STATES, q), make(JointState, topics.CABLE_TENSIONS, q)
+        self.pub_pose = make(PoseStamped, topics.PLATFORM_POSE, q)
+        self.pub_ref = make(MultiDOFJointTrajectory, topics.REFERENCE, q)
+        self.pub_cmd = make(Float64MultiArray, topics.EFFORT_COMMANDS, q) if commands else None
+        self.pub_tpose = make(PoseStamped, topics.GROUND_TRUTH_POSE, q) if truth else None
+        self.pub_tpay = make(InertiaStamped, topics.GROUND_TRUTH_PAYLOAD, q) if truth else None
+        self.pub_clock = make(Clock, "/clock", publisher_qos())
+        z, z3, unit = np.zeros(n), np.zeros(3), [0.0, 0.0, 0.0, 1.0]
+        self.t_js = RawTemplate(convert.joint_state_msg(0.0, [f"winch_{i}" for i in range(1, n + 1)], z, z, z))
+        self.t_ten = RawTemplate(convert.joint_state_msg(0.0, [f"cable_{i}" for i in range(1, n + 1)], z, None, z))
+        self.t_ref = RawTemplate(convert.multidof_msg(0.0, z3, unit, z3, None, z3, None))
+        self.ref_views = (self.t_ref.vector("points[0].transforms[0].translation"),
+                          self.t_ref.vector("points[0].velocities[0].linear"),
+                          self.t_ref.vector("points[0].accelerations[0].linear"))
+        self.t_cmd = CommandTemplate("winch")
+        self.t_clock = RawTemplate(convert.clock_msg(0.0))
+        self.t_pose = RawTemplate(convert.pose_msg(0.0, z3, unit))
+        self.t_tpose = RawTemplate(convert.pose_msg(0.0, z3, unit))
+        self.t_tpay = RawTemplate(convert.inertia_msg(0.0, 0.0, z3))
+
+    def payload(self, mass: float, com) -> None:
+        """The true moving mass (kg) and centre of mass (3,) of the ground truth."""
+        self.t_tpay["inertia.m"][0] = mass
+        self.t_tpay.vector("inertia.com")[:] = com
+
+    def reference(self, t: float, pos, vel, acc) -> None:
+        for view, value in zip(self.ref_views, (pos, vel, acc)):
+            view[:] = value
+        self.t_ref.stamp(t)
+        self.pub_ref.publish(self.t_ref.data())
+
+    def joints(self, t: float, angle, rate, torque) -> None:
+        js = self.t_js
+        js.stamp(t)
+        js["position"][:], js["velocity"][:], js["effort"][:] = angle, rate, torque
+        self.pub_js.publish(js.data())
+
+    def tensions(self, t: float, tension, length=None) -> None:
+        ten = self.t_ten
+        ten.stamp(t)
+        ten["effort"][:] = tension
+        if length is not None:
+            ten["position"][:] = length
+        self.pub_ten.publish(ten.data())
+
+    def command(self, t: float, torques) -> None:
+        self.pub_cmd.publish(self.t_cmd.data(torques, t))
+
+    def extras(self, t: float, pose=None, truth=None) -> None:
+        """/clock, the measured pose ``(position, quat wxyz)`` and the ground truth pose (and
+        payload) when given."""
+        self.t_clock.stamp(t, "clock")
+        self.pub_clock.publish(self.t_clock.data())
+        if pose is not None:
+            self.pub_pose.publish(fill_pose(self.t_pose, t, *pose).data())
+        if truth is not None:
+            self.pub_tpose.publish(fill_pose(self.t_tpose, t, *truth).data())
+            self.t_tpay.stamp(t)
+            self.pub_tpay.publish(self.t_tpay.data())

@@ -1,0 +1,64 @@
+"""A reference a controller node plays itself and publishes on the plant's reference topic.
+
+A controller that does not follow a reference topic plays one: a bag written by ``cablelab
+excite`` (the ``reference_bag`` parameter, :func:`reference_bag_param`) or a built-in trajectory.
+Time starts at the first joint state; each sample is published (``trajectory_msgs/
+JointTrajectory``, stamped like the state it goes with) so recordings hold what was played::
+
+    self.player = ReferencePlayer.from_bag(self, v.reference_bag, topics.REFERENCE, JOINTS)
+    ...
+    q_ref, qd_ref, qdd_ref = self.player(t, q)      # in the joint-state callback
+"""
+from __future__ import annotations
+
+from typing import Callable, Sequence
+
+import numpy as np
+from trajectory_msgs.msg import JointTrajectory
+
+from . import convert
+from .params import Param
+from .qos import publisher_qos
+
+__all__ = ["ReferencePlayer", "reference_bag_param"]
+
+
+def reference_bag_param(topic: str, overrides: str = "reference_source") -> Param:
+    """The controllers' ``reference_bag`` parameter (played reference published on ``topic``)."""
+    return Param("reference_bag", "", "a reference bag written by `cablelab excite`: played from the "
+                 f"first joint state on and published on {topic} (overrides {overrides})")
+
+
+class ReferencePlayer:
+    """Plays ``trajectory(t, q0) -> (q, qd, qdd)`` ((N, n) each at times ``t`` (N,) s from the
+    first state, ``q0`` the first state's positions) and publishes each played sample.
+
+    Args:
+        node: the controller node (creates the publisher).
+        topic: the plant's reference topic.
+        joints: the joint names of the published trajectory point.
+    """
+
+    def __init__(self, node, topic: str, joints: Sequence[str],
+                 trajectory: Callable[[np.ndarray, np.ndarray], tuple]):
+        self.joints, self.trajectory = list(joints), trajectory
+        self.pub = node.create_publisher(JointTrajectory, topic, publisher_qos())
+        self.t0 = None
+        self.q0 = None
+
+    @classmethod
+    def from_bag(cls, node, path: str, topic: str, joints: Sequence[str]) -> "ReferencePlayer":
+        """The reference in the bag at ``path`` (:func:`cablelab.excite.read_reference`)."""
+        from ..excite import read_reference
+
+        play = read_reference(path, topic, joints)
+        return cls(node, topic, joints, lambda t, _q0: play(t))
+
+    def __call__(self, t: float, q) -> tuple:
+        """The reference (q, qd, qdd) (n,) each at state stamp ``t`` (s) of a state at ``q``;
+        published stamped ``t``."""
+        if self.t0 is None:
+            self.t0, self.q0 = t, np.array(q, dtype=float)
+        ref = tuple(x[0] for x in self.trajectory(np.array([t - self.t0]), self.q0))
+        self.pub.publish(convert.joint_trajectory_msg(t, self.joints, *ref))
+        return ref

@@ -1,0 +1,115 @@
+"""The CDPR simulator node's stepping (plants/cdpr/stepping.py), without ROS or MuJoCo: a scripted
+hardware records what was written, so the schedule, the lock-step matching, the brakes and the
+counts are checked against the rules stated in the node's documentation."""
+import numpy as np
+import pytest
+
+from cablelab.plants.cdpr.stepping import MAX_CATCH_UP, SimStepper
+from cablelab.plants.cdpr.trajectory import ReferenceTable
+
+
+class FakeSim:
+    def __init__(self, rate):
+        self.time, self.dt, self.added = 0.0, 1.0 / rate, []
+        self.slack_now = False
+
+    def slack(self):
+        return np.array([self.slack_now, False])
+
+    def add_mass(self, kg):
+        self.added.append((self.time, kg))
+
+
+class FakeHardware:
+    def __init__(self, rate):
+        self.sim = FakeSim(rate)
+        self.command, self.writes, self.started = None, [], False
+
+    def start(self):
+        self.started = True
+
+    def write(self, command):
+        self.writes.append(("brake", self.command) if command is None else ("drive", command))
+        self.sim.time = round(self.sim.time + self.sim.dt, 9)
+
+
+def stepper(real_time, rate=100.0, **kw):
+    hw = FakeHardware(rate)
+    return SimStepper(hw, rate, real_time, lockstep_timeout=10.0, reference=ReferenceTable(rate), **kw), hw
+
+
+def test_real_time_due_counts_late_and_dropped_steps():
+    s, hw = stepper(True)
+    assert hw.started
+    assert s.due(100.0) == 0                      # sim time 0 at wall 100 s
+    assert s.due(100.035) == 3 and s.late_steps == 0      # no command yet: nothing counted
+    s.command(np.ones(2), None)
+    for _ in range(3):
+        s.step(100.035, fresh=True)
+    assert s.k == 3 and s.due(100.0451) == 1 and s.late_steps == 0
+    s.step(100.0451, fresh=True)
+    assert s.due(100.0751) == 3 and s.late_steps == 2     # two ran a period or more late
+    for _ in range(3):
+        s.step(100.0751, fresh=True)
+    assert s.due(100.0751 + 1.0) == MAX_CATCH_UP          # 100 due: 20 run, 80 dropped
+    assert s.dropped_steps == 100 - MAX_CATCH_UP and s.late_steps == 2 + MAX_CATCH_UP - 1
+    assert s.due(100.0751 + 1.0) == 0             # re-anchored: the dropped steps are not owed
+    assert s.due(100.0751 + 1.0101) == 1
+
+
+def test_real_time_brakes_hold_the_last_command_when_stale():
+    s, hw = stepper(True)
+    s.step(0.0, fresh=True)                       # no command yet: brakes, not a running fallback
+    assert hw.writes[-1] == ("brake", None) and (s.fallbacks, s.fallbacks_running) == (1, 0)
+    u = np.array([1.0, 2.0])
+    s.command(u, 0.01)
+    s.step(0.0, fresh=True)
+    assert hw.writes[-1][0] == "drive" and np.array_equal(hw.writes[-1][1], u)
+    assert s.command_age == [1, 0, 0] and s.missed_steps == 0
+    s.step(0.0, fresh=True)                       # the same answer again: one period stale
+    assert s.command_age == [1, 1, 0] and s.stale_command_steps == 1 and s.missed_steps == 1
+    s.step(0.0, fresh=False)                      # timed out: the brakes hold what was commanded
+    assert hw.writes[-1][0] == "brake" and np.array_equal(hw.writes[-1][1], u)
+    assert s.fallbacks_running == 1 and s.missed_steps == 2
+
+
+def test_lock_step_waits_for_the_answer_then_times_out():
+    s, hw = stepper(False)
+    s.published(50.0)
+    assert not s.step(50.0 + 9.9) and not hw.writes            # waits for the controller
+    s.command(np.ones(2), 0.5)                                  # answers another state: still waits
+    assert not s.step(50.0 + 9.9)
+    s.command(np.full(2, 3.0), 0.0)                             # answers the state of sim time 0
+    assert s.step(50.0 + 9.9) and hw.writes[-1][0] == "drive" and s.fallbacks == 0
+    s.published(60.0)
+    assert not s.step(65.0)
+    assert s.step(70.1) and hw.writes[-1][0] == "brake" and s.fallbacks_running == 1
+    assert s.missed_steps == 0                                  # (counted in real time only)
+    s2, _ = stepper(False)                                      # commands naming no stamp: counted
+    s2.published(0.0)
+    assert not s2.step(1.0)
+    s2.command(np.ones(2), None)
+    assert s2.step(1.0)
+    s2.published(1.0)
+    assert not s2.step(1.5)                                     # one step per new command
+
+
+def test_reference_stamps_lead_mass_change_and_duration():
+    s, _ = stepper(True)                          # real time: two periods ahead
+    before, after = s.reference_stamps(0.0)
+    assert before == pytest.approx([0.0, 0.01]) and after == pytest.approx([0.02])
+    assert s.reference_stamps(0.01) == ([], [pytest.approx(0.03)])
+    s, _ = stepper(False)                         # lock-step: each stamp before its state
+    assert s.reference_stamps(0.5) == ([0.5], []) and s.reference_stamps(0.51) == ([0.51], [])
+    s, _ = stepper(False, reference_lead=None)
+    assert s.reference_stamps(0.5) == ([], [])
+    seen = []
+    s, hw = stepper(True, duration=0.05, mass_change=20.0, mass_change_time=0.03,
+                    on_mass_change=seen.append)
+    s.command(np.ones(2), None)
+    while not s.done:
+        s.step(0.0, fresh=True)
+    assert hw.sim.added == [(pytest.approx(0.03), 20.0)] and seen == [20.0] and s.k == 5
+    hw.sim.slack_now = True
+    s.step(0.0, fresh=True)
+    assert s.slack_steps == 1 and s.values()["slack cable steps"] == "1"
