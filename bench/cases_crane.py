@@ -102,6 +102,68 @@ def draw_case(seed: int, kind: str | None = None) -> PlantCase:
     return case
 
 
+# ----------------------------------------------------------------------------- designed experiments
+
+#: the pair a slew-only recording confounds when the payload is not weighed: the payload's weight
+#: ``m g`` and the hoist offset are both constants on the hoist (the slew axis is vertical, so no
+#: weight reaches it); what ``cablelab excite`` is asked to separate
+PAIR = ("OF[hoist]", "m")
+
+
+def draw_designed_case(seed: int, kind: str | None = None) -> PlantCase:
+    """A case whose first recording does not separate what is hidden: the crane only slews (luff
+    and rope held) for ``first_s`` s, the payload is not weighed (m free) and, unless ``kind`` is
+    "control" (default: every fourth seed), the effort offsets of all three drives are hidden. The benchmark
+    then designs an excitation for :data:`PAIR` on that recording and simulates it with
+    :func:`simulate` (``reference``)."""
+    rng = np.random.default_rng(seed + 104729)
+    if kind is None:
+        kind = "control" if seed % 4 == 3 else "pair"
+    case = draw_case(seed, kind="control")
+    tr = case.truth
+    if kind == "pair":
+        J = tr["boom_length"] ** 2 * (tr["payload_mass"] + tr["boom_mass"] / 4) \
+            + tr["counterbalance_distance"] ** 2 * tr["counterbalance_mass"] + tr["slew_inertia"]
+        K = abs(tr["boom_length"] * (tr["payload_mass"] + tr["boom_mass"] / 2)
+                - tr["counterbalance_distance"] * tr["counterbalance_mass"])
+        f_typ = np.array([0.3 * J + 0.3 * tr["viscous"][0], K * 9.81 * 0.5 + 0.5, tr["payload_mass"] * 9.81])
+        tr["offset"] = list(rng.choice([-1, 1], 3) * rng.uniform(0.05, 0.2, 3) * f_typ)
+        case.hidden = ("torque_sensor_offset",)
+        case.true_params = {"torque_sensor_offset": {f"OF[{j}]": v for j, v in zip(JOINT_NAMES, tr["offset"])},
+                            "payload mass": {"m": tr["payload_mass"]}}
+    else:
+        case.true_params = {"payload mass": {"m": tr["payload_mass"]}}
+    case.fixed = {k: v for k, v in case.fixed.items() if k != "m"}      # the payload is not weighed
+    case.family = f"designed {kind}"
+    amp, f = rng.uniform(0.3, 0.6), rng.uniform(0.08, 0.15)
+    tr.update(first_s=30.0, designed_s=60.0, slew_amp=amp, slew_hz=f, reference=slew_only(amp, f))
+    return case
+
+
+def slew_only(amp: float, hz: float, luff: float = 0.5, rope: float = 0.6):
+    """Reference ``fn(t) -> (q, qd, qdd)``: a slew sine of ``amp`` rad at ``hz``, luff and rope held."""
+    w = 2 * np.pi * hz
+
+    def fn(t):
+        t = np.asarray(t, float)
+        q, qd, qdd = (np.zeros((t.size, 3)) for _ in range(3))
+        q[:, 0], qd[:, 0], qdd[:, 0] = amp * np.sin(w * t), amp * w * np.cos(w * t), -amp * w * w * np.sin(w * t)
+        q[:, 1], q[:, 2] = luff, rope
+        return q, qd, qdd
+
+    return fn
+
+
+def tabulated(t_ref, q, qd, qdd):
+    """Reference ``fn(t)`` interpolating a designed motion (held at its last point after the end)."""
+    def fn(t):
+        t = np.asarray(t, float)
+        return tuple(np.column_stack([np.interp(t, t_ref, a[:, j]) for j in range(a.shape[1])])
+                     for a in (q, qd, qdd))
+
+    return fn
+
+
 def _description(tr: dict, with_cb: bool) -> str:
     y = (f"plant: crane\ngravity: 9.81\ncrane:\n  boom_length: {tr['boom_length']:.6g}\n"
          f"  payload_mass: {tr['payload_mass']:.6g}\n  boom_mass: {tr['boom_mass']:.6g}\n")
@@ -149,6 +211,9 @@ def reference(case: PlantCase, rng):
     drives together (minimum-jerk point to point, or chirp bursts below the payload's pendulum
     frequency) separated by rests (:func:`cases_common.moves_and_rests`)."""
     tr = case.truth
+    if tr.get("reference") is not None:       # a given reference (designed-experiment cases)
+        tr["end"] = tr["duration"]
+        return tr["reference"]
     r, end = moves_and_rests(rng, [0.0, 0.5, 0.6], LIMITS, tr["duration"], tr["rest_fraction"], tr["profile"],
                              move_time=3.5 if tr["profile"] == "ptp" else 5.0, chirp_amp=[0.4, 0.12, 0.15])
     case.truth["end"] = end

@@ -29,7 +29,11 @@ DESCRIPTION = "plant: suspended\nname: licas truth\nsuspended:\n  variant: licas
 
 
 def draw_case(seed: int, kind: str | None = None) -> PlantCase:
-    """A random suspended case. ``kind``: "control" or "one" (default drawn 25/75 %)."""
+    """A random suspended case. ``kind``: "control" or "one" (default drawn 25/75 %), or "stops":
+    Coulomb friction strong enough to stop the swing dead within the first 20 s of a 60 s
+    record (``stopping_case``; not in the default draw)."""
+    if kind == "stops":
+        return stopping_case(seed)
     rng = np.random.default_rng(seed)
     if kind is None:
         kind = str(rng.choice(["control", "one"], p=[0.25, 0.75]))
@@ -46,6 +50,21 @@ def draw_case(seed: int, kind: str | None = None) -> PlantCase:
     if "pose_sensor_offset" in hidden:
         truth["offset"] = np.r_[rng.choice([-1, 1], 2) * rng.uniform(0.005, 0.015, 2), 0.0]
     return PlantCase(plant="suspended", seed=seed, family="", fs=100.0, hidden=tuple(hidden),
+                     description=DESCRIPTION, truth=truth)
+
+
+def stopping_case(seed: int, fs: float | None = None, duration: float = 60.0) -> PlantCase:
+    """A free swing that dry friction in the suspension stops dead: f_s drawn 0.15-0.4 N m (the
+    swing of 0.12-0.25 rad dies within 5-20 s), light viscous friction, ``duration`` s recorded,
+    most of it at rest. ``fs=0``: the same record without friction (its control)."""
+    rng = np.random.default_rng(seed)
+    fs = float(rng.uniform(0.15, 0.4)) if fs is None else float(fs)
+    truth = {"swing_x": rng.choice([-1, 1]) * rng.uniform(0.12, 0.25),
+             "swing_y": rng.choice([-1, 1]) * rng.uniform(0.12, 0.25), "yaw": 0.0,
+             "fv": rng.uniform(0.2, 0.5), "fs": fs, "c": 0.0, "offset": np.zeros(3), "eps": 0.005,
+             "duration": float(duration), "mocap_noise": rng.uniform(3e-4, 1e-3)}
+    hidden = ("cable_joint_coulomb_friction",) if fs > 0 else ()
+    return PlantCase(plant="suspended", seed=seed, family="stops", fs=100.0, hidden=hidden,
                      description=DESCRIPTION, truth=truth)
 
 

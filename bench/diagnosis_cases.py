@@ -145,8 +145,6 @@ def reference(case: Case, rng) -> callable:
     def r(tt):
         tt = np.atleast_1d(np.asarray(tt, float))
         out_q, out_v, out_a = np.zeros_like(tt), np.zeros_like(tt), np.zeros_like(tt)
-        qlast = 0.0
-        last_end = -np.inf
         for (a, b, kind, p) in segs:
             d = b - a
             inside = (tt >= a) & (tt < b)

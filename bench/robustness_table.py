@@ -81,7 +81,6 @@ def main() -> int:
         return validation_table()
     d = Path(tempfile.mkdtemp(prefix="cablelab-robust-"))
     try:
-        rows = []
         mid = 12.42
 
         def sh(t, dt):

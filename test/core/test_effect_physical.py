@@ -11,7 +11,7 @@ import pytest
 
 from cablelab.dataset import Dataset
 from cablelab.effects import all_effects
-from cablelab.fit.identify import propagate
+from cablelab.fit.identification import propagate
 
 DOC = Path(__file__).resolve().parents[2] / "docs" / "workbench.md"
 #: coefficients of the regression that are not what a user knows (paper / spec names replace them)

@@ -57,7 +57,7 @@ def test_hidden_coulomb_friction_ranks_first_through_the_facade(bag, tmp_path, m
     assert fc["value"] == pytest.approx(FC, rel=0.05) and 0 < fc["stderr"] < 0.05 * FC
 
     # the report draws the diagnosis it is given: no fit of its own
-    fitting = importlib.import_module("cablelab.fit.identify")
+    from cablelab.fit import identification as fitting
 
     def no_fit(*args, **kwargs):
         raise AssertionError("the report refitted a model")

@@ -7,7 +7,7 @@ once in the effect registry when the model is made. Linear in the free parameter
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Mapping, Sequence
+from typing import Mapping
 
 import numpy as np
 
@@ -166,32 +166,4 @@ class Evaluation:
         return self.phi @ theta + self.y_known
 
 
-def parse_effect_list(text: str | Sequence[str] | None) -> tuple[str, ...]:
-    """``"a,b"`` -> ``("a", "b")`` (blank entries dropped)."""
-    if text is None:
-        return ()
-    if isinstance(text, str):
-        text = text.split(",")
-    return tuple(s.strip() for s in text if s and s.strip())
-
-
-def parse_fixed(items: Sequence[str] | None) -> dict:
-    """``["M=95.1", "Fc=20"]`` -> ``{"M": 95.1, "Fc": 20.0}`` with one-line errors."""
-    out = {}
-    for item in items or ():
-        for part in str(item).split(","):
-            if not part.strip():
-                continue
-            if "=" not in part:
-                raise CablelabError(f"--fix {part!r}: expected NAME=VALUE")
-            k, v = part.split("=", 1)
-            if k.strip() in out:
-                raise CablelabError(f"--fix {k.strip()}: given twice ({k.strip()}={out[k.strip()]:g} and {part.strip()})")
-            try:
-                out[k.strip()] = float(v)
-            except ValueError:
-                raise CablelabError(f"--fix {part!r}: value {v!r} is not a number") from None
-    return out
-
-
-__all__ = ["KNOWN_OUTPUT", "Evaluation", "Model", "parse_effect_list", "parse_fixed"]
+__all__ = ["KNOWN_OUTPUT", "Evaluation", "Model"]

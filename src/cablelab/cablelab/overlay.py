@@ -68,7 +68,7 @@ class Stage:
 
 
 def stage_from_fit(name: str | None, ds: Dataset, ident) -> Stage:
-    """A :class:`Stage` from an :class:`~cablelab.fit.identify.Identification` on ``ds``:
+    """A :class:`Stage` from an :class:`~cablelab.fit.identification.Identification` on ``ds``:
     measured = the fitted measurement (NaN where not valid), prediction = the model output."""
     valid = np.asarray(ident.valid, dtype=bool)
     measured = np.where(valid[:, None], ident.residual + ident.y_hat, np.nan)

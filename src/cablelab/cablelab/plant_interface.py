@@ -134,7 +134,7 @@ ParseSectionHook = Callable[[Mapping[str, Any]], Any]
 DumpSectionHook = Callable[[Any], Mapping[str, Any]]
 SimulateHook = Callable[["Dataset", Mapping[str, float]], dict]
 SimulationFitHook = Callable[..., Any]
-EstimateHook = Callable[..., Any]
+EstimateHook = Callable[..., Any]   # (bag, desc, options: DatasetOptions, *, effects, out)
 CheckBagHook = Callable[["Bag", "Description", DatasetOptions, Mapping[str, Any]], list]
 RemeasureHook = Callable[["Dataset", "Dataset"], "Dataset"]
 MarkersHook = Callable[["Bag", "Description"], Any]
@@ -202,8 +202,10 @@ class PlantInterface(Protocol):
     """``fn(ds, start_params, *, objective, progress=False) -> SimulationFit`` for
     ``identify --simulation nmse|pearson``."""
     estimate: EstimateHook | None
-    """``fn(bag, desc, **options) -> Estimate`` for ``cablelab estimate`` (an object with
-    ``summary() -> dict``, or a dict)."""
+    """``fn(bag, desc, options, *, effects=(), out=None) -> Estimate`` for ``cablelab estimate``
+    (``options``: the :class:`DatasetOptions` with the plant's own options; ``effects``: effect
+    ids added to the nominal model; ``out``: a bag path to write the per-sample estimates to).
+    Returns an object with ``summary() -> dict``, or a dict."""
     check_bag: CheckBagHook | None
     """``fn(bag, desc, options, series) -> list of warnings`` run before every fit
     (``series``: topic -> decoded series): names against the description, impossible values."""

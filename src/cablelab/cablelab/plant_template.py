@@ -543,6 +543,7 @@ NAME`); docs/architecture.md of cablelab, "The plant template", lists what each 
 | `dataset.py` | bag -> `Dataset` |
 | `effects.py` | the plant's effects (regressors), registered by id |
 | `control.py` | control laws (ROS-free) |
+| `closed_form.py` | closed forms of the law: the oracle of the tests |
 | `mjcf.py` | `build_mjcf(...)`: the MuJoCo model |
 | `sim.py` | the ROS-free simulator, offline runs and bags |
 | `topics.py` | the topic names, defined once |
@@ -554,12 +555,37 @@ Install with `pip install -e .` next to `pyproject.toml`; then `cablelab diagnos
 `cable_sim_node --plant NAME` etc. know the plant. Run its tests with `python -m pytest`.
 '''
 
+FILES["PACKAGE/closed_form.py"] = '''\
+"""Closed forms of the plant's law: the oracle the package's tests check the simulator against
+(replace them with the machine's own: an equilibrium, a period, a conserved quantity)."""
+from __future__ import annotations
+
+import numpy as np
+
+#: the constant-torque run of the test: torque (N m), duration (s), sample rate (Hz)
+TORQUE, DURATION, RATE = 0.2, 2.0, 100.0
+
+
+def constant_torque(section, run: dict) -> dict[str, tuple]:
+    """The undamped hinge from rest under :data:`TORQUE`: ``q = tau t^2 / (2 I)``,
+    ``qd = tau t / I``.
+
+    Args:
+        section: the description section; run: the simulator's run (``t``, ``q``, ``qd``).
+    Returns:
+        name -> (simulated, closed form, rtol, atol).
+    """
+    t, inertia = run["t"], section.inertia
+    return {"q": (run["q"], TORQUE * t ** 2 / (2 * inertia), 1e-2, 1e-4),
+            "qd": (run["qd"], TORQUE * t / inertia, 1e-2, 1e-4)}
+'''
+
 FILES["test_PACKAGE.py"] = '''\
 """Tests of the NAME plant (written by ``cablelab new-plant``; extend them with the plant's law).
 
-Oracles: the closed form of a torque-driven rigid body; the damping MuJoCo integrates against
-the viscous friction ``cablelab diagnose`` identifies from a recorded run; the entry-point
-discovery in a fresh interpreter."""
+Oracles: the closed form of the plant's law (:mod:`PACKAGE.closed_form`, which a new plant
+replaces); the damping MuJoCo integrates against the viscous friction ``cablelab diagnose``
+identifies from a recorded run; the entry-point discovery in a fresh interpreter."""
 from __future__ import annotations
 
 import json
@@ -602,24 +628,30 @@ def test_registered_through_the_entry_point(tmp_path):
 
 
 def test_description_section_round_trip_and_one_line_errors():
+    """The dumped section parses back equal; each field made negative is refused in one line
+    naming it."""
     from cablelab.errors import CablelabError
     from PACKAGE.description import dump_section, parse_section
 
     sec = section()
-    assert parse_section(dump_section(sec)) == sec
-    with pytest.raises(CablelabError) as err:
-        parse_section({"inertia": -1.0})
-    assert "inertia" in str(err.value) and "\\n" not in str(err.value)
+    good = dump_section(sec)
+    assert parse_section(good) == sec
+    for key in good:
+        with pytest.raises(CablelabError) as err:
+            parse_section({**good, key: -1.0})
+        assert key in str(err.value) and "\\n" not in str(err.value)
 
 
 def test_simulator_follows_the_closed_form():
-    """Constant torque on the undamped hinge: q = tau t^2 / (2 I), qd = tau t / I."""
+    """A constant torque from rest, simulated, against the law's closed form
+    (:func:`PACKAGE.closed_form.constant_torque`)."""
+    from PACKAGE import closed_form
     from PACKAGE.sim import simulate
 
-    sec, tau = section(), 0.2
-    run = simulate(sec, 2.0, 100.0, lambda t: tau)
-    assert np.allclose(run["q"], tau * run["t"] ** 2 / (2 * sec.inertia), rtol=1e-2, atol=1e-4)
-    assert np.allclose(run["qd"], tau * run["t"] / sec.inertia, rtol=1e-2, atol=1e-4)
+    sec = section()
+    run = simulate(sec, closed_form.DURATION, closed_form.RATE, lambda t: closed_form.TORQUE)
+    for name, (got, want, rtol, atol) in closed_form.constant_torque(sec, run).items():
+        assert np.allclose(got, want, rtol=rtol, atol=atol), (name, got, want)
 
 
 def test_diagnose_finds_the_hidden_damping(tmp_path):

@@ -49,10 +49,13 @@ def run_json(capsys, *argv):
 
 def rms_error_percent(capsys, bag, *args):
     """Per-sample mass error of the estimate vs the truth in the bag: (mean %, rms %)."""
+    from cablelab.plant_interface import DatasetOptions
     from cablelab.plants.cdpr.estimate import estimate_bag
+    from cablelab.plants.cdpr.options import CdprOptions
     eff = args[args.index("--effects") + 1].split(",") if "--effects" in args else ()
     ten = args[args.index("--tensions") + 1] if "--tensions" in args else "dynamometer"
-    est = estimate_bag(bag, tensions=ten, effects=[e for e in eff if e])
+    est = estimate_bag(bag, options=DatasetOptions(plant=CdprOptions(tensions=ten)),
+                       effects=[e for e in eff if e])
     err = 100 * (est.mass - TRUE) / TRUE
     return float(err.mean()), float(np.sqrt(np.mean(err ** 2)))
 

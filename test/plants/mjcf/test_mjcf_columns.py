@@ -6,12 +6,12 @@ from hypothesis import given, settings, strategies as st
 
 import mujoco
 
-from cablelab.plants.mjcf.inverse import (inertial_columns, inverse_dynamics, point_mass_columns,
-                                          set_standard_params, standard_params)
+from cablelab.plants.mjcf.inverse import (body_columns, inverse_dynamics, inverse_record,
+                                          point_mass_columns, set_standard_params, standard_params)
 from cablelab.plants.mjcf.mjcf import load_model
 from cablelab.plants.mjcf.sim import Hidden, truth_model
 
-from cablelab.plants.mjcf.examples import ARM3, text
+from cablelab.plants.mjcf.examples import ARM3, CABLECAM, GANTRY, text
 
 ARM_XML = text(ARM3)
 
@@ -23,7 +23,59 @@ TOOL = 4
 @pytest.fixture(scope="module")
 def tool_columns():
     model, _ = load_model(ARM_XML)
-    return model, inverse_dynamics(model, Q, QD, QDD), inertial_columns(model, TOOL, Q, QD, QDD)
+    cols = body_columns(model, inverse_record(model, Q, QD, QDD), TOOL)
+    return model, inverse_dynamics(model, Q, QD, QDD), cols
+
+
+_INERTIAL_FIELDS = ("body_mass", "body_ipos", "body_inertia", "body_iquat", "body_sameframe")
+
+
+def _difference_columns(model, body, q, qd, qdd, step=1e-3):
+    """The oracle: ``(tau(theta + step e_k) - tau(theta)) / step`` of ``mj_inverse`` with the
+    body's standard parameters written into the model (exact up to round-off: tau is linear in
+    them); the model is restored."""
+    theta0 = standard_params(model, body)
+    saved = [np.array(getattr(model, f)[body]) for f in _INERTIAL_FIELDS]
+    tau0 = inverse_dynamics(model, q, qd, qdd)
+    cols = np.empty(tau0.shape + (10,))
+    try:
+        for k in range(10):
+            th = theta0.copy()
+            th[k] += step
+            set_standard_params(model, body, th)
+            cols[:, :, k] = (inverse_dynamics(model, q, qd, qdd) - tau0) / step
+    finally:
+        for f, v in zip(_INERTIAL_FIELDS, saved):
+            getattr(model, f)[body] = v
+    return cols
+
+
+def _arm_with_gravcomp():
+    """ARM3 with gravity compensation on the upper arm, routed to the shoulder's actuator."""
+    spec = mujoco.MjSpec.from_string(ARM_XML)
+    spec.body("upper").gravcomp = 0.4
+    spec.joint("shoulder").actgravcomp = True
+    spec.body("fore").gravcomp = 1.0
+    return spec.compile()
+
+
+@pytest.mark.parametrize("make", [lambda: load_model(text(ARM3))[0], lambda: load_model(text(GANTRY))[0],
+                                  lambda: load_model(text(CABLECAM))[0], _arm_with_gravcomp],
+                         ids=["arm3", "gantry", "cablecam", "arm3_gravcomp"])
+def test_body_columns_of_one_pass_equal_the_differences_of_mj_inverse(make):
+    """Every moving body's ten columns from one inverse pass (MuJoCo's cdof, cvel, cacc) equal
+    the differences of mj_inverse with the parameters edited, on random states."""
+    model = make()
+    rng = np.random.default_rng(3)
+    q, qd, qdd = rng.normal(size=(3, 40, model.nv))
+    rec = inverse_record(model, q, qd, qdd)
+    np.testing.assert_array_equal(rec.tau, inverse_dynamics(model, q, qd, qdd))
+    for b in range(1, model.nbody):
+        if model.body_weldid[b] == 0:
+            continue
+        oracle = _difference_columns(model, b, q, qd, qdd)
+        np.testing.assert_allclose(body_columns(model, rec, b), oracle,
+                                   atol=1e-8 * (1.0 + np.abs(oracle).max()), err_msg=f"body {b}")
 
 
 def _with_point_mass(mass, pos):

@@ -83,8 +83,9 @@ def test_toy_plant_simulated_recorded_diagnosed_reported(launcher, tmp_path):
 
 def test_toy_plant_is_the_template_plus_its_law_and_its_tests_pass(tmp_path):
     """Every file of the law differs from what the template writes (the rest is the template's,
-    by construction), and the toy's own tests (the template's, with the pendulum's closed form:
-    equilibrium angle and small-oscillation period) pass on the built package."""
+    by construction, its tests included), and the template's tests pass on the built package
+    (with the pendulum's closed form, ``closed_form.py``: equilibrium angle and small-oscillation
+    period)."""
     from cablelab.plant_template import plant_files
 
     template = plant_files("pendulum")

@@ -3,7 +3,9 @@ from __future__ import annotations
 
 import json
 import math
+from typing import Sequence
 
+from ..errors import CablelabError
 from .numeric import number
 
 
@@ -46,7 +48,6 @@ def plant_cli_options(verb: str | None = None) -> dict:
     """The command-line options plants declare (:func:`cablelab.plant_interface.option` fields of
     their ``options_type``): flag -> ``(dest, CliOption, owners)``, ``owners`` the plants that
     declare it; only those ``verb`` offers (None: every verb's)."""
-    from ..errors import CablelabError
     from ..plant_interface import cli_options
     from ..registry import available_plants, get_plant
 
@@ -91,8 +92,6 @@ def plant_option_values(args) -> dict:
 def check_plant_options(args, plant) -> None:
     """A plant-specific option given for a bag of another plant is an error (it would be
     silently ignored): one line naming the option and the plants it belongs to."""
-    from ..errors import CablelabError
-
     for flag, (dest, _, owners) in plant_cli_options().items():
         if getattr(args, dest, None) is None or plant.name in owners:
             continue
@@ -139,8 +138,6 @@ def add_folds(p) -> None:
 def conditioning_from_args(args):
     """:class:`~cablelab.conditioning.Conditioning` from the shared options (defaults where unset)."""
     from ..conditioning import Conditioning
-
-    from ..errors import CablelabError
 
     kw = {}
     cutoff = getattr(args, "cutoff", None)
@@ -207,11 +204,30 @@ def greedy_stages(ds, steps) -> list:
     return [stage_from_fit(stage_name(s.added), ds, s.fit) for s in steps]
 
 
+def parse_fixed(items: Sequence[str] | None) -> dict:
+    """``["M=95.1", "Fc=20"]`` -> ``{"M": 95.1, "Fc": 20.0}`` with one-line errors."""
+    out = {}
+    for item in items or ():
+        for part in str(item).split(","):
+            if not part.strip():
+                continue
+            if "=" not in part:
+                raise CablelabError(f"--fix {part!r}: expected NAME=VALUE")
+            k, v = part.split("=", 1)
+            if k.strip() in out:
+                raise CablelabError(f"--fix {k.strip()}: given twice ({k.strip()}={out[k.strip()]:g} and {part.strip()})")
+            try:
+                out[k.strip()] = float(v)
+            except ValueError:
+                raise CablelabError(f"--fix {part!r}: value {v!r} is not a number") from None
+    return out
+
+
 def load_from_args(args, *, check_out: bool = False):
     """(plant, description, dataset, model) from the shared options; the input checks' warning
     lines are kept in ``args.warnings`` (see :func:`with_warnings`). ``check_out``: check the
     ``--out`` target first (before any work: never over the input, never replaced unasked)."""
-    from ..model import parse_effect_list, parse_fixed
+    from ..effect_spec import parse_effect_list
     from ..workbench import build_model, load_checked
 
     if check_out and getattr(args, "out", None):
@@ -231,16 +247,12 @@ def load_from_args(args, *, check_out: bool = False):
     fixed = parse_fixed(args.fix)
     for name, value in fixed.items():
         if not math.isfinite(value):
-            from ..errors import CablelabError
-
             raise CablelabError(f"--fix {name}={value}: the value must be a finite number")
     model = build_model(plant, desc, parse_effect_list(args.effects), baseline, fixed,
                         strict=getattr(args, "strict", False))
     from ..model import KNOWN_OUTPUT
 
     if not model.effects and KNOWN_OUTPUT not in ds.signals:   # nothing known, nothing to fit
-        from ..errors import CablelabError
-
         raise CablelabError(f"--baseline {args.baseline}: the model has no effects left to fit; add some "
                             f"with --effects A,B (e.g. --effects {','.join(plant.baseline(desc))})")
     return plant, desc, ds, model
@@ -252,8 +264,6 @@ def check_measured(ds) -> list[str]:
     warning line each (a channel the motion never moves, e.g. the sideways swing of a planar
     free swing, is fitted with the others)."""
     import numpy as np
-
-    from ..errors import CablelabError
 
     y = np.asarray(ds.y, dtype=float)
     ok = np.asarray(ds.valid, dtype=bool) & np.isfinite(y).all(axis=1)
@@ -291,8 +301,6 @@ def with_warnings(args, out: dict) -> dict:
 
 def check_alpha(value: float, name: str = "--alpha") -> None:
     """A significance level must lie in (0, 1)."""
-    from ..errors import CablelabError
-
     if not (0.0 < value < 1.0):
         raise CablelabError(f"{name} {value!r}: expected a significance level between 0 and 1 (e.g. 0.01)")
 

@@ -50,7 +50,7 @@ def _run(args) -> int:
     from ..fleet import analyse
     from ..fleet.engine import run_batch
     from ..fleet.report import summary, write_report
-    from ..model import parse_effect_list
+    from ..effect_spec import parse_effect_list
 
     res = run_batch(args.root, args.out, effects=parse_effect_list(args.effects), greedy=args.greedy,
                     folds=args.folds, scheduler=args.scheduler, workers=args.workers,

@@ -25,7 +25,7 @@ def add_arguments(p) -> None:
 
 def run(args) -> int:
     from ..errors import CablelabError
-    from ..model import parse_effect_list
+    from ..effect_spec import parse_effect_list
     from ..workbench import diagnose
 
     check_alpha(args.alpha)

@@ -1,14 +1,13 @@
 """``cablelab estimate BAG [plant options] [--effects a,b] [--out BAG2] --json``.
 
 Dispatches on the plant of the bag's description to its registered ``estimate(bag,
-description, effects=..., out=..., derived_velocity=..., <the plant's own options>)`` (CDPR:
-``tensions=..., pose=...``), which returns a dict or an object
+description, options, effects=..., out=...)`` (``options``: the
+:class:`~cablelab.plant_interface.DatasetOptions` with the plant's own typed options, e.g. the
+CDPR's ``--tensions`` and ``--pose``), which returns a dict or an object
 with ``summary() -> dict`` (CONTRACT section 5: cdpr ``{"plant", "samples", "mass": {"mean",
 "std", "max_abs_dev"}, "com": {"x", "y"}}``; crane: swing-angle statistics).
 """
 from __future__ import annotations
-
-import inspect
 
 from ..errors import CablelabError
 from ._workbench_args import (add_bag, add_json, add_overwrite, add_plant_options, check_plant_options,
@@ -50,7 +49,7 @@ def run(args) -> int:
     from ..atomic import atomic_output, check_target
     from ..bagcheck import check_bag
     from ..bags import open_bag
-    from ..model import parse_effect_list
+    from ..effect_spec import parse_effect_list
     from ..plant_interface import DatasetOptions
     from ..registry import available_plants, get_plant
     from ..workbench import load_bag_description
@@ -69,19 +68,13 @@ def run(args) -> int:
         able = [p for p in available_plants() if get_plant(p).estimate is not None]
         raise CablelabError(f"plant {desc.plant}: no estimator (cablelab estimate supports "
                             f"{', '.join(able)})")
-    own = dataclasses.asdict(options.plant) if options.plant is not None else {}
-    kwargs = {**own, "effects": parse_effect_list(args.effects), "out": None,
-              "derived_velocity": args.check.derived_velocity}
-    accepted = inspect.signature(fn).parameters
-    if not any(p.kind == p.VAR_KEYWORD for p in accepted.values()):
-        kwargs = {k: v for k, v in kwargs.items() if k in accepted}
+    options = dataclasses.replace(options, derived_velocity=args.check.derived_velocity)
+    effects = parse_effect_list(args.effects)
     writing = atomic_output(args.out, overwrite=args.overwrite, inputs=[args.bag, args.description],
                            verb="estimate") \
         if args.out else contextlib.nullcontext(None)
     with writing as tmp:   # the estimates bag appears whole under --out, or not at all
-        if tmp is not None:
-            kwargs["out"] = str(tmp)
-        res = fn(bag, desc, **kwargs)
+        res = fn(bag, desc, options, effects=effects, out=None if tmp is None else str(tmp))
     res = _without_gaps(res, getattr(args, "check", None))
     summary = res.summary() if hasattr(res, "summary") else dict(res)
     if isinstance(summary.get("mass"), dict):     # a mass estimate that is not > 0 is no result

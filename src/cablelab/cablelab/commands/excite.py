@@ -39,7 +39,7 @@ def run(args) -> int:
     from ..atomic import atomic_output, check_target
     from ..errors import CablelabError
     from ..excite import design, get_exciter, write_reference
-    from ..model import parse_effect_list
+    from ..effect_spec import parse_effect_list
     from ..workbench import load_bag_description, load_checked
 
     if not (math.isfinite(args.duration) and args.duration > 0):

@@ -30,7 +30,7 @@ import scipy.stats
 from ..effects import get_effect
 from ..errors import CablelabError
 from ..fit import evaluate, identify
-from ..fit.identify import lag1_autocorrelation
+from ..fit.identification import lag1_autocorrelation
 from ..fit.threads import blas_single
 from ..dataset import Dataset
 from ..model import Model

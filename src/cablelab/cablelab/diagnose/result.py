@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from ..fit.identify import Identification
+    from ..fit.identification import Identification
     from ..model import Model
 
 

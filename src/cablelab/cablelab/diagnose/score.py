@@ -17,7 +17,7 @@
   per channel, ``LR = sum_c n_eff,c log(RSS0_c / RSS1_c)`` ~ chi^2(dp) under "no gain" (Wilks),
   where ``n_eff,c = n (1 - r1_c) / (1 + r1_c)`` is the AR(1) effective sample size of the
   channel's residual (a filtered, oversampled residual is far from white; on a parallel-filtered
-  dataset it is taken every fs / (2 f_c) samples, :func:`~cablelab.fit.identify.sample_step`),
+  dataset it is taken every fs / (2 f_c) samples, :func:`~cablelab.fit.identification.sample_step`),
   tested at
   ``alpha / m`` for the m candidates tried (Bonferroni). The BIC difference on the same
   effective samples is reported alongside.
@@ -27,7 +27,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.stats
 
-from ..fit.identify import effective_samples
+from ..fit.identification import effective_samples
 
 
 def channel_nrmse(y: np.ndarray, y_hat: np.ndarray, valid: np.ndarray | None = None) -> np.ndarray:

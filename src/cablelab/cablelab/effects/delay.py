@@ -3,9 +3,10 @@
 Convention: the effort the model computes from the motion at time t appears in the measurement
 at t + tau, i.e. ``y_meas(t) = y_model(t - tau)``. The effect evaluates the model on the motion
 signals shifted to ``t - tau`` (linear interpolation of every time-indexed signal, actuator
-velocity and map); samples whose shifted time leaves the record or crosses a gap of the time axis
-are marked invalid. The measurement itself is never interpolated: interpolating a noisy signal
-at a fractional shift averages neighbouring samples and would "explain" white noise as a delay.
+velocity and map; a signal is interpolated when first read, :class:`ShiftedSignals`); samples
+whose shifted time leaves the record or crosses a gap of the time axis are marked invalid. The
+measurement itself is never interpolated: interpolating a noisy signal at a fractional shift
+averages neighbouring samples and would "explain" white noise as a delay.
 When a plant's output channels are raw measurements mapped through a motion-dependent matrix
 (the CDPR's wrench ``W(pose(t)) t_meas(t)``), shifting the motion alone would also shift that
 map: the plant's ``remeasure`` hook (:class:`cablelab.registry.Plant`) then keeps the raw
@@ -13,10 +14,11 @@ measurement unshifted and re-forms ``y = W(pose(t - tau)) t_meas(t)``, the wrenc
 tensions exert at the pose they belong to (the measured tensions are not interpolated either).
 tau < 0 means the measurement leads the motion (typical when the "effort" is a controller
 command). tau is found by a bounded outer search around the linear least squares (separable least
-squares, see :mod:`cablelab.fit.identify`).
+squares, see :mod:`cablelab.fit.identification`).
 """
 from __future__ import annotations
 
+from collections.abc import MutableMapping
 from typing import Mapping
 
 import numpy as np
@@ -54,6 +56,47 @@ def shift_array(x: np.ndarray, i: np.ndarray, w: np.ndarray) -> np.ndarray:
     return x[i] * (1.0 - wb) + x[i + 1] * wb
 
 
+def _time_indexed(v, n: int) -> bool:
+    return isinstance(v, np.ndarray) and v.ndim >= 1 and v.shape[0] == n and v.dtype.kind == "f"
+
+
+class ShiftedSignals(MutableMapping):
+    """A dataset's ``signals`` seen at ``t - tau``: each time-indexed float signal is interpolated
+    (:func:`shift_array`) when first read, then kept. A fit reads only the few signals its
+    regressor needs (the nominal output, q, qd, qdd), so a probe of the outer search does not pay
+    for the large column caches a dataset may carry (an ``(N, C, 80)`` block of link inertia
+    columns). The keys are those of the source at the time of the shift; values written later
+    (a cache an effect fills on first use) are kept as written."""
+
+    def __init__(self, source: Mapping, i: np.ndarray, w: np.ndarray):
+        self._source = dict(source)
+        self._i, self._w, self._n = i, w, i.shape[0]
+        self._done: dict = {}
+
+    def __getitem__(self, key):
+        if key not in self._done:
+            v = self._source[key]
+            self._done[key] = shift_array(v, self._i, self._w) if _time_indexed(v, self._n) else v
+        return self._done[key]
+
+    def __setitem__(self, key, value) -> None:
+        self._source[key] = value
+        self._done[key] = value
+
+    def __delitem__(self, key) -> None:
+        del self._source[key]
+        self._done.pop(key, None)
+
+    def __iter__(self):
+        return iter(self._source)
+
+    def __len__(self) -> int:
+        return len(self._source)
+
+    def __contains__(self, key) -> bool:
+        return key in self._source
+
+
 def _transform(ds: Dataset, values: Mapping[str, float]) -> Dataset:
     tau = float(values.get("tau", 0.0))
     if tau == 0.0 or ds.n < 2:
@@ -62,11 +105,9 @@ def _transform(ds: Dataset, values: Mapping[str, float]) -> Dataset:
     n = ds.n
 
     def sh(v):
-        if isinstance(v, np.ndarray) and v.ndim >= 1 and v.shape[0] == n and v.dtype.kind == "f":
-            return shift_array(v, i, w)
-        return v
+        return shift_array(v, i, w) if _time_indexed(v, n) else v
 
-    shifted = ds.replace(signals={k: sh(v) for k, v in ds.signals.items()}, act_vel=sh(ds.act_vel),
+    shifted = ds.replace(signals=ShiftedSignals(ds.signals, i, w), act_vel=sh(ds.act_vel),
                          act_map=sh(ds.act_map), valid=ds.valid & ok)
     hook = _remeasure_hook(ds.plant)
     return shifted if hook is None else hook(ds, shifted)

@@ -152,8 +152,8 @@ def fit_simulation(simulate: Callable[[list[dict]], np.ndarray], params: Sequenc
         se = np.sqrt(np.clip(np.diag(cov), 0, None))
     except np.linalg.LinAlgError:
         se = np.full(p, np.nan)
-    # coloured residuals: inflate by the AR(1) effective sample size, as cablelab.fit.identify
-    from .identify import lag1_autocorrelation
+    # coloured residuals: inflate by the AR(1) effective sample size, as cablelab.fit.identification
+    from .identification import lag1_autocorrelation
 
     r1 = lag1_autocorrelation(r0.reshape(y_meas.shape))
     inflation = float(np.sqrt((1.0 + r1) / (1.0 - r1)))

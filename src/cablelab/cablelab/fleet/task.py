@@ -83,7 +83,7 @@ def run_bag(ref: BagRef, bag_hash: str, effects=(), greedy: bool = False, folds:
 def _rows(ref, base, effects, greedy, folds, report_dir, strict=False):
     import shutil
 
-    from ..model import parse_effect_list
+    from ..effect_spec import parse_effect_list
     from ..workbench import build_model, diagnose, load
 
     path, tmp = _local(ref)

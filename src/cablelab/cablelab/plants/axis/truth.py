@@ -49,7 +49,8 @@ def reference(t: np.ndarray, amplitude: float, base_hz: float = 0.25) -> np.ndar
 
 def simulate_axis(description, truth: AxisTruth, *, duration: float = 20.0, fs: float = 500.0,
                   amplitude: float = 0.2, bandwidth_hz: float = 4.0, noise_effort: float = 0.0,
-                  noise_position: float = 0.0, delay: float = 0.0, seed: int = 0) -> AxisRun:
+                  noise_position: float = 0.0, delay: float = 0.0, seed: int = 0,
+                  reference_fn=None) -> AxisRun:
     """Simulate the axis under a position servo and return what a sensor would record.
 
     Args:
@@ -59,6 +60,8 @@ def simulate_axis(description, truth: AxisTruth, *, duration: float = 20.0, fs: 
         amplitude: reference amplitude (m or rad); bandwidth_hz: servo bandwidth.
         noise_effort, noise_position: white-noise standard deviations.
         delay: the reported effort lags the actuator force by this time, s.
+        reference_fn: ``fn(t) -> q`` (or a tuple whose first item is q) the servo tracks instead
+            of the multi-sine (e.g. a designed excitation, :func:`cablelab.excite.read_reference`).
     """
     import mujoco
     import mujoco.rollout
@@ -71,7 +74,11 @@ def simulate_axis(description, truth: AxisTruth, *, duration: float = 20.0, fs: 
     step = max(1, int(round(1.0 / (fs * dt))))
     n_phys = int(round(duration / dt))
     t_phys = np.arange(n_phys) * dt  # sensor row j = state before step j, at time j dt
-    ref = reference(t_phys, amplitude)
+    if reference_fn is None:
+        ref = reference(t_phys, amplitude)
+    else:
+        ref = reference_fn(t_phys)
+        ref = np.asarray(ref[0] if isinstance(ref, tuple) else ref, float).reshape(-1)
     x0 = initial_state(model, ref[0])
     _, sens = mujoco.rollout.rollout(model, data, x0[None], ref[None, :, None])
     sens = sens[0]

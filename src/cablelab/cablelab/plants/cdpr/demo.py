@@ -102,7 +102,7 @@ def cdpr_page(out: Path, bag: Path, pd_bag: Path | None, rows: list, report_inde
                       ("Model II, motor torques raw", {"tensions": "motor"}),
                       ("Model II, motor torques - friction", {"tensions": "motor", "effects":
                        ("winch_coulomb_friction", "winch_viscous_friction")})):
-        e = estimate_bag(bag, kw.pop("description", None), **kw)
+        e = estimate_bag(bag, kw.pop("description", None), _options(kw.pop("tensions", "dynamometer")), **kw)
         ax[0].plot(e.t - 1.0, e.mass, lw=0.8, label=label)     # t = 0 at the end of the 1 s settle
     ax[0].axhline(TRUE_MASS, color="k", ls="--", lw=1, label="true 615 kg")
     ax[0].set_ylabel("estimated mass (kg)")
@@ -135,6 +135,14 @@ def cdpr_page(out: Path, bag: Path, pd_bag: Path | None, rows: list, report_inde
     return str(path)
 
 
+def _options(tensions: str):
+    """The estimate's options with the tension source ``tensions`` (the CDPR's ``--tensions``)."""
+    from ...plant_interface import DatasetOptions
+    from .options import CdprOptions
+
+    return DatasetOptions(plant=CdprOptions(tensions=tensions))
+
+
 def _model1(bag: Path):
     """The bag's description without the pulley radius (Model I)."""
     from ...bags import open_bag
@@ -164,8 +172,8 @@ def cdpr_analysis(out: Path, a, runs: tuple) -> PartResult:
     log("estimating (cablelab estimate) ...")
     m1 = estimate_bag(pdff, _model1(pdff)).summary()
     m2 = estimate_bag(pdff).summary()
-    raw = estimate_bag(pdff, tensions="motor").summary()
-    fr = estimate_bag(pdff, tensions="motor",
+    raw = estimate_bag(pdff, options=_options("motor")).summary()
+    fr = estimate_bag(pdff, options=_options("motor"),
                       effects=("winch_coulomb_friction", "winch_viscous_friction")).summary()
     _, ez = z_error(pdff)
     ez_pd = z_error(pd)[1] if pd is not None else None

@@ -7,10 +7,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...errors import CablelabError
+from ...plant_interface import DatasetOptions
 from ...registry import get_plant
 from .dataset import CdprArrays, dataset_from_arrays, load_arrays
 from .topics import JOINT_STATES as JOINTS, PAYLOAD_ESTIMATE as ESTIMATE
 from .estimation import mass_com, mass_com_batch
+from .options import CdprOptions
 from .geometry import cable_geometry, check_pulley_radius
 
 
@@ -105,17 +107,29 @@ def estimate_arrays(arr: CdprArrays, description, effects=(), params: dict | Non
                     {k: float(v) for k, v in params.items()}, arr.truth_mass, arr.truth_com)
 
 
-def estimate_bag(bag_path, description=None, *, tensions: str = "dynamometer", effects=(),
-                 pose: str = "desired", out=None, derived_velocity: dict | None = None) -> Estimate:
-    """``cablelab estimate`` for a CDPR bag; ``out`` also writes ``/cdpr/payload_estimate``
-    (InertiaStamped: m, com = (x_G, y_G, NaN), frame ``platform``) stamped like the tensions."""
+def estimate_bag(bag_path, description=None, options: DatasetOptions | None = None, *, effects=(),
+                 out=None) -> Estimate:
+    """``cablelab estimate`` for a CDPR bag.
+
+    Args:
+        bag_path: bag path or an open :class:`~cablelab.bags.Bag`.
+        description: the description (None: the bag's ``/plant_description``).
+        options: the tension source and pose (``options.plant``, a :class:`CdprOptions`; None:
+            dynamometers, desired pose) and the joint velocities to derive.
+        effects: effect ids added to the nominal model (``platform_inertia``, friction, ...).
+        out: also write ``/cdpr/payload_estimate`` (InertiaStamped: m, com = (x_G, y_G, NaN),
+            frame ``platform``) stamped like the tensions to this bag.
+    """
     from ...bags import open_bag
+
+    options = options if options is not None else DatasetOptions(plant=CdprOptions())
+    own = options.plant_options(CdprOptions)
 
     bag = bag_path if hasattr(bag_path, "joint_state") else open_bag(bag_path)   # path or open Bag
     desc = description if description is not None else bag.description
     if desc is None:
         raise CablelabError(f"{bag_path}: no /plant_description in the bag; give --description FILE")
-    arr = load_arrays(bag, desc, tensions, pose, (derived_velocity or {}).get(JOINTS, ()))
+    arr = load_arrays(bag, desc, own.tensions, own.pose, dict(options.derived_velocity).get(JOINTS, ()))
     est = estimate_arrays(arr, desc, effects)
     if out is not None:
         from ...bags import BagWriter

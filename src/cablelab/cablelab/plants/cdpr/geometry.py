@@ -141,9 +141,8 @@ def cable_geometry(exit_points: np.ndarray, anchor_points: np.ndarray, position:
     vx = h - r
     vz = dz
     D2 = vx * vx + vz * vz
-    D = np.sqrt(D2)
     lc = np.sqrt(np.maximum(D2 - r * r, 0.0))                # tangent segment l_ci
-    # radial unit vector to the tangent point: rotate (vx, vz)/D by +acos(r/D) in the plane
+    # radial unit vector to the tangent point: rotate (vx, vz)/|v| by +acos(r/|v|) in the plane
     cx = (r * vx - lc * vz) / D2
     cz = (r * vz + lc * vx) / D2
     phi = np.arctan2(cz, cx)                                 # angle of A' from x_p

@@ -11,6 +11,14 @@
    l_c known): ``base_tilt`` should rank first and the fitted tilt should put 002's -0.2 N m back
    on the slew joint at rest; the waterfall, the ranking and the parameters with units are in
    ``<out>/crane/report/index.html``; ``<out>/crane/report/crane.html`` has the swing-angle plot.
+4. The loop closed for a confounded pair: a recording that only slews (luff and rope held, hidden
+   effort offsets, payload mass not weighed) leaves the hoist offset and the payload mass
+   confounded (the payload's weight is a constant on the hoist, like the offset; the slew axis is
+   vertical, so no weight reaches it); ``cablelab excite`` designs a reference for the pair from
+   that recording; ``pd_feedforward -p reference_bag:=REF`` plays it to the simulated crane over
+   DDS with the recorder; the fit on that run separates the pair and brings the offsets and the
+   mass back. Bags: ``<out>/crane/confounded``, ``<out>/crane/designed`` (reference
+   ``<out>/crane/designed_ref``).
 """
 from __future__ import annotations
 
@@ -47,24 +55,32 @@ def rest_torque(params: dict, first_moment: float, gravity: float, alpha: float 
 
 def run_nodes(out: Path, duration: float, domain: int, tilt: float) -> Path:
     """Sim (tilted base) + estimator + controller + recorder over DDS for ``duration`` simulated s."""
+    return run_over_dds(out / "run", out / "logs", duration, domain,
+                        sim={"base_tilt": f"[{tilt!r}, 0.0]", "mocap_noise": 0.001, "mocap_dropout": 0.01},
+                        controller={"reference_source": "excitation"}, estimator=True)
+
+
+def run_over_dds(bag: Path, logs: Path, duration: float, domain: int, *, sim: dict, controller: dict,
+                 estimator: bool) -> Path:
+    """Sim + controller (+ estimator) + recorder over DDS into ``bag`` for ``duration`` simulated s;
+    ``sim`` and ``controller`` are the nodes' ROS parameters."""
     from ...ros.launch import Launcher
 
-    bag = out / "run"
-    logs = out / "logs"
     rate = 100.0
     with Launcher(domain_id=domain, log_dir=logs) as launch:
         launch.start("recorder", [sys.executable, "-m", "cablelab.cli", "record", "--plant", "crane",
                                   "-o", bag, "--overwrite", "--quiet"])
-        launch.node("estimator", "payload_estimator", "crane", {})
-        launch.node("controller", "pd_feedforward", "crane", {"reference_source": "excitation"})
-        launch.wait_for_subscribers([topics.JOINT_STATES, topics.SWING_ESTIMATE,
-                                     topics.EFFORT_COMMANDS, topics.SWING_TRUTH],
+        if estimator:
+            launch.node("estimator", "payload_estimator", "crane", {})
+        launch.node("controller", "pd_feedforward", "crane", controller)
+        launch.wait_for_subscribers([topics.JOINT_STATES, topics.EFFORT_COMMANDS, topics.SWING_TRUTH]
+                                    + ([topics.SWING_ESTIMATE] if estimator else []),
                                     timeout=90, node_name="cablelab_recorder")
         launch.wait_for_subscribers([topics.JOINT_STATES], timeout=90, node_name="pd_feedforward")
-        launch.wait_for_subscribers([topics.TIP_POSE], timeout=90)
+        if estimator:
+            launch.wait_for_subscribers([topics.TIP_POSE], timeout=90)
         launch.node("sim", "cable_sim_node", "crane", {
-            "rate": rate, "base_tilt": f"[{tilt!r}, 0.0]", "mocap_noise": 0.001,
-            "mocap_dropout": 0.01, "wait_for_subscribers": 3})   # recorder, estimator, controller
+            "rate": rate, **sim, "wait_for_subscribers": 3 if estimator else 2})
         t0 = time.monotonic()
         from ...ros.sim_progress import SimProgress
 
@@ -166,7 +182,94 @@ def described_params():
     return CraneParams.from_description(load_description(str(desc_file)))
 
 
-def analyse(out: Path, bag_dir: Path, *, folds: int = 5) -> PartResult:
+#: step 4: the confounded pair, and the effort offsets [slew N m, luff N m, hoist N] the
+#: simulator adds (hidden from the model, like the payload mass, which it fits)
+LOOP_PARAMS = ("OF[hoist]", "m")
+LOOP_OFFSET = (0.2, 0.0, 1.0)
+LOOP_NOISE = (0.05, 0.05, 0.1)     # effort noise of the offline recording (N m, N m, N)
+
+
+def slew_only(t):
+    """Reference that only slews (0.3 rad at 0.1 Hz); luff (0.5 rad) and rope (0.6 m) held."""
+    t = np.asarray(t, float)
+    q, qd, qdd = (np.zeros((t.size, 3)) for _ in range(3))
+    w = 2 * np.pi * 0.1
+    q[:, 0], qd[:, 0], qdd[:, 0] = 0.3 * np.sin(w * t), 0.3 * w * np.cos(w * t), -0.3 * w * w * np.sin(w * t)
+    q[:, 1], q[:, 2] = REST_LUFF, 0.6
+    return q, qd, qdd
+
+
+def loop_fit(bag_dir: Path):
+    """Fit of the described crane + ``torque_sensor_offset`` on a bag, payload mass free (not
+    weighed), boom and counterbalance as described: (dataset, identification, correlation of
+    the pair, condition number of the pair in that model: :func:`cablelab.excite.condition`)."""
+    from ...diagnose.identifiability import correlations
+    from ...excite import condition
+    from ...fit import identify
+    from ...workbench import build_model, load
+
+    plant, desc, ds = load(bag_dir)
+    c = desc.crane
+    model = build_model(plant, desc, ["torque_sensor_offset"], strict=True,
+                        fixed={"m_b": c.boom_mass, "m_c": c.counterbalance.mass,
+                               "l_c": c.counterbalance.distance})
+    fit = identify(model, ds)
+    names, corr = correlations(fit)
+    a, b = (names.index(p) for p in LOOP_PARAMS)
+    return ds, fit, float(corr[a, b]), condition(model, ds, LOOP_PARAMS)
+
+
+def close_loop(out: Path, *, confounded_s: float, designed_s: float, domain: int) -> dict:
+    """Step 4 up to the recordings: the slew-only recording (offline MuJoCo crane), ``cablelab
+    excite`` on it for :data:`LOOP_PARAMS`, the designed reference played over DDS. Returns the
+    paths and the design's condition numbers."""
+    from ...description import load_description
+    from ...excite import design, get_exciter, write_reference
+    from .sim import CraneTruth, simulate, write_bag
+
+    desc_text = (Path(__file__).parent / "data" / "crane.yaml").read_text()
+    confounded, ref = out / "confounded", out / "designed_ref"
+    log(f"crane: slew-only recording ({confounded_s:.0f} s, offline) with hidden offsets "
+        f"{LOOP_OFFSET} and the payload mass free ...")
+    truth = CraneTruth(torque_offset=LOOP_OFFSET, effort_noise=LOOP_NOISE, mocap_noise=0.0005)
+    write_bag(confounded, simulate(truth, confounded_s, reference=slew_only), desc_text, overwrite=True)
+    ds0, _, rho0, _ = loop_fit(confounded)
+    log(f"crane: {', '.join(LOOP_PARAMS)} correlated {rho0:+.4f}: cablelab excite --params "
+        f"'{','.join(LOOP_PARAMS)}' --duration {designed_s:g} ...")
+    d = design("crane", load_description(desc_text), LOOP_PARAMS, duration=designed_s,
+               before_ds=ds0, max_iter=10)
+    write_reference(ref, d, get_exciter("crane"), desc_text, overwrite=True)
+    log(f"crane: excite's condition number (nominal + offsets, all free) {d.condition_before:.4g} -> "
+        f"{d.condition_after:.4g} ({d.seconds:.1f} s); pd_feedforward -p reference_bag:={ref} over DDS ...")
+    designed = run_over_dds(out / "designed", out / "logs_designed", designed_s, domain,
+                            sim={"offset": f"[{', '.join(repr(v) for v in LOOP_OFFSET)}]"},
+                            controller={"reference_bag": str(ref)}, estimator=False)
+    return {"confounded": confounded, "designed": designed, "reference": ref, "design_s": d.seconds}
+
+
+def loop_rows(loop: dict) -> list:
+    """Step 4's table rows: the pair's correlation and the parameters before and after."""
+    _, f0, rho0, c0 = loop_fit(loop["confounded"])
+    _, f1, rho1, c1 = loop_fit(loop["designed"])
+    truth = described_params().payload_mass
+    off = ", ".join(f"{v:g}" for v in LOOP_OFFSET)
+
+    def params(f):
+        p = f.params
+        return (f"{p['OF[slew]']:+.3f} / {p['OF[luff]']:+.3f} / {p['OF[hoist]']:+.3f} ; "
+                f"{p['m']:.3f}")
+
+    return [
+        ["loop: condition number of (OF[hoist], m) in the fitted model, slew-only -> designed",
+         f"{c0:.4g} -> {c1:.4g}", "-"],
+        ["loop: correlation OF[hoist] ~ m, slew-only -> designed", f"{rho0:+.4f} -> {rho1:+.4f}", "-"],
+        ["loop: offsets slew / luff / hoist ; payload m (kg), slew-only", params(f0),
+         f"sim {off} ; {truth:g}"],
+        ["loop: same, designed reference over DDS", params(f1), f"sim {off} ; {truth:g}"],
+    ]
+
+
+def analyse(out: Path, bag_dir: Path, *, folds: int = 5, loop: dict | None = None) -> PartResult:
     """Steps 2-3 on a recorded bag: swing angles vs truth, diagnose + report, the table rows."""
     from ...bags import open_bag
     from . import plant as C
@@ -222,35 +325,49 @@ def analyse(out: Path, bag_dir: Path, *, folds: int = 5) -> PartResult:
          f"{final.get('I_tot', nan):.3f} / {final.get('I_b', nan):.3f}",
          "sim 0.05 / 0.02; 002 sec. 6.2: negative"],
     ]
+    if loop is not None:
+        rows += loop_rows(loop)
     page = crane_page(out / "report", bag_dir, rows, sw)
-    return PartResult(bags=[bag_dir], rows=rows, report=rep.index, page=page,
+    bags = [bag_dir] + ([loop["confounded"], loop["designed"]] if loop is not None else [])
+    return PartResult(bags=bags, rows=rows, report=rep.index, page=page,
                       first=ranking[0].effect, seconds=time.monotonic() - t_start)
 
 
-def run(out: Path, *, duration: float = 30.0, folds: int = 5, domain: int = 1) -> PartResult:
-    """The whole crane part; ``out`` is its directory (``bags/demo/crane``)."""
+def run(out: Path, *, duration: float = 30.0, folds: int = 5, domain: int = 1,
+        loop_s: tuple[float, float] | None = (30.0, 60.0)) -> PartResult:
+    """The whole crane part; ``out`` is its directory (``bags/demo/crane``). ``loop_s``: the
+    durations of step 4's slew-only and designed recordings (None: no step 4)."""
     t0 = time.monotonic()
-    res = analyse(out, record(out, duration=duration, domain=domain), folds=folds)
+    bag = record(out, duration=duration, domain=domain)
+    loop = close_loop(out, confounded_s=loop_s[0], designed_s=loop_s[1], domain=domain) if loop_s else None
+    res = analyse(out, bag, folds=folds, loop=loop)
     res.seconds = time.monotonic() - t0
     return res
 
 
 def add_arguments(group) -> None:
     group.add_argument("--crane-duration", type=float, default=30.0, help="crane: simulated s")
+    group.add_argument("--crane-loop", type=float, nargs=2, default=(30.0, 60.0), metavar=("S1", "S2"),
+                       help="crane: simulated s of the slew-only and the designed recording of the "
+                            "confounded pair (OF[hoist], m); 0 0 skips that step")
 
 
 def quick(a) -> None:
-    """--quick: a 12 s run."""
+    """--quick: a 12 s run; the confounded pair on 10 s slew-only and a 10 s designed reference."""
     a.crane_duration = min(a.crane_duration, 12.0)
+    a.crane_loop = tuple(min(x, 10.0) for x in a.crane_loop)
 
 
-def _record(out: Path, a) -> Path:
+def _record(out: Path, a):
     from ...ros.launch import unique_domain_id
 
-    return record(out, duration=a.crane_duration, domain=unique_domain_id(3))
+    bag = record(out, duration=a.crane_duration, domain=unique_domain_id(3))
+    s1, s2 = a.crane_loop
+    loop = close_loop(out, confounded_s=s1, designed_s=s2, domain=unique_domain_id(3)) if s1 > 0 and s2 > 0 else None
+    return bag, loop
 
 
 DEMO = DemoPart(plant="crane", title="Boom crane (002), hidden tilted base", order=20,
                 add_arguments=add_arguments, record=_record,
-                analyse=lambda out, a, bag: analyse(out, bag, folds=a.folds), quick=quick,
-                subdir="crane")
+                analyse=lambda out, a, runs: analyse(out, runs[0], folds=a.folds, loop=runs[1]),
+                quick=quick, subdir="crane")

@@ -38,17 +38,17 @@ def _stats(x: np.ndarray) -> dict:
     return {"mean": float(np.mean(x)), "std": float(np.std(x)), "max_abs": float(np.max(np.abs(x)))}
 
 
-def estimate_bag(bag, description=None, *, out=None, cutoff_hz: float | None = None,
-                 overwrite: bool = False, **_options) -> dict:
+def estimate_bag(bag, description=None, options=None, *, effects=(), out=None,
+                 cutoff_hz: float | None = None, overwrite: bool = False) -> dict:
     """``cablelab estimate`` for a crane bag: swing-angle statistics (CONTRACT sec. 5) as JSON.
 
     Args:
         bag: bag path or an open :class:`~cablelab.bags.Bag`.
-        description: unused (the swing estimate needs no parameters); kept for the verb's API.
+        description, options, effects: the estimate hook's arguments; the swing estimate is
+            kinematic (no parameters, no model, no plant options), so it reads none of them.
         out: also write the per-sample estimates as ``/crane/swing_estimate`` (stamped like the
             motion capture) to this bag.
         cutoff_hz: optional low-pass of the angles before differentiation.
-    Other options of the verb (``tensions``, ``effects``, ``pose``) do not apply to the crane.
     """
     if not hasattr(bag, "pose"):
         from ...bags import open_bag

@@ -254,7 +254,7 @@ class CraneSim:
         self.u = u
         self.data.ctrl[:] = u
         steps = max(1, int(round(duration / self.model.opt.timestep)))
-        t0, qpos0, qvel0 = self.data.time, self.data.qpos.copy(), self.data.qvel.copy()
+        t0, qpos0 = self.data.time, self.data.qpos.copy()
         for _ in range(steps):  # MuJoCo stepping with a held command (mj_step per time step)
             mujoco.mj_step(self.model, self.data)
         ok = (self.data.time > t0 and np.all(np.isfinite(self.data.qpos))

@@ -142,16 +142,7 @@ def flight_accel(zd, p: LegParams):
     return -(p.d_f * zd + p.Fc * _sign(zd)) / p.flight_mass - p.g
 
 
-def accel(phase: int, z, zd, f_in, p: LegParams):
-    return stance_accel(z, zd, f_in, p) if phase == STANCE else flight_accel(zd, p)
-
-
 # ----------------------------------------------------------------------------- guards and maps
-
-def touchdown_guard(z, l_fl: float):
-    """Flight guard ``z - l_fl``: touch-down where it crosses 0 downwards."""
-    return z - l_fl
-
 
 def liftoff_guard(z, zd, f_in, p: LegParams):
     """Stance guard ``min(F_GRF / k, z_td - z)`` (m): lift-off where it crosses 0 downwards
@@ -171,13 +162,6 @@ def touchdown_map(zd, p: LegParams) -> float:
 def liftoff_map(z, zd, p: LegParams) -> tuple[float, float]:
     """(zdot+, l_fl): zdot+ = beta_lo zdot- (003 eq. 24), frozen leg length min(z_td, z) (E1)."""
     return p.beta_lo * zd, min(p.z_td, float(z))
-
-
-# ----------------------------------------------------------------------------- excitation
-
-def open_loop_torque(t_since_td, T: float, P: float, stance):
-    """003 eq. 26: ``T sin(2 pi (t - t_d) / P)`` in stance, 0 in flight (N m)."""
-    return np.where(np.asarray(stance, bool), T * np.sin(2.0 * np.pi * np.asarray(t_since_td, float) / P), 0.0)
 
 
 # ----------------------------------------------------------------------------- closed forms

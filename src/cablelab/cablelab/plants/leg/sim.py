@@ -97,14 +97,6 @@ class LegSim:
     def zd(self) -> float:
         return float(self.data.qvel[0])
 
-    def set_mass(self, m: float) -> None:
-        """Change the simulated stance mass (and the MuJoCo body mass), kg."""
-        self.p = self.p.replace(m=m)
-        self.model.body_mass[1] = m
-        # the joint-space inertia is built from the constants mj_setConst derives from body_mass
-        # (without it MuJoCo kept the old mass in M while gravity used the new one)
-        mujoco.mj_setConst(self.model, mujoco.MjData(self.model))
-
     # -------------------------------------------------------------- internals
     def _phase_force(self, z: float, zd: float) -> float:
         p = self.p

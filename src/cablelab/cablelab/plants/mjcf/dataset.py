@@ -17,7 +17,7 @@ from ...dataset import Dataset
 from ...model import KNOWN_OUTPUT
 from ...plant_interface import DatasetOptions
 from .description import section_of
-from .inverse import inertial_columns, inverse_dynamics, point_mass_columns
+from .inverse import body_columns, inverse_record, point_mass_columns
 from .mjcf import HINGE, dof_joints, names
 from .topics import JOINT_STATE, topic
 
@@ -45,8 +45,9 @@ def dataset_from_arrays(t, q, effort, description, options: DatasetOptions | Non
     q_c, qd_c, qdd_c = c["q"], c["qd"], c["qdd"]
     y = c["effort"].copy()
     with_tendons = bool(sec.tendons)
-    res = inverse_dynamics(model, q_c, qd_c, qdd_c, tendons=with_tendons)
-    tau, ten_j = (res if with_tendons else (res, None))
+    rec = inverse_record(model, q_c, qd_c, qdd_c, tendons=with_tendons,
+                         kinematics=bool(sec.payload_body))
+    tau, ten_j = rec.tau, rec.ten_j
     driven = np.ones(len(joints), bool) if driven is None else np.asarray(driven, bool)
     signals = {"q": q_c, "qd": qd_c, "qdd": qdd_c, KNOWN_OUTPUT: tau, "cutoff_hz": c["cutoff_hz"],
                "driven": driven,
@@ -61,7 +62,7 @@ def dataset_from_arrays(t, q, effort, description, options: DatasetOptions | Non
         signals.update({"ten_J": jt, "tension": tens})
     if sec.payload_body:
         body = names(model, "body").index(sec.payload_body)
-        cols = inertial_columns(model, body, q_c, qd_c, qdd_c, base=tau)
+        cols = body_columns(model, rec, body)
         signals["payload_columns"] = point_mass_columns(cols, model.body_ipos[body])
         signals["payload_com0"] = np.array(model.body_ipos[body], float)
     units = tuple("N m" if r else "N" for r in revolute)

@@ -43,8 +43,8 @@ PAYLOAD_MASS = register(Effect(
             Param("mcz", "kg m", 0.0, -np.inf, np.inf, "its first moment about the body's centre of mass, z")),
     explanation="an unknown payload on payload_body: the arm carries more mass than its model",
     signature="residual follows the gravity and inertia load of the payload body",
-    reference="CONTRACT sec. 4 (mjcf); columns: mj_inverse differences in the body's standard "
-              "inertial parameters",
+    reference="CONTRACT sec. 4 (mjcf); columns: MuJoCo's Newton-Euler terms (cdof, cvel, cacc) per "
+              "standard inertial parameter of the body, equal to mj_inverse differences",
     regressor=_payload,
     physical=_payload_physical,
 ))
@@ -139,16 +139,17 @@ def _moving_bodies(model) -> list[int]:
 
 def _link_columns(ds: Dataset) -> np.ndarray:
     """(N, C, 10 n_bodies) columns of every moving body's standard inertial parameters
-    (:func:`.inverse.inertial_columns`), computed once per dataset from its q, qd, qdd."""
+    (:func:`.inverse.body_columns`), computed once per dataset from its q, qd, qdd (one inverse
+    dynamics pass for all bodies)."""
     if LINK_COLUMNS not in ds.signals:
         from .description import section_of
-        from .inverse import inertial_columns, inverse_dynamics
+        from .inverse import body_columns, inverse_record
 
         model = section_of(ds.description).compiled(ds.gravity)
         q, qd, qdd = (ds.require_signal(k) for k in ("q", "qd", "qdd"))
-        base = inverse_dynamics(model, q, qd, qdd)
+        rec = inverse_record(model, q, qd, qdd)
         ds.signals[LINK_COLUMNS] = np.concatenate(
-            [inertial_columns(model, b, q, qd, qdd, base=base) for b in _moving_bodies(model)], axis=2)
+            [body_columns(model, rec, b) for b in _moving_bodies(model)], axis=2)
     return ds.signals[LINK_COLUMNS]
 
 

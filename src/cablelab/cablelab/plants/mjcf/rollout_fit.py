@@ -82,7 +82,7 @@ def sysid_fit(xml: str, t, q, effort, joints, *, payload_body: str | None = None
     import mujoco
     from mujoco import sysid
 
-    from ...fit.identify import lag1_autocorrelation
+    from ...fit.identification import lag1_autocorrelation
 
     t = np.asarray(t, float) - float(t[0])
     q, effort = np.asarray(q, float), np.asarray(effort, float)

@@ -244,8 +244,12 @@ class MjcfSim:
         self.joints = dof_joints(self.model)
         self.tendons = list(section.tendons)
         tn = names(self.model, "tendon")
-        self._tendon_ids = [tn.index(x) for x in self.tendons]
-        self._mujoco = mujoco
+        m = self.model
+        # tension of each measured tendon = its actuators' pull: (n_tendons, nu) @ actuator_force
+        self._pull = np.array([np.where((m.actuator_trntype == 3) & (m.actuator_trnid[:, 0] == tn.index(x)),
+                                        -m.actuator_gear[:, 0], 0.0) for x in self.tendons],
+                              float).reshape(len(self.tendons), m.nu)             # mjTRN_TENDON
+        self._step, self._dt, self._nv = mujoco.mj_step, float(m.opt.timestep), m.nv
         mujoco.mj_forward(self.model, self.data)
 
     @property
@@ -254,17 +258,16 @@ class MjcfSim:
 
     def advance(self, ctrl, duration: float) -> None:
         """Hold ``ctrl`` (nu,) for ``duration`` s (at least one step)."""
-        self.data.ctrl[:] = np.asarray(ctrl, float)
-        n = max(1, int(round(duration / self.model.opt.timestep)))
-        self._mujoco.mj_step(self.model, self.data, nstep=n)
+        self.data.ctrl[:] = ctrl
+        n = max(1, int(round(duration / self._dt)))
+        if n == 1:
+            self._step(self.model, self.data)
+        else:
+            self._step(self.model, self.data, nstep=n)
 
     def state(self):
         """``(t, q (nv,), qd (nv,), effort (nv,) = qfrc_actuator, tension (n_tendons,))``: the
         tension of a measured tendon is the pull of the actuators on it (N, >= 0 when pulling)."""
-        m, d = self.model, self.data
-        tension = np.zeros(len(self._tendon_ids))
-        for k, tid in enumerate(self._tendon_ids):
-            on = (m.actuator_trntype == 3) & (m.actuator_trnid[:, 0] == tid)   # mjTRN_TENDON
-            tension[k] = -float(np.sum(d.actuator_force[on] * m.actuator_gear[on, 0]))
-        return (float(d.time), np.array(d.qpos[: m.nv]), np.array(d.qvel), np.array(d.qfrc_actuator),
-                tension)
+        d = self.data
+        return (d.time, d.qpos[: self._nv].copy(), d.qvel.copy(), d.qfrc_actuator.copy(),
+                self._pull @ d.actuator_force)

@@ -18,7 +18,7 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from .mjcf import AXES, _arm_xml
+from .mjcf import _arm_xml
 from .params import VirtualParams
 
 __all__ = ["ArmGravity", "ArmLaw", "pd_gravity", "fig7_excitation", "sway_offset", "gains", "FIG7"]

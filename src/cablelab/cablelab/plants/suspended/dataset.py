@@ -37,7 +37,7 @@ from .reference import planar_bodies
 from .swing import swing_from_pose
 
 __all__ = ["dataset", "dataset_from_arrays", "modal_inertias", "radial_mass", "platform_tilt", "CHANNELS",
-           "POSE_TOPIC", "SUSPENSION_TOPIC", "JOINT_STATES", "CUTOFF_HZ"]
+           "POSE_TOPIC", "SUSPENSION_TOPIC", "JOINT_STATES", "CUTOFF_HZ", "rest_mask"]
 
 CHANNELS = ("swing_x", "swing_y", "yaw", "stretch")
 POSE_TOPIC = topics.PLATFORM_POSE
@@ -50,6 +50,37 @@ CUTOFF_HZ = 2.0
 #: amplitude below which a channel counts as not excited: swing_x, swing_y, yaw (rad), stretch (m;
 #: 1 mm of mocap noise low-passed at 2 Hz stays well below 3 mm)
 MIN_AMPLITUDE = (0.01, 0.01, 0.02, 0.003)
+#: rest: every excited mode slower than this share of its 99th-percentile speed for a whole swing
+#: period (cf. :data:`cablelab.velocity.ZONE_FRACTION`: a swing's turning point is far shorter)
+REST_FRACTION = 0.03
+
+
+def rest_mask(t: np.ndarray, qd: np.ndarray, excited: np.ndarray, period: float,
+              fraction: float = REST_FRACTION) -> np.ndarray:
+    """(N,) True where the platform is at rest: every excited swing/yaw mode (``qd`` (N, 3),
+    ``excited`` (3,)) stays inside its zero-speed zone (``fraction`` x its p99 speed) over a
+    window of one swing ``period`` (s) around the sample. A swing that dry friction stops holds
+    still at a finite angle: there the friction is whatever balances gravity (stiction), not
+    ``f_s sign(qd)``, and the sign of a filtered noise velocity is noise, so no candidate can
+    predict those samples and they carry no dynamics; a turning point of a moving swing lasts a
+    small part of a period and is never a rest."""
+    qd = np.abs(np.asarray(qd, float)[:, :3])[:, np.asarray(excited[:3], bool)]
+    n = len(t)
+    if qd.shape[1] == 0 or n < 3:
+        return np.zeros(n, bool)
+    zone = fraction * np.nanpercentile(qd, 99, axis=0)
+    slow = np.all(qd < zone, axis=1).astype(float)
+    w = max(int(round(period / max(float(np.median(np.diff(t))), 1e-9))), 1)
+    # a sample is at rest when a whole window containing it is slow
+    full = np.convolve(slow, np.ones(w), "valid") >= w - 0.5           # windows [i, i + w)
+    rest = np.zeros(n, bool)
+    starts = np.flatnonzero(full)
+    if starts.size:
+        cover = np.zeros(n + 1)
+        np.add.at(cover, starts, 1.0)
+        np.add.at(cover, starts + w, -1.0)
+        rest = np.cumsum(cover)[:n] > 0
+    return rest
 
 
 def modal_inertias(p: VirtualParams) -> np.ndarray:
@@ -123,7 +154,9 @@ def dataset_from_arrays(t, pos, quat_wxyz, desc_section, description=None, optio
     # zeroed (the columns keep the measured motion, so every parameter stays fitted, to ~0)
     excited = np.abs(q - q.mean(axis=0)).max(axis=0) > MIN_AMPLITUDE
     y[:, ~excited] = 0.0
-    return Dataset(
+    period = 2 * np.pi * np.sqrt(p.L / g)
+    rest = rest_mask(c["t"], qd, excited, period)
+    ds = Dataset(
         plant="suspended", t=c["t"], y=y, channels=CHANNELS, units=("N m", "N m", "N m", "N"),
         signals={"q": q, "qd": qd, "qdd": qdd, "J": J, "g": g, "L": p.L, "excited": excited,
                  "cutoff_hz": c.get("cutoff_hz", opts.cutoff_hz), "tilt": tilt, "tilt_d": tilt_d,
@@ -133,6 +166,28 @@ def dataset_from_arrays(t, pos, quat_wxyz, desc_section, description=None, optio
         inputs={"swing_x rate": qd[:, 0], "swing_y rate": qd[:, 1], "yaw rate": qd[:, 2]},
         regimes={"swing amplitude": labels[np.searchsorted(edges, amp)]},
         description=description, source=source)
+    return _without_rests(ds, rest)
+
+
+def _without_rests(ds: Dataset, rest: np.ndarray) -> Dataset:
+    """The record cut to its moving span (a platform that dry friction stopped stays stopped:
+    the tail would make whole cross-validation folds of stiction and noise) and the rests inside
+    it marked not valid (not fitted, not scored, the same for every candidate); the share left
+    out is kept as the signal ``rest_share``. A moving span shorter than the samples a diagnosis
+    needs (:data:`cablelab.datachecks.MIN_SAMPLES`) keeps the first rest samples after it, valid,
+    up to that count."""
+    from ...datachecks import MIN_SAMPLES
+
+    moving = np.flatnonzero(~rest)
+    if not rest.any() or moving.size == 0:
+        return ds.replace(signals={**ds.signals, "rest_share": 0.0})
+    first, last = int(moving[0]), int(moving[-1]) + 1
+    end = min(max(last, first + MIN_SAMPLES), ds.n)
+    span = np.arange(first, end)
+    out = ds.subset(span)
+    inside = rest[span] & (span < last)
+    return out.replace(valid=out.valid & ~inside,
+                       signals={**out.signals, "rest_share": 1.0 - float(np.sum(out.valid & ~inside)) / ds.n})
 
 
 def radial_mass(p: VirtualParams) -> float:

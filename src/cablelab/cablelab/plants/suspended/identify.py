@@ -21,8 +21,16 @@ see), the confounded pairs (|correlation| >= 0.9, :func:`cablelab.diagnose.ident
 with its thresholds) and the undetermined parameters: no sensitivity at all, a component >= 0.3
 in a weak direction, a Gauss-Newton standard error (weak directions held fixed; inflated for
 coloured residuals) above ``undetermined_rel`` of the Table 5 range, or confounded beyond 0.99
-with an estimate below 5 standard errors. This sees local non-identifiability only: the compound pendulum's conjugate
-branch (l9z and k^2 / l9z give the same period) is a discrete ambiguity it cannot flag.
+with an estimate below 5 standard errors. That is local non-identifiability only.
+
+Discrete ambiguity, the compound pendulum's conjugate branch: a link's centre of mass at depth d
+below its joint and at the centre of oscillation's conjugate ``d' = L_eq - d`` (``L_eq = J / (m l)``
+of the whole mode, :func:`conjugate_depth`) swing with the same period, so a Pearson cost has a
+basin at each. ``identify(..., starts=k)`` seeds the other branch from that
+closed form plus ``k`` random starts inside the Table 5 bounds, fits locally from the start, the
+conjugate and the best random seed, keeps the best, and reports the other basins that fit the
+record as well within noise (``ambiguous_with``, with the paired block-bootstrap test of
+:mod:`cablelab.diagnose.ambiguity`).
 """
 from __future__ import annotations
 
@@ -32,16 +40,19 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ...diagnose.ambiguity import SPREAD_SIGMAS, paired_log_spread
 from ...diagnose.identifiability import MIN_T, UNIDENTIFIABLE, confounding
 from ...errors import CablelabError
 from ...fit.simulation import SimulationFit, fit_simulation, objective_residual
 from ...effects.base import Param
 from .mjcf import build_truth, build_virtual
+from .dataset import modal_inertias
 from .params import IDENTIFIED, VirtualParams
+from .reference import planar_bodies
 from .sim import initial_state, simulate, truth_start
 from .swing import swing_from_pose
 
-__all__ = ["Experiment", "apply_values", "values_of", "identifiability", "identified_params",
+__all__ = ["Experiment", "apply_values", "conjugate_depth", "basin_text", "values_of", "identifiability", "identified_params",
            "licas_experiments",
            "simulate_experiments", "identify", "validate", "Identification", "metrics",
            "CHANNELS"]
@@ -152,6 +163,9 @@ def identifiability(fit: SimulationFit, params: list[Param], *, undetermined_rel
     norms = np.linalg.norm(J, axis=0)
     live = norms > 1e-12 * max(float(norms.max()), 1e-300)
     idx = np.flatnonzero(live)
+    if idx.size == 0:                          # the output moves with no parameter
+        return {"condition": np.inf, "stderr": {n: np.inf for n in names}, "correlation": None,
+                "confounded": [], "weak_directions": [], "undetermined": list(names)}
     _, S, Vt = np.linalg.svd(J[:, idx] / norms[idx], full_matrices=False)
     cond = float(S[0] / S[-1]) if S[-1] > 0 else np.inf
     strong = S >= weak * S[0]
@@ -179,6 +193,60 @@ def identifiability(fit: SimulationFit, params: list[Param], *, undetermined_rel
            or q.name in confused or q.name in in_weak]
     return {"condition": cond, "stderr": stderr, "correlation": corr, "confounded": conf,
             "weak_directions": weak_dirs, "undetermined": und}
+
+
+#: the link depths with a conjugate branch, their link mass, and the swing modes they enter
+#: (0: about x, J8, seen in r_y; 1: about y, J9, seen in r_x): link 9 turns with J8 and J9
+CONJUGATE = {"l8z": ("m8", (0,)), "l9z": ("m9", (0, 1))}
+
+
+def conjugate_depth(p: VirtualParams, name: str, axis: int = 0) -> float:
+    """The other centre-of-mass depth of link 8 (``l8z``) or 9 (``l9z``) that gives the swing
+    mode about ``axis`` (0: x, the q8 swing seen in r_y; 1: y, q9 in r_x) the same period.
+
+    The mode is a compound pendulum about its joint: inertia ``J(d) = A + m d^2`` (the
+    description's modal inertia, :func:`~.dataset.modal_inertias`) and static moment
+    ``S(d) = B + m d`` (the links + everything hanging below at L). Its equivalent length
+    ``L_eq = J / S`` (the centre of oscillation) is shared by the two roots of
+    ``m d^2 - L_eq m d + (A - L_eq B) = 0``, whose sum is ``L_eq``: ``d' = L_eq - d``
+    (for a lone link, ``B = 0``: ``d d' = A / m = k^2``).
+    """
+    if name not in CONJUGATE or axis not in CONJUGATE[name][1]:
+        raise CablelabError(f"conjugate_depth: {name!r} about axis {axis} has no conjugate branch "
+                            f"(use l8z about 0, l9z about 0 or 1)")
+    d = float(getattr(p, name))
+    b = planar_bodies(p)
+    J = float(modal_inertias(p)[axis])
+    moment = b["M_B"] * p.L + (b["mcA"] if axis == 0 else p.m9 * p.l9z + p.m_plat * p.L)
+    return J / moment - d
+
+
+def _z(y: np.ndarray) -> np.ndarray:
+    return (y - y.mean(axis=0)) / np.where(y.std(axis=0) > 0, y.std(axis=0), 1.0)
+
+
+def _same_fit(y_meas, a, b, objective: str) -> tuple[bool, float, float]:
+    """Whether two simulated outputs fit ``y_meas`` equally within noise: the paired block
+    bootstrap of :func:`cablelab.diagnose.ambiguity.paired_log_spread` on the objective's own
+    scale (per-channel z-scores for Pearson, which ignores amplitude)."""
+    f = _z if objective == "pearson" else (lambda v: v)
+    d, sd = paired_log_spread(f(y_meas), f(a), f(y_meas), f(b))
+    return abs(d) <= SPREAD_SIGMAS * sd, d, sd
+
+
+def basin_text(ident: "Identification", units: dict | None = None) -> str:
+    """One line for a human: the other basins that fit as well, or '' when there is none."""
+    if not ident.ambiguous_with:
+        return ""
+    moved = sorted({k for o in ident.ambiguous_with for k, v in o["values"].items()
+                    if not np.isclose(v, ident.values[k], rtol=0.05, atol=1e-6)})
+
+    def show(vals):
+        return ", ".join(f"{k} = {vals[k]:.3g}" for k in moved)
+    others = "; ".join(show(o["values"]) for o in ident.ambiguous_with)
+    return (f"ambiguous with {others}: fits the record as well as {show(ident.values)} within noise "
+            f"(another basin of the cost, e.g. the conjugate branch of a compound pendulum); this "
+            f"recording cannot tell them apart")
 
 
 def _rest(p: VirtualParams) -> np.ndarray:
@@ -275,6 +343,10 @@ class Identification:
     undetermined: list
     values: dict
     report: dict = field(default_factory=dict)     # :func:`identifiability`
+    #: other basins that fit as well within noise: ``[{"values", "error", "difference", "spread"}]``
+    ambiguous_with: list = field(default_factory=list)
+    #: every local fit of a multi-start: ``[{"start", "values", "error"}]`` (best first)
+    basins: list = field(default_factory=list)
 
 
 def _stack(exps, ys):
@@ -285,7 +357,8 @@ def _stack(exps, ys):
 
 def identify(exps: list[Experiment], p_start: VirtualParams, names=None, *, objective: str = "pearson",
              start: dict | None = None, max_iter: int = 30, undetermined_rel: float = 0.25,
-             progress: bool = False, nthread: int = 2, scan: dict | None = None) -> Identification:
+             progress: bool = False, nthread: int = 2, scan: dict | None = None, starts: int = 0,
+             seed: int = 0) -> Identification:
     """Fit the Table 5 parameters ``names`` (default all (★) rows) to the experiments.
 
     Args:
@@ -297,6 +370,12 @@ def identify(exps: list[Experiment], p_start: VirtualParams, names=None, *, obje
             basin per period slip, so a start whose yaw period is 25 % off (the repo k_p7 on the
             4-tendon truth plant: 2.25 s against 1.77 s) converges to "no yaw spring"; a scan of
             k_p7 over its Table 5 range puts the start in the right basin.
+        starts: multi-start (0: off): ``starts`` random seeds (uniform in the Table 5 bounds,
+            ``seed``) and the conjugate branch of every fitted ``l8z`` / ``l9z``
+            (:func:`conjugate_depth`) are evaluated in one rollout batch; the local fit runs from
+            the start, from each conjugate seed and from the best random seed if it beats them,
+            and the best result is kept. ``ambiguous_with`` lists the other basins (another
+            parameter by more than 5 % of its range) whose fit is equal within noise.
     """
     params = identified_params(p_start.variant, names)
     if start:
@@ -321,11 +400,59 @@ def identify(exps: list[Experiment], p_start: VirtualParams, names=None, *, obje
         params = [dataclasses.replace(q, nominal=float(np.clip(best[q.name], q.lower, q.upper)))
                   for q in params]
 
-    fit = fit_simulation(sim, params, y_meas, objective=objective, max_iter=max_iter, progress=progress)
+    seeds = [{q.name: q.nominal for q in params}]
+    if starts:
+        # r_y shows the swing about x (axis 0), r_x the one about y (axis 1)
+        axes = {a for e in exps for a, c in ((0, 1), (1, 0)) if e.use[c]}
+        extra = _seeds(p_start, params, starts, seed, axes)
+        n_conj = len(extra) - starts
+        seeds += extra
+        cost = [float(np.sum(objective_residual(y_meas, y, objective) ** 2)) for y in sim(seeds)]
+        chosen = list(range(1 + n_conj))
+        best_random = 1 + n_conj + int(np.argmin(cost[1 + n_conj:])) if len(seeds) > 1 + n_conj else None
+        if best_random is not None and cost[best_random] < min(cost[i] for i in chosen):
+            chosen.append(best_random)
+        seeds = [seeds[i] for i in chosen]
+    fits = []
+    for s0 in seeds:
+        x0 = [s0[q.name] for q in params]
+        f = fit_simulation(sim, params, y_meas, objective=objective, max_iter=max_iter, progress=progress, x0=x0)
+        fits.append((float(np.sum(objective_residual(y_meas, f.y_sim, objective) ** 2)), s0, f))
+    fits.sort(key=lambda r: r[0])
+    fit = fits[0][2]
+    basins = [{"start": s0, "values": dict(f.params), "error": float(np.sqrt(c))} for c, s0, f in fits]
+    def apart(a: dict, b: dict) -> bool:      # another basin: some parameter 5 % of its range away
+        return any(abs(a[q.name] - b[q.name]) > 0.05 * (q.upper - q.lower) for q in params)
+
+    ambiguous = []
+    for c, _, f in fits[1:]:
+        if not apart(f.params, fit.params) or any(not apart(f.params, o["values"]) for o in ambiguous):
+            continue
+        same, d, sd = _same_fit(y_meas, fit.y_sim, f.y_sim, objective)
+        if same:
+            ambiguous.append({"values": dict(f.params), "error": float(np.sqrt(c)), "difference": d,
+                              "spread": sd})
     pearson_fit = 1.0 - float(np.sum(objective_residual(y_meas, fit.y_sim, "pearson") ** 2))
     report = identifiability(fit, params, undetermined_rel=undetermined_rel)
     return Identification(fit, apply_values(p_start, fit.params), pearson_fit, report["undetermined"],
-                          dict(fit.params), report)
+                          dict(fit.params), report, ambiguous, basins)
+
+
+def _seeds(p_start: VirtualParams, params: list[Param], k: int, seed: int, axes) -> list[dict]:
+    """Multi-start seeds: the conjugate branch of each fitted l8z / l9z at the start values
+    (clipped to its bounds) in each swing mode of ``axes`` the data show, then ``k`` uniform
+    draws inside the bounds."""
+    base = {q.name: q.nominal for q in params}
+    p0 = apply_values(p_start, base)
+    out = []
+    for q in params:
+        for axis in CONJUGATE.get(q.name, (None, ()))[1]:
+            if axis in axes:
+                out.append({**base, q.name: float(np.clip(conjugate_depth(p0, q.name, axis), q.lower, q.upper))})
+    rng = np.random.default_rng(seed)
+    lo, hi = np.array([q.lower for q in params]), np.array([q.upper for q in params])
+    out += [dict(zip(base, map(float, lo + (hi - lo) * rng.random(len(params))))) for _ in range(k)]
+    return out
 
 
 def validate(p: VirtualParams, exps: list[Experiment], nthread: int = 2) -> list[dict]:

@@ -17,8 +17,6 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass, field
 
-import numpy as np
-
 from ...errors import CablelabError
 
 __all__ = ["ArmLink", "VirtualParams", "parameter_set", "VARIANTS", "SETS", "VIRTUAL_JOINTS",
@@ -111,9 +109,6 @@ class VirtualParams:
     @property
     def n_arm(self) -> int:
         return len(self.arm)
-
-    def arm_mass(self) -> float:
-        return float(sum(a.mass for a in self.arm))
 
 
 #: the identified (★) parameters of 000 Table 5 as (name, LiCAS (p_0, p̄), CRANEbot (p_0, p̄))
@@ -212,11 +207,3 @@ def triangle_ok(diag) -> bool:
     """True if a principal-inertia triple satisfies A + B >= C for every permutation."""
     a, b, c = (float(v) for v in diag)
     return a + b >= c and a + c >= b and b + c >= a and min(a, b, c) >= 0
-
-
-def full_inertia_ok(i6) -> bool:
-    """(ixx, iyy, izz, ixy, ixz, iyz) positive definite and triangle-consistent."""
-    ixx, iyy, izz, ixy, ixz, iyz = (float(v) for v in i6)
-    m = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
-    ev = np.linalg.eigvalsh(m)
-    return bool(ev.min() > 0 and triangle_ok(ev))

@@ -74,7 +74,6 @@ def truth_start(model: mujoco.MjModel, p: VirtualParams, swing_x=0.0, swing_y=0.
     if yaw:
         # a point at radius r turned by yaw: horizontal chord c = 2 r sin(yaw/2); height drop
         # sqrt(L^2 - c^2) instead of L (all four cables stay taut by symmetry)
-        m = mujoco.MjData(model)
         r = np.linalg.norm(model.site("bot0").pos[:2])
         c = 2 * r * np.sin(yaw / 2)
         pos = S - [0, 0, np.sqrt(p.L ** 2 - c ** 2) - 1e-7]

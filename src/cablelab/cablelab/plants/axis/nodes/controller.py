@@ -5,7 +5,8 @@ computes ``u = M_ff qdd_ref + Kp (q_ref - q) + Kd (qd_ref - qd)``
 (:func:`cablelab.plants.axis.control.pd_feedforward`) and publishes it on
 ``/axis/effort_command``. The reference is the latest ``/axis/reference`` (``reference_source:
 topic``, default) or a built-in sine evaluated at the measurement stamp (``reference_source:
-sine``, also published on ``/axis/reference`` so recordings hold it).
+sine``, also published on ``/axis/reference`` so recordings hold it), or a reference bag written by
+``cablelab excite`` (``reference_bag``, played from the first state on and published too).
 
 ROS parameters: :data:`PARAMETERS` (``pd_feedforward --plant axis --help``).
 
@@ -28,6 +29,7 @@ from ....ros import convert
 from ....ros.params import Param
 from ....ros.plant_node import PlantNode
 from ....ros.qos import publisher_qos, stream_qos
+from ....ros.reference import ReferencePlayer, reference_bag_param
 
 
 PARAMETERS = (
@@ -42,6 +44,7 @@ PARAMETERS = (
     Param("frequency", 0.5, "frequency of the built-in sine", "Hz", gt=0.0, le=1e3),
     Param("offset", 0.0, "offset of the built-in sine", "m or rad", ge=-1e3, le=1e3),
     Param("reference_timeout", 0.5, "a reference older than this is stale", "s wall", gt=0.0),
+    reference_bag_param(topics.REFERENCE),
 )
 
 
@@ -57,6 +60,10 @@ class AxisController(PlantNode):
         self.amplitude = v.amplitude
         self.frequency = v.frequency
         self.offset = v.offset
+        self.player = None
+        if v.reference_bag:
+            self.player = ReferencePlayer.from_bag(self, v.reference_bag, topics.REFERENCE, ["joint"])
+            self.source = "bag"
         self.ref = None  # (q, qd, qdd) from the topic
         self.inputs.add("joint_states", timeout=0.5, length=1)
         self.inputs.add("reference", timeout=v.reference_timeout, length=1,
@@ -92,7 +99,9 @@ class AxisController(PlantNode):
             return
         if qd is None or qd.size != q.size or not np.isfinite(qd).all():
             qd = np.zeros_like(q)
-        if self.source == "sine":
+        if self.player is not None:
+            q_ref, qd_ref, qdd_ref = (float(x[0]) for x in self.player(t, q))
+        elif self.source == "sine":
             q_ref, qd_ref, qdd_ref = (float(v) for v in sine_reference(t, self.amplitude, self.frequency,
                                                                         self.offset))
             self.pub_ref.publish(convert.joint_trajectory_msg(t, ["joint"], [q_ref], [qd_ref], [qdd_ref]))

@@ -1,5 +1,6 @@
-"""Leg controller node: ``/leg/hop_estimate`` (+ ``/leg/reference`` apex height) ->
-:class:`~..controller.ApexController` -> ``/leg/effort_commands``.
+"""Leg controller node: ``/leg/hop_estimate`` (+ ``/leg/reference`` apex height, or a schedule
+written by ``cablelab excite``: ``reference_bag``, played from the first estimate on and published
+on ``/leg/reference``) -> :class:`~..controller.ApexController` -> ``/leg/effort_commands``.
 
 ROS parameters: :data:`PARAMETERS` (``pd_feedforward --plant leg --help``).
 """
@@ -21,6 +22,7 @@ from ....ros import convert
 from ....ros.params import Param
 from ....ros.plant_node import PlantNode
 from ....ros.qos import publisher_qos, stream_qos
+from ....ros.reference import ReferencePlayer, reference_bag_param
 
 PARAMETERS = (
     DESCRIPTION,
@@ -33,6 +35,7 @@ PARAMETERS = (
     Param("T_max", 4.0, "largest stance torque", "N m", gt=0.0, le=1e4),
     Param("mode", "apex", "apex-height control or a constant open-loop torque",
           choices=("apex", "open_loop")),
+    reference_bag_param(topics.REFERENCE, "the topic"),
 )
 
 
@@ -45,11 +48,14 @@ class LegControllerNode(PlantNode):
         self.ctl = ApexController(params, params.z_td + v.h_des, T=v.T, P=v.P, k_i=v.k_i, k_ff=v.k_ff,
                                   T_max=v.T_max, mode=v.mode)
         self.last_apex = math.nan
+        self.player = ReferencePlayer.from_bag(self, v.reference_bag, topics.REFERENCE, ["apex_height"]) \
+            if v.reference_bag else None
         self.inputs.add("hop_estimate", timeout=0.5)
         self.inputs.add("reference", timeout=math.inf, length=1, required=False)
         self.pub = self.create_publisher(Float64MultiArray, topics.EFFORT_COMMANDS, publisher_qos())
         self.create_subscription(JointState, topics.HOP_ESTIMATE, self.on_estimate, stream_qos())
-        self.create_subscription(JointTrajectory, topics.REFERENCE, self.on_reference, stream_qos())
+        if self.player is None:
+            self.create_subscription(JointTrajectory, topics.REFERENCE, self.on_reference, stream_qos())
         self.start_diagnostics()
 
     def extend_status(self, level, msg, values):
@@ -66,6 +72,8 @@ class LegControllerNode(PlantNode):
         if pos is None or vel is None or "phase" not in names or not self.inputs.accept(
                 "hop_estimate", pos[[names.index("phase")]], time.monotonic()):
             return  # hold T (stale or NaN estimate)
+        if self.player is not None:
+            self.ctl.h_des = float(self.player(t, pos)[0][0])
         ia = names.index("apex_height")
         h, ta = float(pos[ia]), float(vel[ia])
         if math.isfinite(ta) and ta != self.last_apex:
