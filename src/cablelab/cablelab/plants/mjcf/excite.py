@@ -9,8 +9,8 @@ the actuators' ``ctrlrange`` (times the gear) or ``forcerange`` and the joint's
 :class:`~cablelab.excite.Limits` constraint; a design that breaks one is refused).
 
 The design grid has 5 samples per period of the highest harmonic (the crane's and the CDPR's 10):
-each sample costs eleven MuJoCo inverse-dynamics passes (the model's and the payload body's ten
-inertial columns). The dataset is the one :func:`.dataset.dataset_from_arrays` builds, for a
+each sample costs a MuJoCo inverse-dynamics pass with the body kinematics the payload's columns
+are built from. The dataset is the one :func:`.dataset.dataset_from_arrays` builds, for a
 motion that follows the reference exactly (no conditioning: q, qd, qdd are the designed ones):
 MuJoCo's inverse dynamics as the known output, the payload body's columns, the tendon Jacobians.
 """
@@ -22,7 +22,7 @@ from ...dataset import Dataset
 from ...excite import Exciter, Limits
 from ...model import KNOWN_OUTPUT
 from .description import section_of
-from .inverse import inertial_columns, inverse_dynamics, point_mass_columns
+from .inverse import body_columns, inverse_dynamics, inverse_record, point_mass_columns
 from .mjcf import HINGE, dof_joints, names
 from .topics import TOPICS
 
@@ -100,8 +100,8 @@ def motion_dataset(t, q, qd, qdd, description) -> Dataset:
     revolute = np.array([model.jnt_type[jn.index(j)] == HINGE for j in joints])
     q, qd, qdd = (np.asarray(a, float) for a in (q, qd, qdd))
     with_tendons = bool(sec.tendons)
-    res = inverse_dynamics(model, q, qd, qdd, tendons=with_tendons)
-    tau, ten_j = (res if with_tendons else (res, None))
+    rec = inverse_record(model, q, qd, qdd, tendons=with_tendons, kinematics=bool(sec.payload_body))
+    tau, ten_j = rec.tau, rec.ten_j
     from .mjcf import actuated_joints
 
     measured = set(sec.joints) if sec.joints is not None else set(actuated_joints(model))
@@ -115,7 +115,7 @@ def motion_dataset(t, q, qd, qdd, description) -> Dataset:
         signals.update({"ten_J": jt, "tension": np.zeros((n, jt.shape[1]))})
     if sec.payload_body:
         body = names(model, "body").index(sec.payload_body)
-        cols = inertial_columns(model, body, q, qd, qdd, base=tau)
+        cols = body_columns(model, rec, body)
         signals["payload_columns"] = point_mass_columns(cols, model.body_ipos[body])
         signals["payload_com0"] = np.array(model.body_ipos[body], float)
     return Dataset(
