@@ -346,12 +346,19 @@ def design(plant_name: str, desc, params: Sequence[str], *, duration: float = 60
     probe = ex.motion_dataset(t, *scaled_motion(np.ones(shape), t, lim, ex.base_hz, duration), desc)
     model, _ = model_for(plant, desc, params, probe)
     n = n_j * 2 * h
-
     basis = fourier_basis(t, ex.base_hz, h, duration)
 
+    # stacked evaluation when the plant's dataset keeps one sample per reference sample (not the
+    # leg's, built per hop): checked once on two stacked motions
+    probe2 = ex.motion_dataset(*_stacked_motion(np.ones((2, n)), basis, t, lim, shape), desc)
+    stacked = probe2.n == 2 * len(t)
+
     def conditions(xs):
-        ds = ex.motion_dataset(*_stacked_motion(xs, basis, t, lim, shape), desc)
-        return block_conditions(model, ds, len(xs), params)
+        if stacked:
+            ds = ex.motion_dataset(*_stacked_motion(xs, basis, t, lim, shape), desc)
+            return block_conditions(model, ds, len(xs), params)
+        return np.array([condition(model, ex.motion_dataset(
+            t, *scaled_motion(x.reshape(shape), t, lim, ex.base_hz, duration), desc), params) for x in xs])
 
     def cost_grad(x):
         step = 1e-6 * np.maximum(1.0, np.abs(x))
