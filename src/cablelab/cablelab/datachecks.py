@@ -76,8 +76,13 @@ def check_dataset(ds) -> None:
     if excited.size == ds.n_channels and not excited.any():
         raise CablelabError(f"{src}: no output channel is excited ({', '.join(ds.channels)}): record "
                             "a run with motion")
+    # and channels without an effort sensor (``signals["driven"]`` False: an unactuated joint's
+    # zero-force equation, y = 0 by physics, not a stuck sensor)
+    driven = np.asarray(ds.signals.get("driven", np.ones(ds.n_channels, bool)), bool).reshape(-1)
     for c, ch in enumerate(ds.channels):
         if excited.size == ds.n_channels and not excited[c]:
+            continue
+        if driven.size == ds.n_channels and not driven[c]:
             continue
         y = ds.y[np.isfinite(ds.y[:, c]), c]
         spread = float(np.ptp(y)) if y.size else 0.0

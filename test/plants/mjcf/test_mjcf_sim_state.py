@@ -1,7 +1,7 @@
 """The ROS-free simulator's published state (what ``cable_sim_node --plant mjcf`` sends each
 period) against MuJoCo's own quantities: the measured tendons' tensions through the tendon
-Jacobian give the actuators' generalised force (every actuator of the camera robot pulls a
-measured cable), and advancing in one call or step by step lands on the same state."""
+Jacobian give MuJoCo's generalised actuator force (every actuator of the camera robot pulls a
+measured cable, so no joint effort is measured besides), and advancing in one call or step by step lands on the same state."""
 import mujoco
 import numpy as np
 
@@ -25,7 +25,9 @@ def test_tensions_through_the_tendon_jacobian_are_the_actuator_force():
         t, q, qd, effort, tension = sim.state()
         assert tension.shape == (4,) and np.all(tension > 0)       # cables pull
         ten_j = sim.data.ten_J.reshape(sim.model.ntendon, sim.model.nv)
-        np.testing.assert_allclose(effort, -ten_j.T @ tension, atol=1e-9 * (1 + np.abs(effort).max()))
+        qfrc = sim.data.qfrc_actuator
+        np.testing.assert_allclose(qfrc, -ten_j.T @ tension, atol=1e-9 * (1 + np.abs(qfrc).max()))
+        np.testing.assert_array_equal(effort, np.zeros(sim.model.nv))   # no joint actuator
         np.testing.assert_array_equal(q, sim.data.qpos[: sim.model.nv])
         assert t == sim.data.time
 

@@ -156,8 +156,11 @@ def metrics_table(channels, units, met_b, met_f) -> str:
     def head(name):
         return f"{name} [{shared}]" if shared is not None else name
 
-    rows = [[html.escape(f"{ch} [{unit}]"), _num(100 * mb["nrmse"], "{:.2f} %"),
-             _num(100 * mf["nrmse"], "{:.2f} %"), _num(mf["fit_percent"], "{:.1f} %"),
+    def pct(v):       # no NRMSE on a channel without signal (an unactuated joint's zero force)
+        return _num(None if v is None else 100 * v, "{:.2f} %")
+
+    rows = [[html.escape(f"{ch} [{unit}]"), pct(mb["nrmse"]), pct(mf["nrmse"]),
+             _num(mf["fit_percent"], "{:.1f} %"),
              _num(mf["pearson"], "{:.4f}"), dim(mf["mae"], unit), _num(mf["mre"], "{:.3g}"),
              dim(mf["max_abs"], unit)]
             for ch, unit, mb, mf in zip(channels, units, met_b, met_f)]

@@ -35,7 +35,6 @@ def run(out_dir: Path, quick: bool = False) -> dict:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from ...description import load_description
     from ...workbench import build_model, diagnose, load
     from .description import leg_of
     from .hybrid import LegParams

@@ -115,7 +115,9 @@ def dataset(bag, description, options: DatasetOptions | None = None) -> Dataset:
     for k, j in enumerate(joints):
         if not np.isfinite(q[:, k]).any():
             raise CablelabError(f"{bag.path}: {js_topic} has no position values for joint {j!r}")
-        if not np.isfinite(eff[:, k]).any():
+        finite = np.isfinite(eff[:, k])
+        # an undriven joint's effort is empty or 0 (CONTRACT): no sensor there
+        if not finite.any() or (j not in driven and not eff[finite, k].any()):
             if j in driven:
                 raise CablelabError(f"{bag.path}: {js_topic} has no effort values for the driven "
                                     f"joint {j!r}")

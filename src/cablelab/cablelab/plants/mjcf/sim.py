@@ -250,6 +250,7 @@ class MjcfSim:
                                         -m.actuator_gear[:, 0], 0.0) for x in self.tendons],
                               float).reshape(len(self.tendons), m.nu)             # mjTRN_TENDON
         self._step, self._dt, self._nv = mujoco.mj_step, float(m.opt.timestep), m.nv
+        self._on_joint = m.actuator_trntype == 0                             # mjTRN_JOINT
         mujoco.mj_forward(self.model, self.data)
 
     @property
@@ -266,8 +267,16 @@ class MjcfSim:
             self._step(self.model, self.data, nstep=n)
 
     def state(self):
-        """``(t, q (nv,), qd (nv,), effort (nv,) = qfrc_actuator, tension (n_tendons,))``: the
-        tension of a measured tendon is the pull of the actuators on it (N, >= 0 when pulling)."""
+        """``(t, q (nv,), qd (nv,), effort (nv,), tension (n_tendons,))``: ``effort`` is the
+        generalised force of the joint actuators (what a joint's own motor current measures; the
+        tendon actuators' pull reaches the joints through the measured tensions, so it is not
+        counted twice); the tension of a measured tendon is the pull of the actuators on it (N,
+        >= 0 when pulling)."""
         d = self.data
-        return (d.time, d.qpos[: self._nv].copy(), d.qvel.copy(), d.qfrc_actuator.copy(),
+        if self._on_joint.any():
+            f = d.actuator_force[self._on_joint]
+            effort = actuator_moments(self.model, d)[self._on_joint].T @ f
+        else:
+            effort = np.zeros(self._nv)
+        return (d.time, d.qpos[: self._nv].copy(), d.qvel.copy(), effort,
                 self._pull @ d.actuator_force)
