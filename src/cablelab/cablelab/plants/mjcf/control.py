@@ -15,6 +15,8 @@ from .sim import actuator_moments
 
 #: pretension of tendon actuators in the force distribution, N (cables must pull)
 PRETENSION = 30.0
+#: largest payload (kg) and centre-of-mass distance from its body (m) the law takes
+MAX_PAYLOAD, MAX_REACH = 1e4, 100.0
 
 
 class Feedforward:
@@ -65,3 +67,24 @@ def sine_reference(t: float, n: int, amplitude: float, frequency: float):
     ph = np.arange(n) * np.pi / 3
     s, c = np.sin(w * t + ph) - np.sin(ph), np.cos(w * t + ph)
     return amplitude * s, amplitude * w * c, -amplitude * w * w * np.sin(w * t + ph)
+
+
+def sine_trajectory(n: int, amplitude: float, frequency: float):
+    """The built-in reference as a trajectory ``(tt, q0) -> (q, qd, qdd)`` ((N, n) each at ``tt``
+    (N,) s since the first state, ``q0`` its positions): :func:`sine_reference` around ``q0``,
+    starting there at rest offset zero (what :class:`cablelab.ros.reference.ReferencePlayer` plays)."""
+    def trajectory(tt, q0):
+        dq, dqd, dqdd = sine_reference(np.asarray(tt, float)[:, None], n, amplitude, frequency)
+        return np.asarray(q0, float) + dq, dqd, dqdd
+
+    return trajectory
+
+
+def payload_values(m: float, com) -> np.ndarray | None:
+    """``[m, cx, cy, cz]`` of a payload estimate when physical (a mass in [0, MAX_PAYLOAD] kg, a
+    centre of mass within MAX_REACH m of its body, all finite), else None."""
+    v = np.array([m, *np.asarray(com, float).ravel()], float)
+    if v.size != 4 or not np.isfinite(v).all() or not 0.0 <= v[0] <= MAX_PAYLOAD \
+            or np.abs(v[1:]).max() > MAX_REACH:
+        return None
+    return v
