@@ -73,3 +73,24 @@ def test_measured_tendons_without_tensions_is_a_one_line_error(cam):
     assert "\n" not in str(e.value)
     with pytest.raises(Exception, match=r"got \(.*, 3\)"):
         payload_estimate(t, q, eff, desc, tension=ten[:, :3])
+
+
+def test_joint_values_take_the_models_joints_in_order_one_value_each():
+    from cablelab.plants.mjcf.live import joint_values
+
+    j = ["a", "b"]
+    np.testing.assert_array_equal(joint_values(j, j, [1, 2], np.array([3.0, 4.0])), [1, 2, 3, 4])
+    assert joint_values(["b", "a"], j, [1, 2]) is None               # another order
+    assert joint_values(j, j, [1, 2], [3]) is None                   # a short array
+    assert joint_values(j, j, [1, 2], None) is None                  # a missing field
+    assert joint_values(None, j, [1, 2]) is None
+
+
+def test_tension_values_pick_the_measured_tendons_by_name(cam):
+    desc = cam[0]
+    w = PayloadWindow(desc, 3.0, 10)
+    got = w.tension_values(["cable_3", "spare", "cable_1", "cable_4", "cable_2"], [3.0, 9.0, 1.0, 4.0, 2.0])
+    np.testing.assert_array_equal(got, [1.0, 2.0, 3.0, 4.0])
+    assert w.tension_values(CABLES[:3], [1.0, 2.0, 3.0]) is None          # a tendon missing
+    assert w.tension_values(CABLES, [1.0, 2.0, 3.0]) is None              # names and values differ
+    assert w.tension_values(CABLES, None) is None

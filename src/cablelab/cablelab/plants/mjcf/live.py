@@ -1,5 +1,6 @@
-"""The live payload estimator's sliding window (ROS-free): joint states and measured tendon
-tensions kept by stamp, paired, and fitted every few samples.
+"""The live nodes' samples (ROS-free): the check of a joint state against the model's joints
+(:func:`joint_values`) and the payload estimator's sliding window (:class:`PayloadWindow`): joint
+states and measured tendon tensions kept by stamp, paired, and fitted every few samples.
 
 DDS orders samples within a topic, not across topics: the tension sample of a stamp may arrive
 before or after the joint state of that stamp. Both streams are kept over the window and, at a
@@ -17,10 +18,20 @@ from ...ros.status import SkipLog
 from .estimation import PayloadEstimate, payload_estimate
 from .mjcf import actuated_joints, dof_joints
 
-__all__ = ["PayloadWindow"]
+__all__ = ["PayloadWindow", "joint_values"]
 
 #: fewest paired samples (and share of the window they must span) before a fit
 MIN_SAMPLES, MIN_SPAN = 60, 0.5
+
+
+def joint_values(names, joints, *arrays) -> np.ndarray | None:
+    """The ``arrays`` of a joint message concatenated when its ``names`` are the model's
+    ``joints`` in order and each array has one value per joint (what an input monitor then checks
+    for finite values), else None."""
+    n = len(joints)
+    if list(names or ()) != list(joints) or any(a is None or np.size(a) != n for a in arrays):
+        return None
+    return np.concatenate([np.asarray(a, float).ravel() for a in arrays])
 
 
 class PayloadWindow:
@@ -58,6 +69,14 @@ class PayloadWindow:
         self._trim(self.states)
         self.count += 1
         return self.fit() if self.count % self.every == 0 else None
+
+    def tension_values(self, names, values) -> np.ndarray | None:
+        """The tensions of the section's ``tendons`` in a message naming them (any order, others
+        ignored; names and values of equal number), else None."""
+        names = list(names or ())
+        if values is None or len(names) != np.size(values) or not set(self.tendons) <= set(names):
+            return None
+        return np.array([np.asarray(values, float).ravel()[names.index(x)] for x in self.tendons])
 
     def tension(self, t: float, values) -> None:
         """A tension sample of the section's ``tendons`` (N, in that order)."""

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ...errors import CablelabError
 from .mjcf import dof_joints, names
 
 
@@ -280,3 +281,34 @@ class MjcfSim:
             effort = np.zeros(self._nv)
         return (d.time, d.qpos[: self._nv].copy(), d.qvel.copy(), effort,
                 self._pull @ d.actuator_force)
+
+
+def default_description() -> str:
+    """The shipped example (the three-joint arm, payload on ``tool``) as a description: what the
+    simulator node runs when given none."""
+    from .examples import ARM3
+
+    return description_yaml(ARM3.read_text(encoding="utf-8"), payload_body="tool")
+
+
+def hidden_payload(section, mass: float) -> Hidden | None:
+    """The truth's payload of ``mass`` kg on ``section.payload_body`` at that body's centre of
+    mass (None for no mass).
+
+    Raises:
+        CablelabError: a mass but no ``payload_body`` in the section.
+    """
+    if not mass > 0:
+        return None
+    if not section.payload_body:
+        raise CablelabError("cable_sim_node --plant mjcf: payload_mass needs mjcf.payload_body in "
+                            "the description")
+    model = section.compiled()
+    com = model.body_ipos[names(model, "body").index(section.payload_body)]
+    return Hidden(payload=(section.payload_body, float(mass), tuple(map(float, com))))
+
+
+def publish_period(timestep: float, rate: float) -> float:
+    """The simulator's publishing period: whole physics steps of ``timestep`` s nearest to
+    ``1 / rate`` (at least one; ``rate`` NaN: every step)."""
+    return timestep * max(1, round(1.0 / (rate * timestep))) if rate == rate else timestep

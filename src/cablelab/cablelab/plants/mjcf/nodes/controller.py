@@ -26,6 +26,7 @@ from ....ros.plant_node import PlantNode
 from ....ros.qos import publisher_qos, stream_qos
 from ....ros.reference import ReferencePlayer, reference_bag_param
 from ..control import Feedforward, payload_values, sine_trajectory
+from ..live import joint_values
 from ..topics import TOPICS, topic
 
 PARAMETERS = (
@@ -69,8 +70,7 @@ class MjcfController(PlantNode):
         if self.player is None:
             self.create_subscription(JointTrajectory, ref_topic, self.on_reference, stream_qos())
         if sec.payload_body:
-            self.create_subscription(InertiaStamped, topic(sec, "payload_estimate"), self.on_payload,
-                                     stream_qos())
+            self.create_subscription(InertiaStamped, topic(sec, "payload_estimate"), self.on_payload, stream_qos())
 
     def on_reference(self, msg: JointTrajectory) -> None:
         ref = convert.reference_point(msg, self.joints)
@@ -84,17 +84,14 @@ class MjcfController(PlantNode):
 
     def on_state(self, msg: JointState) -> None:
         t, names, q, qd, _eff = convert.joint_state_arrays(msg)
-        n = len(self.joints)
-        ok = names == self.joints and q is not None and qd is not None and q.size == n and qd.size == n
-        if not self.accept("joint_states", np.concatenate([q, qd]) if ok else None):
+        if not self.accept("joint_states", joint_values(names, self.joints, q, qd)):
             return
-        self.hold = q.copy() if self.hold is None else self.hold
+        self.hold = (q.copy(), np.zeros(q.size), np.zeros(q.size)) if self.hold is None else self.hold
         if self.player is not None:
             ref = self.player(t, q)
-        elif self.ref is not None and self.inputs.fresh("reference", time.monotonic()):
-            ref = self.ref
         else:                                   # no fresh reference: hold where it started
-            ref = (self.hold, np.zeros(n), np.zeros(n))
+            ref = self.ref if self.ref is not None and self.inputs.fresh("reference", time.monotonic()) \
+                else self.hold
         self.pub.publish(convert.command_msg(self.law.command(q, qd, *ref), stamp=t, label="joint"))
 
 

@@ -19,7 +19,7 @@ from ....ros import convert
 from ....ros.params import DESCRIPTION, Param
 from ....ros.plant_node import PlantNode
 from ....ros.qos import catch_up_qos, publisher_qos
-from ..live import PayloadWindow
+from ..live import PayloadWindow, joint_values
 from ..topics import topic
 
 PARAMETERS = (
@@ -63,18 +63,18 @@ class MjcfEstimator(PlantNode):
         return level, msg, values
 
     def on_tension(self, msg: JointState) -> None:
+        if self.win is None or not self.win.tendons:        # not subscribed: nothing measured
+            return
         t, names, _q, _qd, eff = convert.joint_state_arrays(msg)
-        ok = names is not None and eff is not None and set(self.win.tendons) <= set(names) \
-            and len(names) == eff.size
-        ten = np.array([eff[names.index(x)] for x in self.win.tendons]) if ok else None
-        if self.accept("cable_tensions", ten):
+        if self.accept("cable_tensions", ten := self.win.tension_values(names, eff)):
             self.win.tension(t, ten)
 
     def on_state(self, msg: JointState) -> None:
         t, names, q, _qd, eff = convert.joint_state_arrays(msg)
-        n, w = len(self.win.joints), self.win
-        ok = names == w.joints and q is not None and eff is not None and q.size == n and eff.size == n
-        if not self.accept("joint_states", np.concatenate([q, np.where(w.driven, eff, 0.0)]) if ok else None):
+        w = self.win
+        if eff is not None and eff.size == w.driven.size:
+            eff = np.where(w.driven, eff, 0.0)         # an undriven joint's effort is not measured
+        if not self.accept("joint_states", joint_values(names, w.joints, q, eff)):
             return
         est = w.state(t, q, eff)
         if est is not None:

@@ -27,8 +27,7 @@ from ....ros.plant_node import PlantNode
 from ....ros.qos import publisher_qos, stream_qos
 from ..description import section_of
 from ..markers import sim_markers
-from ..mjcf import names
-from ..sim import Hidden, MjcfSim
+from ..sim import MjcfSim, default_description, hidden_payload, publish_period
 from ..topics import topic
 
 PARAMETERS = merge((
@@ -44,39 +43,20 @@ PARAMETERS = merge((
 ), START_GATE)
 
 
-def default_description() -> str:
-    """The shipped example (a three-joint arm, payload on ``tool``) when no description is given."""
-    from ..examples import ARM3
-    from ..sim import description_yaml
-
-    return description_yaml(ARM3.read_text(encoding="utf-8"), payload_body="tool")
-
-
 class MjcfSimNode(PlantNode):
     def __init__(self):
         super().__init__("cable_sim_node")
         v = self.declare_params(PARAMETERS)
         self.description = load_description(v.description or default_description())
         sec = section_of(self.description)
-        hidden = None
-        if v.payload_mass > 0:
-            if not sec.payload_body:
-                raise CablelabError("cable_sim_node --plant mjcf: payload_mass needs mjcf.payload_body "
-                                    "in the description")
-            com = sec.compiled().body_ipos[names(sec.compiled(), "body").index(sec.payload_body)]
-            hidden = Hidden(payload=(sec.payload_body, v.payload_mass, tuple(map(float, com))))
-        self.sim = MjcfSim(sec, self.description.gravity, hidden)
-        step = self.sim.model.opt.timestep
-        self.period = step * max(1, round(1.0 / (v.rate * step))) if v.rate == v.rate else step
+        self.sim = MjcfSim(sec, self.description.gravity, hidden_payload(sec, v.payload_mass))
+        self.period = publish_period(self.sim.model.opt.timestep, v.rate)
         self.ctrl = [0.0] * self.sim.model.nu
         self.start_gate()
-        self.last_publish = time.monotonic()
         self.inputs.add("effort_commands", timeout=v.command_timeout, length=self.sim.model.nu)
-        self.pub_js = self.create_publisher(JointState, topic(sec, "joint_states"), publisher_qos())
-        self.pub_truth = self.create_publisher(JointState, topic(sec, "ground_truth_joint_states"),
-                                               publisher_qos())
-        self.pub_ten = (self.create_publisher(JointState, topic(sec, "cable_tensions"), publisher_qos())
-                        if sec.tendons else None)
+        pub = lambda key: self.create_publisher(JointState, topic(sec, key), publisher_qos())  # noqa: E731
+        self.pub_js, self.pub_truth = pub("joint_states"), pub("ground_truth_joint_states")
+        self.pub_ten = pub("cable_tensions") if sec.tendons else None
         self.clock = ClockPublisher(self)
         self.publish_description(self.description)
         self.create_subscription(Float64MultiArray, topic(sec, "effort_commands"), self.on_command,
@@ -92,15 +72,13 @@ class MjcfSimNode(PlantNode):
         return level, msg, values
 
     def on_command(self, msg: Float64MultiArray) -> None:
-        values = convert.float_array(msg)
-        if self.inputs.accept("effort_commands", values, time.monotonic()):
+        if (values := self.take_command("effort_commands", msg)) is not None:
             self.ctrl = [float(x) for x in values]
 
     def tick(self) -> None:
-        now = time.monotonic()
         if self.waiting_for_subscribers(self.pub_js, self.last_publish, self.publish_state):
             return
-        if not self.inputs.fresh("effort_commands", now):
+        if not self.inputs.fresh("effort_commands", time.monotonic()):
             self.ctrl = [0.0] * self.sim.model.nu       # no (fresh) command: drives off
         self.sim.advance(self.ctrl, self.period)
         self.publish_state()
@@ -111,9 +89,8 @@ class MjcfSimNode(PlantNode):
         if not all(math.isfinite(x) for x in q):
             raise CablelabError("cable_sim_node --plant mjcf: the simulation diverged (NaN state)")
         self.clock.publish(t)
-        joints = self.sim.joints
-        self.pub_js.publish(convert.joint_state_msg(t, joints, q, qd, effort))
-        self.pub_truth.publish(convert.joint_state_msg(t, joints, q, qd, effort))
+        for pub in (self.pub_js, self.pub_truth):
+            pub.publish(convert.joint_state_msg(t, self.sim.joints, q, qd, effort))
         if self.pub_ten is not None:
             self.pub_ten.publish(convert.joint_state_msg(t, self.sim.tendons, None, None, tension))
 
