@@ -37,13 +37,18 @@ RANGE_MARGIN = 0.9
 
 @dataclass(frozen=True)
 class Limits:
-    """The machine's limits per joint (SI): position range, speed, acceleration."""
+    """The machine's limits per joint (SI): position range, speed, acceleration; ``constraint``
+    (optional) ``fn(q, qd, qdd) -> [violation lines]`` for what per-joint ranges cannot say (the
+    CDPR's cables between their minimum and maximum tension). A plant with a constraint chooses
+    its box, speeds and accelerations so that every motion inside them satisfies it (checked on
+    the designed reference)."""
 
     joints: tuple
     lower: np.ndarray
     upper: np.ndarray
     speed: np.ndarray
     accel: np.ndarray
+    constraint: Callable | None = None
 
     def check(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, tol: float = 1e-9) -> list[str]:
         """Violations (one line each) of a motion (N, n) against the limits; empty if none."""
@@ -56,6 +61,8 @@ class Limits:
                 out.append(f"{name}: speed {np.abs(qd[:, j]).max():.4g} above {self.speed[j]:.4g}")
             if np.abs(qdd[:, j]).max() > self.accel[j] * (1 + 1e-6) + tol:
                 out.append(f"{name}: acceleration {np.abs(qdd[:, j]).max():.4g} above {self.accel[j]:.4g}")
+        if self.constraint is not None:
+            out.extend(self.constraint(q, qd, qdd))
         return out
 
 
@@ -67,9 +74,14 @@ class Exciter:
         limits: ``fn(description) -> Limits``.
         motion_dataset: ``fn(t, q, qd, qdd, description) -> Dataset``: the dataset the plant's
             effects see for a motion that follows the reference exactly (outputs zero).
-        reference_topic: the plant's ``reference`` topic (trajectory_msgs/JointTrajectory).
+        reference_topic: the plant's ``reference`` topic.
         base_hz: lowest frequency of the Fourier series; harmonics: number of harmonics.
         rate_hz: sample rate of the written reference.
+        grid: samples per period of the highest harmonic on the design grid (the cost's); fewer
+            for a plant whose dataset is costly per sample.
+        trajectory: ``"joint"`` (trajectory_msgs/JointTrajectory of the limits' joints) or
+            ``"pose"`` (trajectory_msgs/MultiDOFJointTrajectory of a level platform: the joints
+            are its x, y, z).
     """
 
     limits: Callable
@@ -78,6 +90,8 @@ class Exciter:
     base_hz: float = 0.05
     harmonics: int = 5
     rate_hz: float = 100.0
+    grid: float = 10.0
+    trajectory: str = "joint"
 
 
 _EXCITERS: dict[str, Exciter] = {}
@@ -117,36 +131,45 @@ def _window(t: np.ndarray, duration: float):
     return a * b, ad * b - a * bd, add * b - 2 * ad * bd + a * bdd
 
 
+def fourier_basis(t: np.ndarray, base_hz: float, harmonics: int, duration: float):
+    """``(Bx, Bxd, Bxdd)`` (N, 2H): the windowed Fourier series is linear in its coefficients,
+    ``x = Bx @ [a, b]`` (a: sine, b: cosine velocity amplitudes), starting at 0 at ``t[0]``."""
+    om = 2 * np.pi * base_hz * np.arange(1, harmonics + 1)          # (H,)
+    arg = t[:, None] * om[None, :]                                # (N, H)
+    s, c = np.sin(arg), np.cos(arg)
+    x = np.hstack([s / om, -c / om])
+    x = x - x[:1]                                                  # start at the centre
+    xd = np.hstack([c, s])
+    xdd = np.hstack([-s * om, c * om])
+    w, wd, wdd = (v[:, None] for v in _window(t, duration))
+    return w * x, wd * x + w * xd, wdd * x + 2 * wd * xd + w * xdd
+
+
 def fourier_motion(coef: np.ndarray, t: np.ndarray, base_hz: float, duration: float):
     """Unit-scale deviation ``(x, xd, xdd)`` (N, n_joints) of the windowed Fourier series with
     coefficients ``coef`` (n_joints, 2, H): a (sine) and b (cosine) velocity amplitudes."""
     n_j, _, h = coef.shape
-    k = np.arange(1, h + 1)
-    om = 2 * np.pi * base_hz * k                                  # (H,)
-    arg = t[:, None] * om[None, :]                                # (N, H)
-    s, c = np.sin(arg), np.cos(arg)
-    a, b = coef[:, 0, :], coef[:, 1, :]                           # (n_j, H)
-    x = s @ (a / om).T - c @ (b / om).T
-    xd = c @ a.T + s @ b.T
-    xdd = -(s * om) @ a.T + (c * om) @ b.T
-    x = x - x[:1]                                                  # start at the centre
-    w, wd, wdd = _window(t, duration)
-    w, wd, wdd = w[:, None], wd[:, None], wdd[:, None]
-    return w * x, wd * x + w * xd, wdd * x + 2 * wd * xd + w * xdd
+    flat = coef.reshape(n_j, 2 * h).T
+    return tuple(m @ flat for m in fourier_basis(t, base_hz, h, duration))
+
+
+def _scale(x, xd, xdd, limits: Limits):
+    """``(q, qd, qdd)`` of unit-scale deviations (..., N, n_joints) scaled per joint (and per
+    leading index) to the largest amplitude the limits allow, around each range's centre."""
+    centre = 0.5 * (limits.lower + limits.upper)
+    half = 0.5 * (limits.upper - limits.lower) * RANGE_MARGIN
+    with np.errstate(divide="ignore"):
+        s = np.min(np.stack([half / np.max(np.abs(x), axis=-2),
+                             limits.speed / np.max(np.abs(xd), axis=-2),
+                             limits.accel / np.max(np.abs(xdd), axis=-2)]), axis=0)
+    s = np.where(np.isfinite(s), s, 0.0)[..., None, :]
+    return centre + s * x, s * xd, s * xdd
 
 
 def scaled_motion(coef, t, limits: Limits, base_hz: float, duration: float):
     """``(q, qd, qdd)``: the Fourier deviation scaled per joint to the largest amplitude the
     limits allow, around the centre of each joint's range (limits hold by construction)."""
-    x, xd, xdd = fourier_motion(coef, t, base_hz, duration)
-    centre = 0.5 * (limits.lower + limits.upper)
-    half = 0.5 * (limits.upper - limits.lower) * RANGE_MARGIN
-    with np.errstate(divide="ignore"):
-        s = np.min(np.stack([half / np.max(np.abs(x), axis=0),
-                             limits.speed / np.max(np.abs(xd), axis=0),
-                             limits.accel / np.max(np.abs(xdd), axis=0)]), axis=0)
-    s = np.where(np.isfinite(s), s, 0.0)
-    return centre + s * x, s * xd, s * xdd
+    return _scale(*fourier_motion(coef, t, base_hz, duration), limits)
 
 
 def _weighted_columns(model, ds):
@@ -204,10 +227,15 @@ def model_for(plant, desc, params: Sequence[str], ds) -> tuple:
         eff = get_effect(eid, plant.name)
         for p in list(eff.columns(ds)) + list(eff.nonlinear):
             known.setdefault(p.name, eid)
+    nonlinear = {p.name for eid in known.values() for p in get_effect(eid, plant.name).nonlinear}
     for name in params:
         if name not in known:
             raise CablelabError(f"--params {name!r}: no parameter of that name for plant {plant.name} "
                                 f"(parameters: {', '.join(sorted(known))})")
+        if name in nonlinear:
+            raise CablelabError(f"--params {name!r}: a nonlinear parameter of {known[name]} (no regressor "
+                                f"column whose information the design could condition); name linear "
+                                f"parameters")
         if known[name] not in base and known[name] not in owners:
             owners.append(known[name])
     return Model(plant.name, tuple(base + owners)), tuple(known[n] for n in params)
@@ -236,9 +264,61 @@ class Design:
                 "seconds": self.seconds}
 
 
+def _stacked_motion(xs, basis, t, limits: Limits, shape):
+    """The motions of coefficient vectors ``xs`` (k, n) one after the other on one time axis
+    (each starts and ends at rest at the range's centre, so the stacked motion is smooth):
+    ``(t, q, qd, qdd)`` of k blocks of ``len(t)`` samples (``basis``: :func:`fourier_basis`)."""
+    step = t[1] - t[0] if len(t) > 1 else 1.0
+    span = t[-1] - t[0] + step
+    flat = np.asarray(xs).reshape(len(xs), shape[0], -1)           # (k, n_j, 2H)
+    q, qd, qdd = _scale(*(np.einsum("nh,kjh->knj", m, flat) for m in basis), limits)
+    t_all = (t[None, :] + span * np.arange(len(xs))[:, None]).ravel()
+    return (t_all,) + tuple(m.reshape(-1, shape[0]) for m in (q, qd, qdd))
+
+
+def block_conditions(model, ds, blocks: int, params: Sequence[str]) -> np.ndarray:
+    """:func:`condition` of each of ``blocks`` equal consecutive time blocks of ``ds`` at once
+    (what one batched regressor evaluation of :func:`_stacked_motion` gives): the same
+    weighting and Schur complement, from each block's information matrix (eigenvalues below
+    1e-13 of the largest count as a rank deficiency of the other parameters)."""
+    phi, cols, _ = model.regressor(ds)
+    names = [c.name for c in cols]
+    n, c, p = phi.shape
+    phi = phi.reshape(blocks, n // blocks, c, p)
+    ok = (np.asarray(ds.valid, bool).reshape(blocks, -1) & np.isfinite(phi).all(axis=(2, 3)))
+    a = np.where(ok[:, :, None, None], phi, 0.0)
+    cnt = np.maximum(ok.sum(axis=1), 1)[:, None]
+    rms = np.sqrt(np.sum(a ** 2, axis=(1, 3)) / (cnt * p))                   # (k, C)
+    a = a / np.where(rms > 0, rms, 1.0)[:, None, :, None]
+    a = a.reshape(blocks, -1, p)
+    g = np.einsum("kmi,kmj->kij", a, a)
+    d = np.sqrt(np.maximum(np.einsum("kii->ki", g), 0.0))                     # column norms
+    dead = (d <= 1e-12 * np.maximum(d.max(axis=1, keepdims=True), 1e-300)).any(axis=1)
+    d = np.where(d > 0, d, 1.0)
+    g = g / d[:, :, None] / d[:, None, :]
+    sel = [names.index(q) for q in params] if params else list(range(p))
+    rest = [i for i in range(p) if i not in sel]
+    s = g[:, sel][:, :, sel]
+    if rest:
+        grr, grs = g[:, rest][:, :, rest], g[:, rest][:, :, sel]
+        w, v = np.linalg.eigh(grr)
+        inv = np.where(w > 1e-13 * np.maximum(w[:, -1:], 1e-300), 1.0 / np.where(w > 0, w, 1.0), 0.0)
+        proj = np.einsum("kri,ki,ksi->krs", v, inv, v)
+        s = s - np.einsum("kri,krs,ksj->kij", grs, proj, grs)
+    lam = np.linalg.eigvalsh(0.5 * (s + np.swapaxes(s, 1, 2)))[:, 0]
+    out = np.where(lam > 1e-15, 1.0 / np.where(lam > 1e-15, lam, 1.0), np.inf)
+    return np.where(dead, np.inf, out)
+
+
 def design(plant_name: str, desc, params: Sequence[str], *, duration: float = 60.0,
            before_ds=None, seed: int = 0, starts: int = 1, max_iter: int = 30) -> Design:
     """Design an excitation of ``duration`` s for the named parameters (module doc).
+
+    The cost (log condition number on a grid of 10 samples per period of the highest harmonic)
+    and its forward-difference gradient are evaluated together: the k + 1 motions (the point and
+    one step along each coefficient) are stacked on one time axis, so the plant's dataset and the
+    model's regressor are built once per gradient (:func:`block_conditions`) instead of k + 1
+    times.
 
     Args:
         plant_name, desc: the plant and its description (limits, geometry).
@@ -259,27 +339,47 @@ def design(plant_name: str, desc, params: Sequence[str], *, duration: float = 60
     ex = get_exciter(plant_name)
     lim = ex.limits(desc)
     n_j, h = len(lim.joints), ex.harmonics
-    # design grid: 10 samples per period of the highest harmonic
-    fs = 10.0 * ex.base_hz * h
+    shape = (n_j, 2, h)
+    # design grid: ex.grid (10) samples per period of the highest harmonic
+    fs = ex.grid * ex.base_hz * h
     t = np.arange(0.0, duration, 1.0 / fs)
-    probe = ex.motion_dataset(t, *scaled_motion(np.ones((n_j, 2, h)), t, lim, ex.base_hz, duration), desc)
+    probe = ex.motion_dataset(t, *scaled_motion(np.ones(shape), t, lim, ex.base_hz, duration), desc)
     model, _ = model_for(plant, desc, params, probe)
+    n = n_j * 2 * h
+    basis = fourier_basis(t, ex.base_hz, h, duration)
 
-    def cost(x):
-        q, qd, qdd = scaled_motion(x.reshape(n_j, 2, h), t, lim, ex.base_hz, duration)
-        c = condition(model, ex.motion_dataset(t, q, qd, qdd, desc), params)
-        return float(np.log(c)) if np.isfinite(c) else 1e3
+    # stacked evaluation when the plant's dataset keeps one sample per reference sample (not the
+    # leg's, built per hop): checked once on two stacked motions
+    probe2 = ex.motion_dataset(*_stacked_motion(np.ones((2, n)), basis, t, lim, shape), desc)
+    stacked = probe2.n == 2 * len(t)
+
+    def conditions(xs):
+        if stacked:
+            ds = ex.motion_dataset(*_stacked_motion(xs, basis, t, lim, shape), desc)
+            return block_conditions(model, ds, len(xs), params)
+        return np.array([condition(model, ex.motion_dataset(
+            t, *scaled_motion(x.reshape(shape), t, lim, ex.base_hz, duration), desc), params) for x in xs])
+
+    def cost_grad(x):
+        step = 1e-6 * np.maximum(1.0, np.abs(x))
+        c = conditions(np.vstack([x, x + np.diag(step)]))
+        logc = np.where(np.isfinite(c), np.log(np.where(np.isfinite(c), c, 1.0)), 1e3)
+        return float(logc[0]), (logc[1:] - logc[0]) / step
 
     rng = np.random.default_rng(seed)
     best = None
     for _ in range(max(1, starts)):
-        x0 = rng.normal(size=n_j * 2 * h) / np.tile(np.arange(1, h + 1), n_j * 2)
-        res = scipy.optimize.minimize(cost, x0, method="L-BFGS-B", options={"maxiter": max_iter})
+        x0 = rng.normal(size=n) / np.tile(np.arange(1, h + 1), n_j * 2)
+        res = scipy.optimize.minimize(cost_grad, x0, jac=True, method="L-BFGS-B",
+                                      options={"maxiter": max_iter})
         if best is None or res.fun < best.fun:
             best = res
-    coef = best.x.reshape(n_j, 2, h)
+    coef = best.x.reshape(shape)
     t_out = np.arange(0.0, duration + 0.5 / ex.rate_hz, 1.0 / ex.rate_hz)
     q, qd, qdd = scaled_motion(coef, t_out, lim, ex.base_hz, duration)
+    bad = lim.check(q, qd, qdd)
+    if bad:   # a plant whose box does not guarantee its constraint: refuse, never write it
+        raise CablelabError(f"designed reference breaks the machine's limits: {bad[0]}")
     after = condition(model, ex.motion_dataset(t_out, q, qd, qdd, desc), params)
     before = condition(model, before_ds, params) if before_ds is not None else None
     return Design(t_out, q, qd, qdd, lim, tuple(params), before, after, model,
@@ -296,22 +396,34 @@ def write_reference(path, d: Design, exciter: Exciter, description_yaml: str | N
     with BagWriter(path, overwrite=overwrite) as w:
         if description_yaml:
             w.write_description(description_yaml)
-        w.write_joint_trajectory(exciter.reference_topic, d.t, list(d.limits.joints), d.q, d.qd, d.qdd)
+        if exciter.trajectory == "pose":
+            level = np.tile([0.0, 0.0, 0.0, 1.0], (len(d.t), 1))           # x, y, z, w
+            w.write_multidof_trajectory(exciter.reference_topic, d.t, d.q, level, d.qd, None, d.qdd)
+        else:
+            w.write_joint_trajectory(exciter.reference_topic, d.t, list(d.limits.joints), d.q, d.qd,
+                                     d.qdd)
 
 
 def read_reference(path, topic: str, joints: Sequence[str]):
     """``fn(t) -> (q, qd, qdd)`` (N, n) interpolating a reference bag written by
-    :func:`write_reference` (held at its last point after the end): what a controller plays."""
+    :func:`write_reference` (held at its last point after the end): what a controller plays.
+    A pose reference (MultiDOFJointTrajectory) gives the platform's x, y, z (``joints`` unused)."""
     from .bags import open_bag
 
     bag = open_bag(path)
     if not bag.has(topic):
         raise CablelabError(f"{path}: no {topic} in the reference bag (topics: "
                             f"{', '.join(sorted(bag.topics)) or 'none'})")
-    tr = bag.joint_trajectory(topic, list(joints))
-    tt = tr.t - tr.t[0]
-    cols = [np.asarray(a, float) if a is not None else np.zeros_like(tr.positions)
-            for a in (tr.positions, tr.velocities, tr.accelerations)]
+    if bag.topics[topic].endswith("MultiDOFJointTrajectory"):     # a platform pose: x, y, z
+        tr = bag.multidof_trajectory(topic)
+        tt = tr.t - tr.t[0]
+        cols = [np.nan_to_num(np.asarray(a, float)) for a in
+                (tr.position, tr.linear_velocity, tr.linear_acceleration)]
+    else:
+        tr = bag.joint_trajectory(topic, list(joints))
+        tt = tr.t - tr.t[0]
+        cols = [np.asarray(a, float) if a is not None else np.zeros_like(tr.positions)
+                for a in (tr.positions, tr.velocities, tr.accelerations)]
 
     def fn(t):
         t = np.atleast_1d(np.asarray(t, float))
@@ -321,5 +433,6 @@ def read_reference(path, topic: str, joints: Sequence[str]):
     return fn
 
 
-__all__ = ["Design", "Exciter", "Limits", "condition", "design", "fourier_motion", "get_exciter",
+__all__ = ["Design", "Exciter", "Limits", "block_conditions", "condition", "design", "fourier_basis",
+           "fourier_motion", "get_exciter",
            "model_for", "read_reference", "register_exciter", "scaled_motion", "write_reference"]

@@ -1,9 +1,9 @@
-"""``cablelab batch ROOT [--effects a,b] [--greedy] [--scheduler ADDRESS] -o OUT``: diagnose every
+"""``cablelab batch ROOT [--effects a,b] [--greedy] [--strict] [--scheduler ADDRESS] -o OUT``: diagnose every
 bag under ROOT on Dask distributed, write OUT/results.parquet and the fleet report OUT/index.html."""
 from __future__ import annotations
 
 from .numeric import number
-from ._workbench_args import add_folds, add_json, dump_json
+from ._workbench_args import add_folds, add_json, add_strict, dump_json
 
 HELP = "diagnose every bag under ROOT (Dask), results.parquet + fleet report with parameter drift"
 
@@ -16,6 +16,7 @@ def add_arguments(p) -> None:
     p.add_argument("--greedy", action="store_true",
                    help="add significant effects one at a time; parameters from the final model")
     add_folds(p)
+    add_strict(p)
     p.add_argument("--scheduler", metavar="ADDRESS", default=None,
                    help="existing Dask scheduler, e.g. tcp://HOST:8786 (default: a LocalCluster)")
     p.add_argument("--workers", type=number(ge=1, le=4096, integer=True), default=None, metavar="N",
@@ -53,7 +54,8 @@ def _run(args) -> int:
 
     res = run_batch(args.root, args.out, effects=parse_effect_list(args.effects), greedy=args.greedy,
                     folds=args.folds, scheduler=args.scheduler, workers=args.workers,
-                    group_by=args.group_by, reports=args.reports, progress=not args.json)
+                    group_by=args.group_by, reports=args.reports, progress=not args.json,
+                    strict=args.strict)
     rows, findings, tests = analyse(res["table"], args.alpha)
     index = write_report(args.out, rows, findings, tests, root=str(args.root))
     out = summary(rows, findings)
@@ -63,6 +65,9 @@ def _run(args) -> int:
         return 0
     print(f"{out['bags']} bags ({res['ran']} diagnosed now, {res['skipped']} already done), "
           f"{out['failed']} failed, {res['seconds']:.1f} s; wrote {args.out}/results.parquet and {index}")
+    if out.get("held"):
+        print(f"  warning: {out['held']} bags do not excite every parameter (held at their description or "
+              f"neutral values: the warnings column; --strict refuses them)")
     for d in out["drift"]:
         print(f"  drift: {d['machine']} {d['effect']} {d['param']} since {d['since']}")
     return 0

@@ -120,7 +120,7 @@ def series_from_rows(rows: list[dict], min_bags: int = MIN_BAGS) -> list[Series]
         except ValueError:
             continue
         for name, v in params.items():
-            if v.get("value") is None:
+            if v.get("value") is None or v.get("held"):   # held: not measured by this bag
                 continue
             groups.setdefault((r["machine"], r["effect"], name), []).append(
                 (r["start_time"], v["value"], v.get("stderr"), r["bag"]))

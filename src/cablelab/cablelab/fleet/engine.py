@@ -82,11 +82,14 @@ def start_client(scheduler: str | None = None, workers: int | None = None, *, qu
 
 def run_batch(root, out, *, effects=(), greedy: bool = False, folds: int = 5, scheduler: str | None = None,
               workers: int | None = None, group_by: str | None = None, reports: bool = False,
-              progress: bool = True, client=None, max_group: int | None = None) -> dict:
+              progress: bool = True, client=None, max_group: int | None = None,
+              strict: bool = False) -> dict:
     """Diagnose every bag under ``root`` into ``out`` (the dashboard link always goes to stderr,
     the progress bar when ``progress``); returns ``{"refs", "hashes", "ran",
     "skipped", "table", "seconds", "dashboard"}`` (the table: :mod:`cablelab.fleet.table`).
     ``max_group``: most bags per task (default :data:`MAX_GROUP`; 1: one task per bag).
+    ``strict``: refuse a bag whose data do not determine every parameter (its row's status is
+    the refusal) instead of holding those parameters with a warning (``--strict``).
 
     ``out`` may not be, contain or lie inside ``root``; an existing ``out`` must be empty or an
     earlier batch output (marker file); it is locked against a second batch for the run
@@ -98,14 +101,14 @@ def run_batch(root, out, *, effects=(), greedy: bool = False, folds: int = 5, sc
     try:
         return _run_batch(root, out, effects=effects, greedy=greedy, folds=folds, scheduler=scheduler,
                           workers=workers, group_by=group_by, reports=reports, progress=progress,
-                          client=client, max_group=max_group)
+                          client=client, max_group=max_group, strict=strict)
     finally:
         if taken:
             release_target(out)
 
 
 def _run_batch(root, out: Path, *, effects, greedy, folds, scheduler, workers, group_by, reports,
-               progress, client, max_group) -> dict:
+               progress, client, max_group, strict=False) -> dict:
     refs = find_bags(root, group_by)
     t0 = time.monotonic()
     own = client is None
@@ -125,7 +128,7 @@ def _run_batch(root, out: Path, *, effects, greedy, folds, scheduler, workers, g
             rep = str(out / "bags" / h) if reports else None
             todo.append((ref, h, rep))
         ran, failed = _run(client, todo, out, effects, greedy, folds, progress,
-                           MAX_GROUP if max_group is None else max_group)
+                           MAX_GROUP if max_group is None else max_group, strict)
     finally:
         if own:
             client.close()
@@ -173,10 +176,11 @@ def groups(n: int, workers: int, max_group: int = MAX_GROUP) -> list[int]:
     return sizes
 
 
-def run_bags(refs, hashes, reports, effects=(), greedy: bool = False, folds: int = 5) -> list[list[dict]]:
+def run_bags(refs, hashes, reports, effects=(), greedy: bool = False, folds: int = 5,
+             strict: bool = False) -> list[list[dict]]:
     """The task: :func:`~cablelab.fleet.task.run_bag` of each bag of a group, one after the
     other (memory stays one bag's); rows per bag."""
-    return [run_bag(r, h, effects, greedy, folds, rep) for r, h, rep in zip(refs, hashes, reports)]
+    return [run_bag(r, h, effects, greedy, folds, rep, strict) for r, h, rep in zip(refs, hashes, reports)]
 
 
 def _failed_row(ref, h, exc) -> dict:
@@ -210,7 +214,8 @@ def _n_workers(client) -> int:
         return 1
 
 
-def _run(client, todo, out, effects, greedy, folds, progress, max_group=MAX_GROUP) -> tuple[int, int]:
+def _run(client, todo, out, effects, greedy, folds, progress, max_group=MAX_GROUP,
+         strict=False) -> tuple[int, int]:
     """Run the bags of ``todo`` (``(ref, hash, report dir)``): one ``client.map`` of tasks of
     :func:`groups` of bags, finished tasks noticed by polling their futures' local state every
     :data:`POLL_SECONDS`, their results gathered and written as one part (:class:`PartWriter`)
@@ -256,7 +261,8 @@ def _run(client, todo, out, effects, greedy, folds, progress, max_group=MAX_GROU
     try:
         with _sigterm_as_exit():
             left = client.map(run_bags, *zip(*[(refs[a:b], hashes[a:b], reps[a:b]) for a, b in bounds]),
-                              effects=tuple(effects), greedy=greedy, folds=folds, key=keys, pure=False)
+                              effects=tuple(effects), greedy=greedy, folds=folds, strict=strict, key=keys,
+                              pure=False)
             while left:
                 time.sleep(POLL_SECONDS)
                 now = [f for f in left if f.done()]
@@ -279,12 +285,13 @@ def _run(client, todo, out, effects, greedy, folds, progress, max_group=MAX_GROU
     return n, failed
 
 
-def run_loop(refs, hashes, *, effects=(), greedy: bool = False, folds: int = 5, out=None) -> list[dict]:
+def run_loop(refs, hashes, *, effects=(), greedy: bool = False, folds: int = 5, out=None,
+             strict: bool = False) -> list[dict]:
     """The same per-bag task in a plain Python loop (the benchmark's baseline); with ``out``, the
     rows are written once at the end as ``out/results.parquet``."""
     rows = []
     for ref, h in zip(refs, hashes):
-        rows += run_bag(ref, h, tuple(effects), greedy, folds, None)
+        rows += run_bag(ref, h, tuple(effects), greedy, folds, None, strict)
     if out is not None:
         Path(out).mkdir(parents=True, exist_ok=True)
         _table.write_atomic(_table.to_table(rows), Path(out) / _table.RESULTS)

@@ -133,7 +133,8 @@ def write_report(out, rows: list[dict], findings, tests, *, title: str = "cablel
         link = (f"<a href='bags/{r['bag_hash']}/index.html'>report</a>" if rep.exists() else
                 f"<code>cablelab report {html.escape(r['url'])} -o DIR</code>")
         trs.append([html.escape(r["machine"]), html.escape(str(r["start_time"] or "")), html.escape(r["bag"]),
-                    html.escape(r["status"] if r["status"] == "ok" else "failed"), link])
+                    html.escape(("ok; " + r["warnings"] if r.get("warnings") else "ok")
+                                if r["status"] == "ok" else "failed"), link])
     parts.append(_table(trs, ["machine", "start", "bag", "status", "per-bag report"]))
     parts.append("</body></html>")
     index = out / "index.html"
@@ -144,11 +145,17 @@ def write_report(out, rows: list[dict], findings, tests, *, title: str = "cablel
 
 
 def summary(rows: list[dict], findings) -> dict:
-    """The ``--json`` object of CONTRACT section 5 (plus nothing else)."""
-    bags = {}
+    """The ``--json`` object of CONTRACT section 5, plus ``held`` when some bags do not excite
+    every parameter: their number (those parameters held with a warning)."""
+    bags, held = {}, set()
     for r in rows:
         bags.setdefault((r["bag"]), r["status"])
-    return {"bags": len(bags), "failed": sum(1 for s in bags.values() if s != "ok"),
-            "drift": [{"machine": f.machine, "effect": f.effect, "param": f.param,
-                       "since": f.since.astimezone(_dt.timezone.utc).isoformat().replace("+00:00", "Z")} for f in findings]}
+        if r.get("warnings") and r["status"] == "ok":
+            held.add(r["bag"])
+    out = {"bags": len(bags), "failed": sum(1 for s in bags.values() if s != "ok"),
+           "drift": [{"machine": f.machine, "effect": f.effect, "param": f.param,
+                      "since": f.since.astimezone(_dt.timezone.utc).isoformat().replace("+00:00", "Z")} for f in findings]}
+    if held:
+        out["held"] = len(held)
+    return out
 

@@ -7,7 +7,8 @@ One row per bag and effect. Columns (CONTRACT + extras): ``bag`` (path relative 
 null for nominal effects), ``significant``, ``error_before``, ``error_after`` (held-out NRMSE,
 fraction), ``p_value``, ``params`` (JSON text: name -> {"value", "stderr"}), ``model`` (final
 model, effects joined by '+'), ``status`` (``ok`` or the one-line failure), ``seconds`` (task
-wall time of the bag).
+wall time of the bag), ``warnings`` (null, or the line naming the parameters the bag did not excite,
+held at their description or neutral values; ``--strict`` refuses such a bag instead).
 
 Finished bags are written in chunks: ``OUT/parts/<time_ns>-<pid>-<seq>.parquet`` holds the rows
 of every bag finished since the previous part (the engine writes one per second of results and at
@@ -36,7 +37,7 @@ SCHEMA = pa.schema([
     ("start_time", pa.timestamp("us", tz="UTC")), ("plant", pa.string()), ("effect", pa.string()),
     ("in_model", pa.bool_()), ("rank", pa.int32()), ("significant", pa.bool_()),
     ("error_before", pa.float64()), ("error_after", pa.float64()), ("p_value", pa.float64()),
-    ("params", pa.string()), ("model", pa.string()), ("status", pa.string()), ("seconds", pa.float64()),
+    ("params", pa.string()), ("model", pa.string()), ("status", pa.string()), ("seconds", pa.float64()), ("warnings", pa.string()),
 ])
 PARTS = "parts"
 RESULTS = "results.parquet"

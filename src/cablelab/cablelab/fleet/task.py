@@ -24,10 +24,11 @@ def _one_line(exc: BaseException) -> str:
     return text[0] if text else type(exc).__name__
 
 
-def _params_json(values: dict, stderr: dict | None, names) -> str:
+def _params_json(values: dict, stderr: dict | None, names, held=()) -> str:
+    """name -> {"value", "stderr"} (+ ``"held": true`` for a parameter the bag did not excite)."""
     stderr = stderr or {}
-    return json.dumps({k: {"value": _f(values.get(k)), "stderr": _f(stderr.get(k))} for k in names
-                       if k in values})
+    return json.dumps({k: {"value": _f(values.get(k)), "stderr": _f(stderr.get(k)),
+                           **({"held": True} if k in held else {})} for k in names if k in values})
 
 
 def _f(v):
@@ -56,13 +57,16 @@ def _local(ref: BagRef):
 
 
 def run_bag(ref: BagRef, bag_hash: str, effects=(), greedy: bool = False, folds: int = 5,
-            report_dir: str | None = None) -> list[dict]:
-    """Diagnose one bag. Returns its rows (see :mod:`cablelab.fleet.table`); never raises."""
+            report_dir: str | None = None, strict: bool = False) -> list[dict]:
+    """Diagnose one bag. Returns its rows (see :mod:`cablelab.fleet.table`); never raises.
+    Parameters the bag does not excite are held at their description or neutral values, named
+    in the rows' ``warnings`` and flagged ``held`` in ``params``; ``strict`` refuses such a bag
+    instead (its one row's ``status`` is the refusal), as ``diagnose --strict``."""
     t0 = time.monotonic()
     base = {"bag": ref.rel, "url": ref.url, "bag_hash": bag_hash, "machine": ref.machine,
             "start_time": ref.start_time, "plant": None}
     try:
-        rows = _rows(ref, base, effects, greedy, folds, report_dir)
+        rows = _rows(ref, base, effects, greedy, folds, report_dir, strict)
     except Exception as exc:  # noqa: BLE001 - every failure becomes a row
         from ..errors import CablelabError
 
@@ -76,7 +80,7 @@ def run_bag(ref: BagRef, bag_hash: str, effects=(), greedy: bool = False, folds:
     return rows
 
 
-def _rows(ref, base, effects, greedy, folds, report_dir):
+def _rows(ref, base, effects, greedy, folds, report_dir, strict=False):
     import shutil
 
     from ..effect_spec import parse_effect_list
@@ -92,7 +96,7 @@ def _rows(ref, base, effects, greedy, folds, report_dir):
             start = _dt.datetime.fromtimestamp(open_bag(path).start, _dt.timezone.utc)
         base = dict(base, plant=plant.name, machine=base["machine"] or desc.name or "",
                     start_time=start)
-        model = build_model(plant, desc, parse_effect_list(list(effects)))
+        model = build_model(plant, desc, parse_effect_list(list(effects)), strict=strict)
         cands = plant.candidates(desc)
         d = diagnose(ds, model, cands, folds=folds, greedy_mode=greedy, quiet=True)
         first = {c.effect: (i, c) for i, c in enumerate(d.ranking)}
@@ -100,12 +104,17 @@ def _rows(ref, base, effects, greedy, folds, report_dir):
             final_effects, final_error = list(d.final.effects), d.final.error
             fvals, ferr = d.final.params, d.final.stderr
             last = {c.effect: c for c in d.final.ranking}
+            fit = d.final.fit
         else:
+            fit = d.fit
             final_effects, final_error = list(model.effects), d.baseline_error
             reported = d.fit.reported(ds)[0]   # the model's parameters in the user's terms
             fvals = {k: v["value"] for k, v in reported.items()}
             ferr = {k: v["stderr"] for k, v in reported.items()}
             last = {c.effect: c for c in d.ranking}
+        held = fit.held if fit is not None else dict(d.held)
+        warning = fit.held_warning() if fit is not None else d.held_warning
+        base = dict(base, warnings=warning)
         rows = []
         model_text = "+".join(final_effects)
         for eff in final_effects:
@@ -115,7 +124,7 @@ def _rows(ref, base, effects, greedy, folds, report_dir):
                              error_before=d.baseline_error if c is None else c.error_before,
                              error_after=final_error if c is None else c.error_after,
                              p_value=None if c is None else c.p_value,
-                             params=_params_json(fvals, ferr, _effect_names(eff, ds)),
+                             params=_params_json(fvals, ferr, _effect_names(eff, ds), held),
                              model=model_text, status="ok"))
         for eff, (rank, c) in first.items():
             if eff in final_effects:
@@ -123,7 +132,7 @@ def _rows(ref, base, effects, greedy, folds, report_dir):
             lc = last.get(eff, c)
             rows.append(dict(base, effect=eff, in_model=False, rank=rank, significant=bool(c.significant),
                              error_before=c.error_before, error_after=c.error_after, p_value=c.p_value,
-                             params=_params_json(lc.params, lc.stderr, list(lc.params)),
+                             params=_params_json(lc.params, lc.stderr, list(lc.params), lc.held or ()),
                              model=model_text, status="ok"))
         if report_dir:
             from ..report import build_report

@@ -14,6 +14,7 @@ ROS parameters: :data:`PARAMETERS` (``pd_feedforward --plant cdpr --help``). Com
 """
 from __future__ import annotations
 
+import math
 import time
 from functools import partial
 
@@ -62,6 +63,9 @@ PARAMETERS = merge((
     Param("state_timeout", 0.5, "a joint state older than this is stale", "s wall", gt=0.0),
     Param("sync_wait", 0.005, "a state waits this long for the reference of its stamp before the "
           "latest one is used", "s wall", ge=0.0, le=1.0),
+    Param("reference_bag", "", "a reference bag written by `cablelab excite`: played from the first "
+          "joint state on and published on /cdpr/reference (run the simulator with "
+          "publish_reference:=false)"),
     Param("estimate_wait", 0.0, "a state waits this long for the estimate of its stamp (0 = never: "
           "use the latest; with a lock-step simulator: one deterministic chain)", "s wall",
           ge=0.0, le=10.0),
@@ -88,6 +92,12 @@ class CdprController(PlantNode):
         ref_sub = self.create_subscription(MultiDOFJointTrajectory, topics.REFERENCE, self.on_reference, q, raw=True)
         est_sub = self.create_subscription(InertiaStamped, topics.PAYLOAD_ESTIMATE, self.on_estimate, q)
         self.create_subscription(JointState, topics.JOINT_STATES, self.on_state, q, raw=True)
+        self.play, self.play_t0 = None, None
+        if v.reference_bag:     # the designed reference, published for each state's stamp
+            from ....excite import read_reference
+
+            self.play = read_reference(v.reference_bag, topics.REFERENCE, ("x", "y", "z"))
+            self.pub_ref = self.create_publisher(MultiDOFJointTrajectory, topics.REFERENCE, publisher_qos())
         # only a state wakes the node: the reference (published before the state of its stamp)
         # and the estimate wait queued until a state or the timer takes them (one wake-up per
         # cycle at 1 kHz instead of three); an awaited estimate (estimate_wait) still wakes it
@@ -137,6 +147,10 @@ class CdprController(PlantNode):
             state = rawmsg.joint_state_arrays(msg, self.readers["state"])
         except ValueError:
             state = (float("nan"), [], None, None, None)      # rejected by command()
+        if self.play is not None and math.isfinite(state[0]):
+            self.play_t0 = state[0] if self.play_t0 is None else self.play_t0
+            p, v, a = (x[0] for x in self.play(state[0] - self.play_t0))
+            self.pub_ref.publish(convert.multidof_msg(state[0], p, [0.0, 0.0, 0.0, 1.0], v, None, a, None))
         if self.stream.needs_inputs_first(state[0]):
             drain(*self.polled)         # the reference and estimate that came before it
         self.stream.state(state, time.monotonic())
