@@ -81,20 +81,21 @@ def joint_part(ds: Dataset, x: np.ndarray) -> np.ndarray:
 
 def _tendon_names(ds: Dataset) -> list[str]:
     """The tendons with a length channel; ``["tendon"]`` (the naming template) for a dataset
-    without an ``mjcf`` description; a one-line error for an mjcf dataset without lengths."""
+    without an ``mjcf`` description; none for an mjcf dataset without lengths."""
     if LENGTH_TENDONS in ds.signals:
         return list(ds.signals[LENGTH_TENDONS])
-    if getattr(ds.description, "mjcf", None) is None:
-        return ["tendon"]
-    raise CablelabError(
-        f"effect tendon_elasticity: {ds.source or 'the dataset'} has no cable lengths: cable "
-        "stretch shows against the lengths the winch encoders measure (cable_tensions position "
-        "of the description's tendons)")
+    return ["tendon"] if getattr(ds.description, "mjcf", None) is None else []
 
 
 def _regressor(ds: Dataset) -> np.ndarray:
-    """Per tendon: ``-T`` on its length channel (compliance) and 1 (zero correction)."""
+    """Per tendon: ``-T`` on its length channel (compliance) and 1 (zero correction); a one-line
+    error for a dataset without lengths."""
     names = _tendon_names(ds)
+    if LENGTH_TENDONS not in ds.signals:
+        raise CablelabError(
+            f"effect tendon_elasticity: {ds.source or 'the dataset'} has no cable lengths: cable "
+            "stretch shows against the lengths the winch encoders measure (cable_tensions "
+            "position of the description's tendons)")
     sec_tendons = list(ds.description.mjcf.tendons)
     tension = ds.require_signal("tension")[:, [sec_tendons.index(x) for x in names]]
     nj, k = int(ds.signals[JOINT_CHANNELS]), len(names)
