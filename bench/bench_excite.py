@@ -24,21 +24,14 @@ from cablelab.workbench import load
 def _crane_slew_only():
     """The crane slewing alone, luff and hoist held (a hoist offset hidden)."""
     import cablelab.plants.crane as crane_pkg
+    from cablelab.plants.crane.reference import slew_only
     from cablelab.plants.crane.sim import CraneTruth, simulate, write_bag
-
-    def ref(t):
-        q = np.zeros((len(t), 3))
-        qd, qdd = np.zeros_like(q), np.zeros_like(q)
-        w = 2 * np.pi * 0.1
-        q[:, 0], qd[:, 0], qdd[:, 0] = 0.3 * np.sin(w * t), 0.3 * w * np.cos(w * t), -0.3 * w * w * np.sin(w * t)
-        q[:, 1], q[:, 2] = 0.5, 0.6
-        return q, qd, qdd
 
     desc = (Path(crane_pkg.__file__).parent / "data" / "crane.yaml").read_text()
     with tempfile.TemporaryDirectory() as d:
         write_bag(Path(d) / "b", simulate(CraneTruth(torque_offset=(0.0, 0.5, 0.0),
                                                      effort_noise=(0.05, 0.05, 0.1)), 30.0,
-                                          reference=ref), desc)
+                                          reference=slew_only()), desc)
         _, dsc, ds = load(Path(d) / "b")
     return dsc, ds
 

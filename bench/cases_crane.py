@@ -42,6 +42,7 @@ import mujoco
 import numpy as np
 
 from cases_common import PlantCase, coloured_noise, moves_and_rests, quantize
+from cablelab.plants.crane.reference import slew_only
 
 JOINT_NAMES = ("slew", "luff", "hoist")
 ONE = [("joint_coulomb_friction",), ("torque_sensor_offset",), ("base_tilt",), ("counterbalance",),
@@ -138,20 +139,6 @@ def draw_designed_case(seed: int, kind: str | None = None) -> PlantCase:
     amp, f = rng.uniform(0.3, 0.6), rng.uniform(0.08, 0.15)
     tr.update(first_s=30.0, designed_s=60.0, slew_amp=amp, slew_hz=f, reference=slew_only(amp, f))
     return case
-
-
-def slew_only(amp: float, hz: float, luff: float = 0.5, rope: float = 0.6):
-    """Reference ``fn(t) -> (q, qd, qdd)``: a slew sine of ``amp`` rad at ``hz``, luff and rope held."""
-    w = 2 * np.pi * hz
-
-    def fn(t):
-        t = np.asarray(t, float)
-        q, qd, qdd = (np.zeros((t.size, 3)) for _ in range(3))
-        q[:, 0], qd[:, 0], qdd[:, 0] = amp * np.sin(w * t), amp * w * np.cos(w * t), -amp * w * w * np.sin(w * t)
-        q[:, 1], q[:, 2] = luff, rope
-        return q, qd, qdd
-
-    return fn
 
 
 def tabulated(t_ref, q, qd, qdd):

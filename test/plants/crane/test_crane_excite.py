@@ -17,6 +17,7 @@ from cablelab.diagnose.identifiability import correlations
 from cablelab.excite import get_exciter, read_reference
 from cablelab.fit import identify
 from cablelab.plants.crane.topics import REFERENCE
+from cablelab.plants.crane.reference import slew_only
 from cablelab.plants.crane.sim import CraneTruth, simulate, write_bag
 from cablelab.workbench import build_model, load
 
@@ -27,15 +28,6 @@ DESC = (Path(crane_pkg.__file__).parent / "data" / "crane.yaml").read_text()
 TRUTH = CraneTruth(torque_offset=(0.0, 0.5, 0.0), effort_noise=(0.05, 0.05, 0.1), mocap_noise=0.0005)
 
 
-def _slew_only(t):
-    q = np.zeros((len(t), 3))
-    qd, qdd = np.zeros_like(q), np.zeros_like(q)
-    w = 2 * np.pi * 0.1
-    q[:, 0], qd[:, 0], qdd[:, 0] = 0.3 * np.sin(w * t), 0.3 * w * np.cos(w * t), -0.3 * w * w * np.sin(w * t)
-    q[:, 1], q[:, 2] = 0.5, 0.6
-    return q, qd, qdd
-
-
 def _corr(r, a, b):
     names, corr = correlations(r)
     return corr[names.index(a), names.index(b)]
@@ -44,7 +36,7 @@ def _corr(r, a, b):
 @pytest.fixture(scope="module")
 def confounded(tmp_path_factory):
     path = tmp_path_factory.mktemp("crane_excite") / "slew_only"
-    write_bag(path, simulate(TRUTH, 30.0, reference=_slew_only), DESC)
+    write_bag(path, simulate(TRUTH, 30.0, reference=slew_only()), DESC)
     return str(path)
 
 

@@ -125,6 +125,20 @@ class SimProgress:
                 self.bar.set_postfix_str(f"other processes use {others:.1f} of {self.load.cores} cores"
                                          if others > self.busy else "", refresh=False)
 
+    def wait_for(self, launch, until: float, name: str, logs, stall: float = 120.0) -> None:
+        """Poll until the simulated time reaches ``until`` s, checking that every process of
+        ``launch`` (a :class:`cablelab.ros.launch.Launcher`) is alive; no simulated time for
+        ``stall`` s of wall time raises RuntimeError naming ``name`` and the ``logs``."""
+        last, t_last = 0.0, time.monotonic()
+        while self.sim_time < until:
+            self.poll(0.5)
+            launch.check_alive()
+            if self.sim_time > last:
+                last, t_last = self.sim_time, time.monotonic()
+            elif time.monotonic() - t_last > stall:
+                raise RuntimeError(f"{name}: no simulated time for {stall:.0f} s (at {last:.1f} s); "
+                                   f"logs in {logs}")
+
     def close(self) -> None:
         self.bar.close()
         try:

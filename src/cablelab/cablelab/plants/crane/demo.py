@@ -30,6 +30,7 @@ import numpy as np
 
 from ...demo import DemoPart, PartResult, log
 from . import topics
+from .reference import slew_only
 
 PAPER_REST_TORQUE = -0.2   # N m on the slew joint at rest at beta = 0.5 rad (002 sec. 6.5)
 REST_LUFF = 0.5            # rad, the luff angle of that measurement (and of the sim's start)
@@ -86,14 +87,7 @@ def run_over_dds(bag: Path, logs: Path, duration: float, domain: int, *, sim: di
 
         # simulated time from /clock (rate and ETA from it); no sample for 120 s wall is an error
         with SimProgress(launch.probe(), duration, "crane") as bar:
-            last, t_last = 0.0, time.monotonic()
-            while bar.sim_time < duration - 0.5 / rate:
-                bar.poll(0.5)
-                launch.check_alive()
-                if bar.sim_time > last:
-                    last, t_last = bar.sim_time, time.monotonic()
-                elif time.monotonic() - t_last > 120:
-                    raise RuntimeError(f"crane: no simulated time for 120 s (at {last:.1f} s); logs in {logs}")
+            bar.wait_for(launch, duration - 0.5 / rate, "crane", logs)
         time.sleep(1.0)
         codes = launch.stop_all()
     bad = {k: v for k, v in codes.items() if v != 0}
@@ -189,16 +183,6 @@ LOOP_OFFSET = (0.2, 0.0, 1.0)
 LOOP_NOISE = (0.05, 0.05, 0.1)     # effort noise of the offline recording (N m, N m, N)
 
 
-def slew_only(t):
-    """Reference that only slews (0.3 rad at 0.1 Hz); luff (0.5 rad) and rope (0.6 m) held."""
-    t = np.asarray(t, float)
-    q, qd, qdd = (np.zeros((t.size, 3)) for _ in range(3))
-    w = 2 * np.pi * 0.1
-    q[:, 0], qd[:, 0], qdd[:, 0] = 0.3 * np.sin(w * t), 0.3 * w * np.cos(w * t), -0.3 * w * w * np.sin(w * t)
-    q[:, 1], q[:, 2] = REST_LUFF, 0.6
-    return q, qd, qdd
-
-
 def loop_fit(bag_dir: Path):
     """Fit of the described crane + ``torque_sensor_offset`` on a bag, payload mass free (not
     weighed), boom and counterbalance as described: (dataset, identification, correlation of
@@ -232,7 +216,7 @@ def close_loop(out: Path, *, confounded_s: float, designed_s: float, domain: int
     log(f"crane: slew-only recording ({confounded_s:.0f} s, offline) with hidden offsets "
         f"{LOOP_OFFSET} and the payload mass free ...")
     truth = CraneTruth(torque_offset=LOOP_OFFSET, effort_noise=LOOP_NOISE, mocap_noise=0.0005)
-    write_bag(confounded, simulate(truth, confounded_s, reference=slew_only), desc_text, overwrite=True)
+    write_bag(confounded, simulate(truth, confounded_s, reference=slew_only(luff=REST_LUFF)), desc_text, overwrite=True)
     ds0, _, rho0, _ = loop_fit(confounded)
     log(f"crane: {', '.join(LOOP_PARAMS)} correlated {rho0:+.4f}: cablelab excite --params "
         f"'{','.join(LOOP_PARAMS)}' --duration {designed_s:g} ...")

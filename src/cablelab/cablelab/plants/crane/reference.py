@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["reference_trajectory"]
+__all__ = ["reference_trajectory", "slew_only"]
 
 
 def reference_trajectory(t, q0=(0.0, 0.5, 0.6), amplitude=(0.6, 0.25, 0.15), base_freq=0.08,
@@ -35,3 +35,22 @@ def reference_trajectory(t, q0=(0.0, 0.5, 0.6), amplitude=(0.6, 0.25, 0.15), bas
         qdr.append(wd * x + w * xd)
         qddr.append(wdd * x + 2 * wd * xd + w * xdd)
     return np.stack(qr, 1), np.stack(qdr, 1), np.stack(qddr, 1)
+
+
+def slew_only(amplitude: float = 0.3, hz: float = 0.1, luff: float = 0.5, rope: float = 0.6):
+    """A reference ``fn(t) -> (q, qd, qdd)`` (each (N, 3)) that only slews (a sine of ``amplitude``
+    rad at ``hz``), luff (rad) and rope (m) held: a recording that leaves the hoist effort
+    offset and the payload mass confounded (the experiment-design demo's and benchmark's first
+    recording)."""
+    w = 2 * np.pi * hz
+
+    def fn(t):
+        t = np.asarray(t, float)
+        q, qd, qdd = (np.zeros((t.size, 3)) for _ in range(3))
+        q[:, 0] = amplitude * np.sin(w * t)
+        qd[:, 0] = amplitude * w * np.cos(w * t)
+        qdd[:, 0] = -amplitude * w * w * np.sin(w * t)
+        q[:, 1], q[:, 2] = luff, rope
+        return q, qd, qdd
+
+    return fn

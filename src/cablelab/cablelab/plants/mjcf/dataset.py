@@ -5,7 +5,9 @@ side ``y`` is the joint effort of ``joint_states`` (a joint without actuator and
 0, its zero-force equation) plus the measured tendon tensions through the tendon Jacobian,
 ``y = effort - ten_J^T T`` (a tension pulls its tendon shorter). The model side starts with
 MuJoCo's inverse dynamics of the given model at the conditioned ``q, qd, qdd``
-(:data:`cablelab.model.KNOWN_OUTPUT`); effects add their columns (:mod:`.effects`).
+(:data:`cablelab.model.KNOWN_OUTPUT`); effects add their columns (:mod:`.effects`). When the
+bag carries the measured tendons' lengths (``cable_tensions`` position), one length channel per
+tendon follows the joint channels (:mod:`.tendon`).
 """
 from __future__ import annotations
 
@@ -23,13 +25,15 @@ from .topics import JOINT_STATE, topic
 
 
 def dataset_from_arrays(t, q, effort, description, options: DatasetOptions | None = None, *, qd=None,
-                        tension=None, driven=None, source: str = "data") -> Dataset:
+                        tension=None, lengths=None, driven=None, source: str = "data") -> Dataset:
     """Dataset from raw arrays in the model's dof order.
 
     Args:
         t: (N,) s; q: (N, nv) joint positions; effort: (N, nv) measured generalised forces
             (0 for a joint without actuator); qd: optional measured velocities (N, nv).
         tension: (N, n_tendons) measured tensions of the section's ``tendons`` (N), or None.
+        lengths: ``{tendon: (N,) m}`` the lengths the winch encoders read of some of those
+            tendons, or None: a length channel each (:func:`.tendon.with_length_channels`).
         driven: (nv,) bool, the joints whose effort is measured (default: every joint).
         description: a :class:`~cablelab.description.Description` with an ``mjcf`` section.
     """
@@ -39,12 +43,16 @@ def dataset_from_arrays(t, q, effort, description, options: DatasetOptions | Non
     opts = options.conditioning if options is not None else Conditioning()
     jtype = [model.jnt_type[names(model, "joint").index(j)] for j in joints]
     revolute = np.array([jt == HINGE for jt in jtype])
+    with_tendons = bool(sec.tendons)
+    lengths = dict(lengths or {}) if with_tendons else {}
+    measured = np.asarray(effort, float).reshape(len(t), -1)
+    if lengths:  # a length reading is a measured output too: conditioned like the efforts
+        measured = np.column_stack([measured] + [np.asarray(v, float) for v in lengths.values()])
     c = condition_motion(np.asarray(t, float), np.asarray(q, float).reshape(len(t), -1),
-                         np.asarray(effort, float).reshape(len(t), -1), opts, revolute=revolute,
+                         measured, opts, revolute=revolute,
                          qd=None if qd is None else np.asarray(qd, float), source=source)
     q_c, qd_c, qdd_c = c["q"], c["qd"], c["qdd"]
-    y = c["effort"].copy()
-    with_tendons = bool(sec.tendons)
+    y = c["effort"][:, :len(joints)].copy()
     rec = inverse_record(model, q_c, qd_c, qdd_c, tendons=with_tendons,
                          kinematics=bool(sec.payload_body))
     tau, ten_j = rec.tau, rec.ten_j
@@ -72,6 +80,11 @@ def dataset_from_arrays(t, q, effort, description, options: DatasetOptions | Non
         actuators=tuple(joints), act_vel=qd_c, act_units=act_units,
         inputs={f"{j} velocity": c["qd_smooth"][:, k] for k, j in enumerate(joints)},
         description=description, source=source)
+    if lengths:
+        from .tendon import with_length_channels
+
+        rigid = rec.ten_length[:, [names(model, "tendon").index(x) for x in lengths]]
+        ds = with_length_channels(ds, tuple(lengths), c["effort"][:, len(joints):], rigid)
     if c["parallel_hz"]:
         from ...parallel_filter import edge_mask
 
@@ -138,5 +151,14 @@ def dataset(bag, description, options: DatasetOptions | None = None) -> Dataset:
                                 f"{', '.join(ts.names) or 'none'})")
         tension = np.column_stack([np.interp(js.t, ts.t, ts.effort[:, ts.names.index(x)])
                                    for x in sec.tendons])
+        lengths = {x: _on_grid(js.t, ts.t, ts.position[:, ts.names.index(x)])
+                   for x in sec.tendons if np.isfinite(ts.position[:, ts.names.index(x)]).any()}
     return dataset_from_arrays(js.t, q, eff, description, options, qd=qd, tension=tension,
-                               driven=has_effort, source=str(bag.path))
+                               lengths=lengths if sec.tendons else None, driven=has_effort,
+                               source=str(bag.path))
+
+
+def _on_grid(t, t_src, x):
+    """``x`` sampled at ``t_src`` interpolated at ``t`` over its finite samples."""
+    ok = np.isfinite(x)
+    return np.interp(t, t_src[ok], x[ok])

@@ -1,7 +1,9 @@
 """Effects of the ``mjcf`` plant (CONTRACT section 4). Their columns come from the MuJoCo model
 through the dataset (:mod:`.dataset`, :mod:`.inverse`), none is an equation written for one
 machine. The generic joint friction, sensor offset and time delay apply through the
-``joint_actuators`` capability (one actuator per joint of the model).
+``joint_actuators`` capability (one actuator per joint of the model). ``tendon_elasticity`` acts on
+the cable-length channels and lives with them in :mod:`.tendon`; the rigid-body columns here are
+zero on those channels (:func:`.tendon.on_joint_channels`).
 """
 from __future__ import annotations
 
@@ -13,13 +15,15 @@ from ...errors import CablelabError
 from ...dataset import Dataset
 from ...effects.base import Effect, Param
 from ...model import KNOWN_OUTPUT
+from . import tendon  # noqa: F401  (registers tendon_elasticity)
+from .tendon import joint_part, on_joint_channels
 
 
 def _payload(ds: Dataset) -> np.ndarray:
     cols = ds.signals.get("payload_columns")
     if cols is None:
         raise CablelabError("effect payload_mass: the description names no mjcf.payload_body")
-    return cols
+    return on_joint_channels(ds, cols)
 
 
 def _payload_physical(ds: Dataset):
@@ -101,8 +105,9 @@ JOINT_SPRING = register(Effect(
 def _gain(ds: Dataset) -> np.ndarray:
     """The nominal force on each joint whose effort is measured (a joint without an effort
     sensor has no torque constant: its column is zero, the gain is not excited)."""
-    driven = np.asarray(ds.signals.get("driven", np.ones(ds.n_channels, bool)), bool)
-    return ds.actuator_block(ds.require_signal(KNOWN_OUTPUT) * driven[None, :])
+    nominal = joint_part(ds, ds.require_signal(KNOWN_OUTPUT))
+    driven = np.asarray(ds.signals.get("driven", np.ones(nominal.shape[1], bool)), bool)
+    return ds.actuator_block(nominal * driven[None, :])
 
 
 def _gain_physical(ds: Dataset):
@@ -150,7 +155,7 @@ def _link_columns(ds: Dataset) -> np.ndarray:
         rec = inverse_record(model, q, qd, qdd)
         ds.signals[LINK_COLUMNS] = np.concatenate(
             [body_columns(model, rec, b) for b in _moving_bodies(model)], axis=2)
-    return ds.signals[LINK_COLUMNS]
+    return on_joint_channels(ds, ds.signals[LINK_COLUMNS])
 
 
 def _link_names(ds: Dataset) -> list[str]:

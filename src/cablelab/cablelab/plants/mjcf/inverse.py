@@ -30,7 +30,8 @@ class InverseRecord:
     """MuJoCo's inverse dynamics of a record and the kinematics its columns are built from.
 
     Attributes:
-        tau: (N, nv) ``qfrc_inverse``; ten_j: (N, ntendon, nv) tendon Jacobians or None.
+        tau: (N, nv) ``qfrc_inverse``; ten_j: (N, ntendon, nv) tendon Jacobians or None;
+        ten_length: (N, ntendon) the tendons' lengths at q (rigid cables), or None.
         xpos (N, nbody, 3), xmat (N, nbody, 3, 3): body frames; subtree_com (N, nbody, 3);
         cdof (N, nv, 6), cvel and cacc (N, nbody, 6): com-based (rotation : translation),
         or None when only ``tau`` was asked for.
@@ -38,6 +39,7 @@ class InverseRecord:
 
     tau: np.ndarray
     ten_j: np.ndarray | None = None
+    ten_length: np.ndarray | None = None
     xpos: np.ndarray | None = None
     xmat: np.ndarray | None = None
     subtree_com: np.ndarray | None = None
@@ -51,7 +53,7 @@ def inverse_record(model, q, qd, qdd, *, tendons=False, kinematics=True) -> Inve
 
     Args:
         model: :class:`mujoco.MjModel`; q, qd, qdd: (N, nv) in dof order.
-        tendons: also keep the tendon Jacobians ``ten_J``.
+        tendons: also keep the tendon Jacobians ``ten_J`` and lengths ``ten_length``.
         kinematics: also run ``mj_rnePostConstraint`` and keep what :func:`body_columns` needs.
     """
     import mujoco
@@ -62,11 +64,13 @@ def inverse_record(model, q, qd, qdd, *, tendons=False, kinematics=True) -> Inve
     data = mujoco.MjData(model)
     tau = np.empty((n, nv))
     tj = np.empty((n, model.ntendon, nv)) if tendons else None
+    tl = np.empty((n, model.ntendon)) if tendons else None
     kin = {k: np.empty((n,) + shape) for k, shape in
            (("xpos", (nb, 3)), ("xmat", (nb, 9)), ("subtree_com", (nb, 3)), ("cdof", (nv, 6)),
             ("cvel", (nb, 6)), ("cacc", (nb, 6)))} if kinematics else {}
     inv, post = mujoco.mj_inverse, mujoco.mj_rnePostConstraint
     qpos, qvel, qacc, res, ten_j = data.qpos, data.qvel, data.qacc, data.qfrc_inverse, data.ten_J
+    ten_len = data.ten_length
     fields = [(kin[k], getattr(data, k)) for k in kin]
     for i in range(n):
         qpos[:] = q[i]
@@ -76,13 +80,14 @@ def inverse_record(model, q, qd, qdd, *, tendons=False, kinematics=True) -> Inve
         tau[i] = res
         if tendons:
             tj[i] = ten_j.reshape(model.ntendon, nv)
+            tl[i] = ten_len
         if kinematics:
             post(model, data)
             for dst, src in fields:
                 dst[i] = src
     if kinematics:
         kin["xmat"] = kin["xmat"].reshape(n, nb, 3, 3)
-    return InverseRecord(tau=tau, ten_j=tj, **kin)
+    return InverseRecord(tau=tau, ten_j=tj, ten_length=tl, **kin)
 
 
 def inverse_dynamics(model, q, qd, qdd, *, tendons=False):

@@ -19,7 +19,8 @@ def baseline(description) -> tuple[str, ...]:
 
 def candidates(description) -> tuple[str, ...]:
     """Effects a diagnosis tries: the mjcf effects (``payload_mass`` when the description names
-    a ``payload_body``) and the generic joint ones. ``link_inertia`` is not among them: it holds
+    a ``payload_body``, ``tendon_elasticity`` when it names measured ``tendons``: it needs their
+    lengths in the bag, and says so when they are absent) and the generic joint ones. ``link_inertia`` is not among them: it holds
     every rigid-body change (a payload is a change of its body's inertia) and would tie with the
     more specific effects; fit it with ``identify --effects link_inertia``."""
     sec = getattr(description, "mjcf", None) if description is not None else None
@@ -27,6 +28,8 @@ def candidates(description) -> tuple[str, ...]:
              "actuator_gain", "torque_sensor_offset", "time_delay")
     if sec is not None and sec.payload_body:
         cands = ("payload_mass",) + cands
+    if sec is not None and sec.tendons:
+        cands = cands + ("tendon_elasticity",)
     return cands
 
 

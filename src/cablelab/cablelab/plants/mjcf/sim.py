@@ -29,6 +29,10 @@ class Hidden:
         gain: per joint: the effort sensor reads gain x the applied force.
         stiffness: per joint ``(k, q0)``: a spring pulling the joint towards q0.
         link_mass: per body: mass added at its centre of mass (kg; its inertia unchanged).
+        tendon_stiffness: per tendon: the cable stretches with stiffness k (N/m): its winch
+            encoder reads the rest length paid out, MuJoCo's tendon length minus the stretch
+            T / k under MuJoCo's own tension T (recorded lengths only, :func:`record_all`).
+        length_offset: per tendon: the zero of its length encoder (m).
     """
 
     payload: tuple | None = None
@@ -38,6 +42,8 @@ class Hidden:
     gain: dict = field(default_factory=dict)
     stiffness: dict = field(default_factory=dict)
     link_mass: dict = field(default_factory=dict)
+    tendon_stiffness: dict = field(default_factory=dict)
+    length_offset: dict = field(default_factory=dict)
 
 
 def _set(joint, attr: str, value: float) -> None:
@@ -111,7 +117,7 @@ def actuator_moments(model, data) -> np.ndarray:
 
 
 def simulate(model, duration: float = 12.0, seed: int = 0, kp: float = 400.0, kd: float = 40.0,
-             amplitude: float = 0.8, pretension: float = 30.0):
+             amplitude: float = 0.8, pretension: float = 30.0, lengths: bool = False):
     """Run the truth model under PD + bias feedback tracking a multisine (one sample per step).
 
     The wanted generalised force is spread over the actuators by least squares around a
@@ -121,7 +127,7 @@ def simulate(model, duration: float = 12.0, seed: int = 0, kp: float = 400.0, kd
     Returns:
         ``t (T,), q (T, nv), qd (T, nv), effort (T, nv), act (T, nu)``: the state each step
         starts from, the generalised actuator force applied during it (``qfrc_actuator``) and
-        the actuator forces.
+        the actuator forces; with ``lengths``, also the tendon lengths (T, ntendon) m.
     """
     import mujoco
 
@@ -133,6 +139,7 @@ def simulate(model, duration: float = 12.0, seed: int = 0, kp: float = 400.0, kd
     qd = np.empty((T, model.nv))
     eff = np.empty((T, model.nv))
     act = np.empty((T, model.nu))
+    ten_len = np.empty((T, model.ntendon))
     mujoco.mj_forward(model, d)
     mass = np.maximum(np.array(model.dof_M0), 0.05)
     kp_v, kd_v = kp * mass, kd * mass
@@ -144,10 +151,11 @@ def simulate(model, duration: float = 12.0, seed: int = 0, kp: float = 400.0, kd
         A = actuator_moments(model, d).T                     # (nv, nu)
         d.ctrl[:] = c0 + np.linalg.lstsq(A, tau - A @ c0, rcond=None)[0]
         q[k], qd[k] = d.qpos[: model.nv], d.qvel
+        ten_len[k] = d.ten_length
         mujoco.mj_step2(model, d)
         eff[k] = d.qfrc_actuator
         act[k] = d.actuator_force
-    return t, q, qd, eff, act
+    return (t, q, qd, eff, act, ten_len) if lengths else (t, q, qd, eff, act)
 
 
 def record(model, hidden: Hidden = Hidden(), *, duration: float = 12.0, seed: int = 0,
@@ -162,10 +170,13 @@ def record(model, hidden: Hidden = Hidden(), *, duration: float = 12.0, seed: in
 
 def record_all(model, hidden: Hidden = Hidden(), *, duration: float = 12.0, seed: int = 0,
                encoder_bits: int = 18, effort_noise: float = 0.02, effort_quantum: float = 1e-3,
-               tension_noise: float = 0.2) -> dict:
+               tension_noise: float = 0.2, length_quantum: float = 1e-5) -> dict:
     """:func:`record` plus ``tension`` (T, n_tendons): per tendon the pull of the actuators on
-    it (N) with white noise ``tension_noise``, and ``tendons`` their names."""
-    t, q, qd, eff, act = simulate(model, duration, seed)
+    it (N) with white noise ``tension_noise``, ``length`` (T, n_tendons): the length its winch
+    encoder reads (m, quantised to ``length_quantum``: MuJoCo's tendon length, less the stretch
+    of a ``hidden.tendon_stiffness`` cable under its true tension, plus the encoder's zero), and
+    ``tendons`` their names."""
+    t, q, qd, eff, act, ten_len = simulate(model, duration, seed, lengths=True)
     rng = np.random.default_rng(seed + 1)
     quantum = 2 * np.pi / 2**encoder_bits
     q_meas = np.round(q / quantum) * quantum
@@ -180,9 +191,14 @@ def record_all(model, hidden: Hidden = Hidden(), *, duration: float = 12.0, seed
     tension = np.zeros((len(t), model.ntendon))
     for a in np.flatnonzero(model.actuator_trntype == 3):                 # mjTRN_TENDON
         tension[:, model.actuator_trnid[a, 0]] -= act[:, a] * model.actuator_gear[a, 0]
+    tn = names(model, "tendon")
+    k = np.array([hidden.tendon_stiffness.get(x, np.inf) for x in tn])
+    zero = np.array([hidden.length_offset.get(x, 0.0) for x in tn])
+    length = ten_len - tension / k + zero           # tension before the sensor noise: the truth
+    length = np.round(length / length_quantum) * length_quantum
     tension += rng.normal(0.0, tension_noise, tension.shape)
     return {"t": t, "q": q_meas, "effort": e, "joints": joints, "tension": tension,
-            "tendons": names(model, "tendon")}
+            "length": length, "tendons": tn}
 
 
 def description_yaml(xml: str, **section) -> str:
@@ -197,10 +213,11 @@ def description_yaml(xml: str, **section) -> str:
 
 
 def write_bag(path, xml: str, hidden: Hidden = Hidden(), *, duration: float = 12.0, seed: int = 0,
-              overwrite: bool = True, **section) -> str:
+              overwrite: bool = True, cable_lengths: bool = False, **section) -> str:
     """Simulate the truth (``xml`` + ``hidden``) and write a contract bag of it: the description
     (the user's model, without the hidden effect), ``/mjcf/joint_states`` and, for the section's
-    ``tendons``, ``/mjcf/cable_tensions``."""
+    ``tendons``, ``/mjcf/cable_tensions`` (with the winch encoders' lengths as ``position`` when
+    ``cable_lengths``)."""
     from ...bags import BagWriter
 
     model = truth_model(xml, hidden)
@@ -215,6 +232,7 @@ def write_bag(path, xml: str, hidden: Hidden = Hidden(), *, duration: float = 12
         if measured:
             idx = [r["tendons"].index(x) for x in measured]
             w.write_joint_states("/mjcf/cable_tensions", t0 + r["t"], measured,
+                                 position=r["length"][:, idx] if cable_lengths else None,
                                  effort=r["tension"][:, idx])
     return str(path)
 

@@ -133,14 +133,7 @@ def record_case(name: str, case: Case, work: Path) -> Path:
                                                       "wait_for_subscribers": 3 if estimator else 2,
                                                       **case.sim})
         with SimProgress(launch.probe(), case.duration, name) as bar:
-            last, t_last = 0.0, time.monotonic()
-            while bar.sim_time < case.duration:
-                bar.poll(0.5)
-                launch.check_alive()
-                if bar.sim_time > last:
-                    last, t_last = bar.sim_time, time.monotonic()
-                elif time.monotonic() - t_last > 120:
-                    raise RuntimeError(f"{name}: no simulated time for 120 s; logs in {work}")
+            bar.wait_for(launch, case.duration, name, work)
         time.sleep(0.5)
         codes = launch.stop_all()
     if any(codes.values()):
