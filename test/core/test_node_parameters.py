@@ -321,3 +321,16 @@ def test_simulator_refuses_a_pulley_radius_the_geometry_cannot_hold(ros_with, tm
     with pytest.raises(CablelabError) as exc:
         _make("cdpr", "sim").destroy_node()
     assert "description cdpr.pulley_radius: 100 m is larger than the geometry allows" in str(exc.value)
+
+
+def test_pick_takes_over_another_nodes_specs_unchanged():
+    """A node sharing another node's parameters (the CDPR control loop) declares the very same
+    specs (name, default, description, range), in the order asked; an unknown name is an error."""
+    from cablelab.ros.params import Param, pick
+
+    specs = (Param("a", 1.0, "first", ge=0.0), Param("b", "x", "second", choices=("x", "y")),
+             Param("c", [1.0], "third"))
+    got = pick(specs, "c", "a")
+    assert [s.name for s in got] == ["c", "a"] and got[0] is specs[2] and got[1] is specs[0]
+    with pytest.raises(KeyError):
+        pick(specs, "d")

@@ -55,6 +55,29 @@ def test_a_bag_plays_its_samples_from_the_first_state_on(tmp_path):
     np.testing.assert_allclose(got[0], q[-1], atol=1e-12)
 
 
+def test_a_platform_pose_bag_is_played_and_published_as_a_pose_reference(tmp_path):
+    """The CDPR's designed reference: a MultiDOFJointTrajectory bag played from the first state
+    on, each sample published as the platform's pose reference (orientation identity)."""
+    from cablelab.bags import BagWriter
+
+    t = 10.0 + 0.01 * np.arange(101)
+    q, qd, qdd = sine(t - t[0], np.array([0.0, 0.0, 1.0]))
+    level = np.tile([0.0, 0.0, 0.0, 1.0], (len(t), 1))
+    with BagWriter(tmp_path / "ref") as w:
+        w.write_multidof_trajectory("/cdpr/reference", t, q, level, qd, None, qdd)
+    node = FakeNode()
+    p = ReferencePlayer.from_bag(node, str(tmp_path / "ref"), "/cdpr/reference", ("x", "y", "z"), platform=True)
+    p(3.0, ())
+    got = p(3.25, ())                                 # 0.25 s in: the bag's sample 25
+    np.testing.assert_allclose(np.stack(got), np.stack([q[25], qd[25], qdd[25]]), atol=1e-9)
+    r = convert.multidof_arrays(node.sent[-1])
+    assert r["t"] == pytest.approx(3.25) and node.topic == "/cdpr/reference"
+    np.testing.assert_allclose(r["position"], q[25], atol=1e-9)
+    np.testing.assert_allclose(r["linear_velocity"], qd[25], atol=1e-9)
+    np.testing.assert_allclose(r["linear_acceleration"], qdd[25], atol=1e-9)
+    np.testing.assert_allclose(r["quaternion"], [0.0, 0.0, 0.0, 1.0])
+
+
 def test_reference_point_and_named_positions():
     msg = convert.joint_trajectory_msg(1.0, JOINTS, [1.0, 2.0, 3.0], [0.1, 0.2], None)
     q, qd, qdd = convert.reference_point(msg, JOINTS)

@@ -51,6 +51,24 @@ def test_estimates_meet_the_pose_of_their_stamp_and_say_why_not(desc):
     assert s.poll() is None
 
 
+def test_estimate_report_says_the_worst_problem_then_recent_skips(desc):
+    """/diagnostics of the estimator: ERROR while no description configured it, a WARN naming
+    the reason of recently skipped samples, the counts and the options."""
+    s = EstimateStream(EstimatorConfig())
+    s.describe(None, 9.81)
+    level, msg, values = s.report(0, "ok", {})
+    assert level == 2 and "no cdpr section" in msg
+    s.describe(desc.cdpr, desc.gravity)
+    s.sample(0.0, np.full(8, 3000.0))
+    level, msg, values = s.report(0, "ok", {})
+    assert (level, msg) == (1, "skipped samples (no desired pose yet)")
+    assert values == {"skipped": "1", "last problem": "no desired pose yet", "model": "II",
+                      "tensions": "dynamometer", "pose": "desired"}
+    assert s.report(1, "stale tensions", {})[:2] == (1, "stale tensions")   # an input problem first
+    s.skips.last_skip = -1e9                                               # not recent any more
+    assert s.report(0, "ok", {})[:2] == (0, "ok")
+
+
 def test_commands_wait_for_the_reference_of_their_stamp(desc):
     cfg = controller_config(PARAMS, desc.cdpr.platform_mass)
     assert cfg.nominal_mass == desc.cdpr.platform_mass and cfg.gains.kp == 1.0
@@ -83,6 +101,15 @@ def test_commands_wait_for_the_reference_of_their_stamp(desc):
     s.prepare_next(tt[1])
     s.estimate(tt[2], 600.0, np.array([0.01, 0.0, np.nan]))
     assert s.estimates_rejected == 1 and s.prepared is None and s.controller.mass == 600.0
+    # /diagnostics: the counts and the live feedforward mass; ERROR before a description
+    level, msg, values = s.report(0, "ok", {}, "PDFF", 7)
+    assert values == {"mode": "PDFF", "commands": "7", "skipped": "0", "estimates rejected": "1",
+                      "commands prepared ahead": "1", "feedforward mass kg": "600.0"}
+    s.skips.skip("bad motor state (NaN, empty or wrong length)")
+    assert s.report(level, msg, {}, "PDFF", 7)[1].endswith("bad motor state (NaN, empty or wrong length)")
+    fresh = CommandStream(False, sync_wait=0.005, estimate_wait=0.0)
+    level, msg, values = fresh.report(0, "ok", {}, "PD", 0)
+    assert (level, msg) == (2, "waiting for /plant_description") and values["feedforward mass kg"] == "-"
 
 
 def test_an_awaited_estimate_holds_the_state_until_it_comes_or_times_out(desc):

@@ -3,7 +3,7 @@ import numpy as np
 
 import mujoco
 
-from cablelab.plants.crane.control import Gains, control_law, hold_command
+from cablelab.plants.crane.control import LIVE_GAINS, Gains, control_law, hold_command, joint_command, sim_drive
 from cablelab.plants.crane.model import CraneParams
 from cablelab.plants.crane.mjcf import build_mjcf
 from cablelab.plants.crane.sim import CraneTruth, contract_to_qpos, simulate
@@ -41,6 +41,52 @@ def test_hold_command_holds_the_crane_still():
     data.ctrl[:] = u[0]
     mujoco.mj_forward(model, data)
     assert np.abs(data.qacc).max() < 1e-9
+
+
+def test_sim_drive_applies_answers_and_fresh_commands_else_holds_against_mujoco_gravity():
+    """The simulator's drive choice: an answer (lock-step) or a fresh command in real time is
+    applied as given; missing, stale, or unanswered in lock-step, the drives hold: at rest that
+    is MuJoCo's gravity load on the actuated joints (mj_inverse with zero acceleration, swing
+    hanging), with damping opposing the joint rates."""
+    model = build_mjcf(CraneTruth(params=P))
+    data = mujoco.MjData(model)
+    q = np.array([0.4, 0.6, 0.9, 0.0, 0.0])
+    u = np.array([1.0, -2.0, 3.0])
+    for answered, fresh, lockstep in [(True, False, True), (False, True, False)]:
+        got, held = sim_drive(u, q, np.zeros(5), P, answered=answered, fresh=fresh, lockstep=lockstep)
+        assert got is u and not held
+    data.qpos[:] = contract_to_qpos(q)[0]
+    data.qvel[:] = 0.0
+    data.qacc[:] = 0.0
+    mujoco.mj_inverse(model, data)
+    f = data.qfrc_inverse
+    gravity = np.array([f[0], f[1] - f[2], f[4]])     # contract luff = f_beta - f_psi (swing held)
+    for args in [(None, True, False), (u, False, False), (u, True, True)]:
+        got, held = sim_drive(args[0], q, np.zeros(5), P, answered=False, fresh=args[1], lockstep=args[2])
+        assert held
+        np.testing.assert_allclose(got, gravity, rtol=1e-6, atol=1e-6)
+    qd = np.array([0.5, -0.3, 0.2, 0.0, 0.0])
+    got, held = sim_drive(None, q, qd, P, answered=False, fresh=False, lockstep=False)
+    np.testing.assert_allclose(got - gravity, -np.asarray(LIVE_GAINS.kd) * qd[:3], rtol=1e-6, atol=1e-6)
+
+
+def test_joint_command_at_its_reference_or_stale_is_mujocos_gravity_load():
+    """The controller node's command for one state: at rest on its reference (no acceleration)
+    and with a stale reference (hold) alike it is MuJoCo's gravity load on the actuated joints;
+    a NaN or missing rate counts as zero; a position error pushes toward the reference."""
+    model = build_mjcf(CraneTruth(params=P))
+    data = mujoco.MjData(model)
+    q5 = np.array([-0.7, 0.4, 1.1, 0.0, 0.0])
+    data.qpos[:] = contract_to_qpos(q5)[0]
+    data.qvel[:] = data.qacc[:] = 0.0
+    mujoco.mj_inverse(model, data)
+    f = data.qfrc_inverse
+    gravity = np.array([f[0], f[1] - f[2], f[4]])
+    q, z = q5[:3], np.zeros(3)
+    for qd, ref in [(z, (q, z, z)), (np.full(3, np.nan), None), (None, (q, z, z))]:
+        np.testing.assert_allclose(joint_command(q, qd, ref, P), gravity, rtol=1e-6, atol=1e-6)
+    u = joint_command(q, z, (q + 0.1, z, z), P, Gains())
+    np.testing.assert_allclose(u - gravity, 0.1 * np.asarray(Gains().kp), rtol=1e-6)
 
 
 def test_feedforward_reduces_tracking_error():

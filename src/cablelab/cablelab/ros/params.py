@@ -241,6 +241,13 @@ def merge(*groups) -> tuple:
     return tuple(out.values())
 
 
+def pick(specs, *names) -> tuple:
+    """The specs of ``names`` from ``specs``, in that order (a node that takes over another
+    node's parameters); a name ``specs`` does not hold is a KeyError."""
+    by = {s.name: s for s in specs}
+    return tuple(by[n] for n in names)
+
+
 def help_text(specs, width: int = 100) -> str:
     """The parameters as the text block of a node's ``--help``."""
     import textwrap

@@ -14,7 +14,7 @@ from __future__ import annotations
 from typing import Callable, Sequence
 
 import numpy as np
-from trajectory_msgs.msg import JointTrajectory
+from trajectory_msgs.msg import JointTrajectory, MultiDOFJointTrajectory
 
 from . import convert
 from .params import Param
@@ -37,22 +37,26 @@ class ReferencePlayer:
         node: the controller node (creates the publisher).
         topic: the plant's reference topic.
         joints: the joint names of the published trajectory point.
+        platform: the reference is the platform's position x, y, z, published as a
+            ``MultiDOFJointTrajectory`` (orientation identity; the CDPR) instead.
     """
 
     def __init__(self, node, topic: str, joints: Sequence[str],
-                 trajectory: Callable[[np.ndarray, np.ndarray], tuple]):
-        self.joints, self.trajectory = list(joints), trajectory
-        self.pub = node.create_publisher(JointTrajectory, topic, publisher_qos())
+                 trajectory: Callable[[np.ndarray, np.ndarray], tuple], platform: bool = False):
+        self.joints, self.trajectory, self.platform = list(joints), trajectory, platform
+        self.pub = node.create_publisher(MultiDOFJointTrajectory if platform else JointTrajectory, topic,
+                                         publisher_qos())
         self.t0 = None
         self.q0 = None
 
     @classmethod
-    def from_bag(cls, node, path: str, topic: str, joints: Sequence[str]) -> "ReferencePlayer":
+    def from_bag(cls, node, path: str, topic: str, joints: Sequence[str],
+                 platform: bool = False) -> "ReferencePlayer":
         """The reference in the bag at ``path`` (:func:`cablelab.excite.read_reference`)."""
         from ..excite import read_reference
 
         play = read_reference(path, topic, joints)
-        return cls(node, topic, joints, lambda t, _q0: play(t))
+        return cls(node, topic, joints, lambda t, _q0: play(t), platform)
 
     def __call__(self, t: float, q) -> tuple:
         """The reference (q, qd, qdd) (n,) each at state stamp ``t`` (s) of a state at ``q``;
@@ -60,5 +64,9 @@ class ReferencePlayer:
         if self.t0 is None:
             self.t0, self.q0 = t, np.array(q, dtype=float)
         ref = tuple(x[0] for x in self.trajectory(np.array([t - self.t0]), self.q0))
-        self.pub.publish(convert.joint_trajectory_msg(t, self.joints, *ref))
+        if self.platform:
+            p, v, a = ref
+            self.pub.publish(convert.multidof_msg(t, p, [0.0, 0.0, 0.0, 1.0], v, None, a, None))
+        else:
+            self.pub.publish(convert.joint_trajectory_msg(t, self.joints, *ref))
         return ref

@@ -43,6 +43,13 @@ def cdpr_markers(desc, position, R, tensions=None) -> list[Marker]:
     return out
 
 
+def sim_markers(desc, sim) -> list[Marker]:
+    """The simulator's 3D view: the platform at the true pose of ``sim``
+    (:class:`~.sim.CdprSim`), the cables coloured by their true tension."""
+    p, q = sim.truth_pose()
+    return cdpr_markers(desc, p, quat_to_matrix(q), sim.truth_state()["tension"])
+
+
 def bag_markers(bag, desc):
     """``(t, frames)`` at about 30 Hz along a recording: the measured platform pose (else the
     ground truth, else the reference), the dynamometer tensions when recorded; None without a

@@ -11,7 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...ros.status import SkipLog
+from ...ros.inputs import ERROR, WARN
+from ...ros.status import SkipLog, add_problem
 from ...stamped import StampedBuffer
 from .control import PdffConfig
 from .live import ControllerConfig, EstimatorConfig, LiveController, LiveEstimator
@@ -96,6 +97,20 @@ class EstimateStream:
         if res is None:
             return self.skips.skip(self.estimator.status[-1][1])
         return (t, *res)
+
+    def report(self, level: int, msg: str, values: dict) -> tuple[int, str, dict]:
+        """The estimator's part of /diagnostics: ``(level, msg)`` raised to the worst problem of
+        the estimator (ERROR while no description configured it), else a WARN for recently
+        skipped samples when nothing else is wrong; ``values`` gains the counts and options."""
+        est_status = self.estimator.status if self.estimator is not None else [(ERROR, self.skips.last_problem)]
+        worst = max((s[0] for s in est_status), default=0)
+        if worst > 0:
+            level, msg = add_problem(level, msg, worst, est_status[-1][1])
+        elif self.skips.is_recent() and level == 0:
+            level, msg = WARN, f"skipped samples ({self.skips.last_problem})"
+        values.update({"skipped": str(self.skips.skipped), "last problem": self.skips.last_problem or "none",
+                       "model": self.config.model, "tensions": self.config.tensions, "pose": self.config.pose})
+        return level, msg, values
 
 
 class CommandStream:
@@ -188,6 +203,23 @@ class CommandStream:
             return
         stamp, (pos, quat, vel, acc) = nxt
         self.prepared = self.controller.prepare(stamp, pos, quat, vel, acc)
+
+    def report(self, level: int, msg: str, values: dict, mode: str, commands: int) -> tuple[int, str, dict]:
+        """The controller's part of /diagnostics: ERROR while no description configured the law,
+        else ``(level, msg)`` raised to the law's last problem; a WARN for recently skipped
+        states; ``values`` gains ``mode`` (PDFF or PD), the counts (``commands`` published) and
+        the feedforward mass."""
+        ctl = self.controller
+        if ctl is None:
+            level, msg = ERROR, self.skips.last_problem or "waiting for /plant_description"
+        elif ctl.status and ctl.status[-1][0] > 0:
+            level, msg = add_problem(level, msg, ctl.status[-1][0], ctl.status[-1][1])
+        level, msg = self.skips.warn(level, msg)
+        values.update({"mode": mode, "commands": str(commands), "skipped": str(self.skips.skipped),
+                       "estimates rejected": str(self.estimates_rejected),
+                       "commands prepared ahead": str(self.prepared_used),
+                       "feedforward mass kg": "-" if ctl is None or ctl.mass is None else f"{ctl.mass:.1f}"})
+        return level, msg, values
 
     def torques(self, t: float, q, qd):
         """Torques for the motor state of stamp ``t`` at the reference of that stamp (prepared

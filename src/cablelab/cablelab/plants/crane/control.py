@@ -16,7 +16,7 @@ import numpy as np
 
 from .model import CraneParams, gravity_vector, mass_matrix
 
-__all__ = ["Gains", "LIVE_GAINS", "control_law", "hold_command"]
+__all__ = ["Gains", "LIVE_GAINS", "control_law", "hold_command", "joint_command", "sim_drive"]
 
 
 @dataclass(frozen=True)
@@ -65,3 +65,38 @@ def hold_command(q, qd, params: CraneParams, gains: Gains = Gains(), swing=None)
     """(N, 3) fallback when the reference or the state is stale: G_a(q) - Kd qd."""
     q5 = _q5(q, swing)
     return gravity_vector(q5, params)[:, :3] - np.asarray(gains.kd) * np.atleast_2d(qd)
+
+
+def joint_command(q, qd, ref, params: CraneParams, gains: Gains = Gains(), swing=None,
+                  feedforward: bool = True) -> np.ndarray:
+    """(3,) efforts for one joint state ``q`` (3,), ``qd`` (3,; missing or not finite: zero):
+    :func:`control_law` toward ``ref`` = (q_ref, qd_ref, qdd_ref) (3,) each, or :func:`hold_command`
+    where the crane is when ``ref`` is None (stale); ``swing`` (1, 2) measured swing or None."""
+    q = np.asarray(q, float)
+    if qd is None or np.size(qd) != 3 or not np.isfinite(qd).all():
+        qd = np.zeros(3)
+    if ref is None:
+        return hold_command(q[None], np.asarray(qd, float)[None], params, gains, swing)[0]
+    return control_law(q[None], np.asarray(qd, float)[None], ref[0][None], ref[1][None], ref[2][None],
+                       params, gains, swing, feedforward)[0]
+
+
+def sim_drive(u, q, qd, params: CraneParams, *, answered: bool, fresh: bool, lockstep: bool):
+    """The effort the simulated drives apply over the next period, and whether it is the hold.
+
+    Args:
+        u: (3,) the last good command, or None before the first.
+        q, qd: (5,) contract state (slew, luff, hoist, theta1, theta2) and its rates.
+        answered: ``u`` answers the last published state (lock-step): applied however late.
+        fresh: ``u`` is younger than the command timeout.
+        lockstep: lock-step is on (an unanswered step then never reuses an old command).
+
+    Returns:
+        ``(effort (3,), held)``: ``u``, or the drives holding the crane (:func:`hold_command`
+        with :data:`LIVE_GAINS`, like a brake) when ``u`` is missing, stale or not an answer in
+        lock-step.
+    """
+    if answered or (u is not None and fresh and not lockstep):
+        return u, False
+    q, qd = np.asarray(q, float), np.asarray(qd, float)
+    return hold_command(q[None, :3], qd[None, :3], params, LIVE_GAINS, swing=q[None, 3:])[0], True

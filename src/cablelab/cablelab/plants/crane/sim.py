@@ -28,12 +28,13 @@ from .kinematics import gimbal_rates_to_swing, gimbal_to_swing, swing_to_gimbal
 from .mjcf import build_mjcf, gravity_in_base
 from .model import CraneParams, gravity_vector, mass_matrix
 from .reference import reference_trajectory
+from ...errors import CablelabError
 from ...rotations import wxyz_to_xyzw
 
 __all__ = ["CraneTruth", "set_state", "gravity_in_base", "simulate", "SimResult",
            "reference_trajectory", "QPOS", "contract_acceleration", "truth_accelerations",
            "contract_to_qpos", "qpos_to_contract", "DEFAULT_KP", "DEFAULT_KD", "CraneSim",
-           "write_bag"]
+           "write_bag", "truth_from_parameters"]
 
 QPOS = ("slew", "luff", "swing_y", "swing_x", "hoist")
 
@@ -288,6 +289,20 @@ class CraneSim:
         return {"joints": s[0:3].copy(), "joint_rates": s[3:6].copy(), "effort": eff,
                 "tip": tip, "tip_quat": wxyz_to_xyzw(s[16:20]), "payload": pay,
                 "payload_quat": wxyz_to_xyzw(s[23:27])}
+
+
+def truth_from_parameters(node: str, params: CraneParams, v) -> tuple[CraneTruth, tuple]:
+    """The simulated crane's truth and initial ``(slew, luff, rope length)`` from the validated
+    simulator node parameters ``v`` (:data:`cablelab.plants.crane.nodes.sim.PARAMETERS`); a
+    one-line error naming ``node`` for a rope length that is not positive."""
+    q0 = tuple(v.initial)
+    if q0[2] <= 0:
+        raise CablelabError(f"{node}: parameter initial:={list(q0)}: expected a rope "
+                            "length (third value) > 0 [m]")
+    return CraneTruth(params=params, base_tilt=tuple(v.base_tilt), viscous=tuple(v.viscous),
+                      coulomb=tuple(v.coulomb), torque_offset=tuple(v.offset),
+                      mocap_noise=v.mocap_noise, mocap_dropout=v.mocap_dropout,
+                      timestep=v.timestep), q0
 
 
 def write_bag(path, res: SimResult, description_yaml: str, *, overwrite: bool = False) -> None:

@@ -1,18 +1,14 @@
 """Axis PD + feedforward controller node.
 
 On every ``/axis/joint_states`` message (event-driven, in the measurement's own time base) it
-computes ``u = M_ff qdd_ref + Kp (q_ref - q) + Kd (qd_ref - qd)``
-(:func:`cablelab.plants.axis.control.pd_feedforward`) and publishes it on
-``/axis/effort_command``. The reference is the latest ``/axis/reference`` (``reference_source:
-topic``, default) or a built-in sine evaluated at the measurement stamp (``reference_source:
-sine``, also published on ``/axis/reference`` so recordings hold it), or a reference bag written by
-``cablelab excite`` (``reference_bag``, played from the first state on and published too).
-
-ROS parameters: :data:`PARAMETERS` (``pd_feedforward --plant axis --help``).
-
-Each command names the stamp of the state it answers (``layout.dim[0].label = 'joint stamp=<t>'``,
-:func:`cablelab.ros.convert.command_msg`): a lock-step simulator applies only the answer to its
-latest state.
+publishes ``u = M_ff qdd_ref + Kp (q_ref - q) + Kd (qd_ref - qd)``
+(:func:`cablelab.plants.axis.control.pd_feedforward`) on ``/axis/effort_command``, naming the
+stamp of the state it answers (:func:`cablelab.ros.convert.command_msg`: a lock-step simulator
+applies only the answer to its latest state). The reference is the latest ``/axis/reference``
+(``reference_source: topic``, default), a built-in sine evaluated at the measurement stamp
+(``reference_source: sine``) or a ``reference_bag`` written by ``cablelab excite`` (played from
+the first state on); the last two are published on ``/axis/reference`` so recordings hold them.
+Parameters: ``pd_feedforward --plant axis --help``.
 """
 from __future__ import annotations
 

@@ -1,20 +1,14 @@
-"""Axis simulator node: MuJoCo single axis driven by ``/axis/effort_command``.
+"""Axis simulator node: MuJoCo single axis (:mod:`cablelab.plants.axis.sim`) driven by
+``/axis/effort_command``.
 
 Publishes ``/axis/joint_states`` (name ``joint``: position, velocity, effort = applied command +
-sensor offset), ``/axis/ground_truth/joint_states`` (effort = true applied force), ``/clock``
-and ``/plant_description`` (transient-local). Physics: :mod:`cablelab.plants.axis.sim`.
-
-ROS parameters: :data:`PARAMETERS` (``cable_sim_node --plant axis --help``). ``lockstep``: the
-simulation advances one period only after the command answering the last published state
-arrived, so a loaded machine slows the run down instead of delaying the control loop.
-
-Lock-step matching (:class:`cablelab.ros.lockstep.LockStep`, ``wait_first``): a command that
-names the stamp of the state it answers is applied only if it answers the latest state; answers
-to earlier ones (e.g. to a state resent while waiting) are counted on /diagnostics and ignored,
-so resends can never add a control delay. A command that names no stamp answers whatever state
-was published last.
-
-The effort reported with a state is the command held over the period that ends at that state.
+sensor offset; the command held over the period that ends at that state),
+``/axis/ground_truth/joint_states`` (effort = true applied force), ``/clock`` and
+``/plant_description`` (transient-local). ``lockstep``: the simulation advances one period only
+after the command answering the last published state arrived, so a loaded machine slows the run
+down instead of delaying the control loop (:class:`cablelab.ros.lockstep.LockStep`, ``wait_first``:
+answers to earlier states are counted on /diagnostics and ignored).
+Parameters: ``cable_sim_node --plant axis --help``.
 """
 from __future__ import annotations
 

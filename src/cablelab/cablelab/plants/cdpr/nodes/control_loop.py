@@ -12,13 +12,11 @@ it publishes what the three-process loop has on its topics: ``/cdpr/joint_states
 ``/cdpr/payload_estimate`` of the separate ``payload_estimator`` without waiting; without a
 fresh one the feedforward uses the nominal mass and /diagnostics says so (WARN).
 
-ROS parameters: :data:`PARAMETERS` (``control_loop --plant cdpr --help``): the loop's
-(:data:`cablelab.ros.control_loop.LOOP_PARAMETERS`), ``hardware``, the controller's as
-``pd_feedforward --plant cdpr``, the reference's and the simulator's as ``cable_sim_node --plant
-cdpr``. ``hardware``: ``sim`` (the MuJoCo CAROCA, :class:`~cablelab.plants.cdpr.hardware.
-SimulatedCdpr`), ``stub`` (:class:`cablelab.hardware.DriverStub`, which stops with what a driver
-must implement) or ``package.module:Class`` (your driver, built as ``Class(joint_names,
-description)``).
+Parameters (``control_loop --plant cdpr --help``): the loop's, ``hardware``, and those of
+``pd_feedforward`` and ``cable_sim_node --plant cdpr`` it shares. ``hardware``: ``sim`` (the
+MuJoCo CAROCA, :class:`~cablelab.plants.cdpr.hardware.SimulatedCdpr`), ``stub``
+(:class:`cablelab.hardware.DriverStub`, which stops with what a driver must implement) or
+``package.module:Class`` (your driver, built as ``Class(joint_names, description)``).
 """
 from __future__ import annotations
 
@@ -30,7 +28,7 @@ from ....hardware import DriverStub, load_hardware_class
 from ....ros import convert
 from ....ros.control_loop import LOOP_PARAMETERS, ControlLoopNode
 from ....ros.fastspin import take_newest
-from ....ros.params import Param, executor_params, merge
+from ....ros.params import Param, executor_params, merge, pick
 from ....ros.qos import stream_qos
 from .. import topics
 from ..hardware import SimulatedCdpr
@@ -46,18 +44,13 @@ from .outputs import CdprOutputs
 __all__ = ["CdprControlLoop", "make_node", "PARAMETERS"]
 
 
-def _of(specs, *names):
-    by = {s.name: s for s in specs}
-    return tuple(by[n] for n in names)
-
-
 PARAMETERS = merge(
     LOOP_PARAMETERS,
     (Param("hardware", "sim", "the winches: sim (the MuJoCo CAROCA), stub (a driver stub that says "
            "what a driver must implement) or package.module:Class (your driver)"),),
-    _of(_controller.PARAMETERS, "feedforward", "nominal_mass", "kp", "kd", "coulomb", "viscous",
+    pick(_controller.PARAMETERS, "feedforward", "nominal_mass", "kp", "kd", "coulomb", "viscous",
         "min_tension", "preload", "max_torque", "model", "estimate_timeout"),
-    _of(_sim.PARAMETERS, "trajectory_speed", "settle", "description", "payload_mass", "payload_com",
+    pick(_sim.PARAMETERS, "trajectory_speed", "settle", "description", "payload_mass", "payload_com",
         "pulleys", "winch_coulomb", "winch_viscous", "motor_inertia", "tension_noise", "tension_bias",
         "torque_noise", "pose_noise", "timestep", "seed", "extras_every"),
     executor_params(True))

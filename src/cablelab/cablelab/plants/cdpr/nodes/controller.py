@@ -1,16 +1,15 @@
 """CDPR controller node: PD on motor angles + mass feedforward (PDFF, 001 Fig. 6, eq. 14-15).
 
 Each ``/cdpr/joint_states`` sample gives one ``/cdpr/effort_commands`` (motor torques, N m, order
-winch_1..n) from :class:`cablelab.plants.cdpr.live.LiveController`: motor-angle PD with the
-inverse geometric model of the reference ``/cdpr/reference``, feedforward of 001 eq. 14 with the
-live ``/cdpr/payload_estimate`` (``feedforward`` true, PDFF) or none (PD), friction compensation
-(eq. 15) and a minimum-tension floor. A stale or implausible estimate falls back to the nominal
-mass (WARN on /diagnostics). Each command carries the stamp of the state it answers in
-``layout.dim[0].label`` (``winch stamp=<s>``, optional; a lock-step simulator matches it). Without a reference (or with a bad motor state) nothing is
-published (the simulator's brakes hold) and /diagnostics says why.
-
-ROS parameters: :data:`PARAMETERS` (``pd_feedforward --plant cdpr --help``). Commands go out as pre-serialised messages
-(:class:`cablelab.ros.rawmsg.CommandTemplate`).
+winch_1..n; pre-serialised, naming the stamp of the state it answers for a lock-step simulator)
+from :class:`cablelab.plants.cdpr.live.LiveController`: motor-angle PD with the inverse geometric
+model of the reference ``/cdpr/reference`` (or a played ``reference_bag``, published there),
+feedforward of 001 eq. 14 with the live ``/cdpr/payload_estimate`` (``feedforward`` true, PDFF)
+or none (PD), friction compensation (eq. 15) and a minimum-tension floor. A stale or implausible
+estimate falls back to the nominal mass (WARN on /diagnostics). Without a reference (or with a
+bad motor state) nothing is published (the simulator's brakes hold) and /diagnostics says why.
+Matching samples by stamp: :class:`cablelab.plants.cdpr.streams.CommandStream`.
+Parameters: ``pd_feedforward --plant cdpr --help``.
 """
 from __future__ import annotations
 
@@ -28,12 +27,12 @@ from ..control import PdffConfig
 from ..streams import CommandStream, controller_config
 from ....ros import convert, rawmsg
 from ....ros.fastspin import drain, poll
-from ....ros.inputs import ERROR
 from ....ros.params import Param, executor_params, merge
 from ....ros.plant_node import PlantNode
 from ....ros.qos import publisher_qos, stream_qos
 from ....ros.rawmsg import CommandTemplate, RawReader
-from ....ros.status import Latency, add_problem
+from ....ros.reference import ReferencePlayer
+from ....ros.status import Latency
 from ....rotations import xyzw_to_wxyz
 
 
@@ -92,12 +91,8 @@ class CdprController(PlantNode):
         ref_sub = self.create_subscription(MultiDOFJointTrajectory, topics.REFERENCE, self.on_reference, q, raw=True)
         est_sub = self.create_subscription(InertiaStamped, topics.PAYLOAD_ESTIMATE, self.on_estimate, q)
         self.create_subscription(JointState, topics.JOINT_STATES, self.on_state, q, raw=True)
-        self.play, self.play_t0 = None, None
-        if v.reference_bag:     # the designed reference, published for each state's stamp
-            from ....excite import read_reference
-
-            self.play = read_reference(v.reference_bag, topics.REFERENCE, ("x", "y", "z"))
-            self.pub_ref = self.create_publisher(MultiDOFJointTrajectory, topics.REFERENCE, publisher_qos())
+        self.player = ReferencePlayer.from_bag(self, v.reference_bag, topics.REFERENCE, ("x", "y", "z"),
+                                               platform=True) if v.reference_bag else None
         # only a state wakes the node: the reference (published before the state of its stamp)
         # and the estimate wait queued until a state or the timer takes them (one wake-up per
         # cycle at 1 kHz instead of three); an awaited estimate (estimate_wait) still wakes it
@@ -147,10 +142,8 @@ class CdprController(PlantNode):
             state = rawmsg.joint_state_arrays(msg, self.readers["state"])
         except ValueError:
             state = (float("nan"), [], None, None, None)      # rejected by command()
-        if self.play is not None and math.isfinite(state[0]):
-            self.play_t0 = state[0] if self.play_t0 is None else self.play_t0
-            p, v, a = (x[0] for x in self.play(state[0] - self.play_t0))
-            self.pub_ref.publish(convert.multidof_msg(state[0], p, [0.0, 0.0, 0.0, 1.0], v, None, a, None))
+        if self.player is not None and math.isfinite(state[0]):
+            self.player(state[0], ())        # the designed reference of this stamp, published first
         if self.stream.needs_inputs_first(state[0]):
             drain(*self.polled)         # the reference and estimate that came before it
         self.stream.state(state, time.monotonic())
@@ -183,18 +176,9 @@ class CdprController(PlantNode):
             self.latency.since(t0)
 
     def extend_status(self, level, msg, values):
-        ctl, st = self.controller, self.stream
-        if ctl is None:
-            level, msg = ERROR, st.skips.last_problem or "waiting for /plant_description"
-        elif ctl.status and ctl.status[-1][0] > 0:
-            level, msg = add_problem(level, msg, ctl.status[-1][0], ctl.status[-1][1])
-        level, msg = st.skips.warn(level, msg)
-        values.update({"mode": "PDFF" if self.feedforward else "PD", "commands": str(self.sent),
-                       "skipped": str(st.skips.skipped), "estimates rejected": str(st.estimates_rejected),
-                       "commands prepared ahead": str(st.prepared_used),
-                       "feedforward mass kg": "-" if ctl is None or ctl.mass is None else f"{ctl.mass:.1f}"})
+        level, msg, values = self.stream.report(level, msg, values, "PDFF" if self.feedforward else "PD",
+                                                self.sent)
         return level, msg, self.latency.report(values)
-
 
 def make_node() -> PlantNode:
     return CdprController()

@@ -1,17 +1,14 @@
 """CDPR payload estimator node: mass and CoM (x_G, y_G) per sample (001 eq. 12-13), live.
 
 Inputs: ``/cdpr/cable_tensions`` (dynamometers) or ``/cdpr/joint_states`` (motor torques,
-friction compensated, 001 eq. 15), and the pose for the wrench matrix: ``/cdpr/reference``
-(desired, 001's real-time choice) or ``/cdpr/platform_pose`` (measured). The description comes
-from the ``description`` parameter or ``/plant_description``. Each tension sample gives one
-``/cdpr/payload_estimate`` (InertiaStamped, m = total moving mass, com = (x_G, y_G, NaN), frame
-``platform``) stamped like it, computed by :class:`cablelab.plants.cdpr.live.LiveEstimator`.
+friction compensated, 001 eq. 15), only the one the ``tensions`` source needs, and the pose of
+the wrench matrix: ``/cdpr/reference`` (desired, 001's real-time choice) or
+``/cdpr/platform_pose`` (measured); the description from ``description`` or ``/plant_description``.
+Each tension sample gives one ``/cdpr/payload_estimate`` (pre-serialised InertiaStamped, m = total
+moving mass, com = (x_G, y_G, NaN), frame ``platform``) stamped like it: matching and counting in
+:class:`cablelab.plants.cdpr.streams.EstimateStream`, the law :class:`cablelab.plants.cdpr.live.LiveEstimator`.
 Bad input (NaN, wrong length, negative tension, ill-conditioned W, stale pose) publishes nothing
-and is reported on /diagnostics; slack cables are reported as WARN.
-
-ROS parameters: :data:`PARAMETERS` (``payload_estimator --plant cdpr --help``). The estimate goes out as a pre-serialised message
-(:class:`cablelab.ros.rawmsg.RawTemplate`); only the topic the ``tensions`` source needs is
-subscribed (``/cdpr/cable_tensions`` or ``/cdpr/joint_states``).
+and is reported on /diagnostics; slack cables as WARN. Parameters: ``payload_estimator --plant cdpr --help``.
 """
 from __future__ import annotations
 
@@ -26,12 +23,11 @@ from .. import topics
 from ..streams import EstimateStream, estimator_config
 from ....ros import convert, rawmsg
 from ....ros.fastspin import drain, poll
-from ....ros.inputs import ERROR, WARN
 from ....ros.params import Param, executor_params, merge
 from ....ros.plant_node import PlantNode
 from ....ros.qos import publisher_qos, stream_qos
 from ....ros.rawmsg import RawReader, RawTemplate
-from ....ros.status import Latency, add_problem
+from ....ros.status import Latency
 from ....rotations import xyzw_to_wxyz
 
 
@@ -159,19 +155,9 @@ class CdprPayloadEstimator(PlantNode):
         self.latency.since(t0)
 
     def extend_status(self, level, msg, values):
-        skips, est = self.stream.skips, self.stream.estimator
-        est_status = est.status if est is not None else [(ERROR, skips.last_problem)]
-        worst = max((s[0] for s in est_status), default=0)
-        if worst > 0:
-            level, msg = add_problem(level, msg, worst, est_status[-1][1])
-        elif skips.is_recent() and level == 0:
-            level, msg = WARN, f"skipped samples ({skips.last_problem})"
-        values.update({"published": str(self.published), "skipped": str(skips.skipped),
-                       "last problem": skips.last_problem or "none",
-                       "model": self.config.model, "tensions": self.config.tensions,
-                       "pose": self.config.pose})
+        values["published"] = str(self.published)
+        level, msg, values = self.stream.report(level, msg, values)
         return level, msg, self.latency.report(values)
-
 
 def make_node() -> PlantNode:
     return CdprPayloadEstimator()

@@ -1,21 +1,16 @@
-"""CDPR simulator node: the MuJoCo CAROCA of 001 (real pulleys, friction winches) driven by
-``/cdpr/effort_commands``.
+"""CDPR simulator node: the MuJoCo CAROCA of 001 (real pulleys, friction winches;
+:class:`cablelab.plants.cdpr.sim.CdprSim`) driven by ``/cdpr/effort_commands``.
 
 Publishes (CONTRACT sec. 2) ``/cdpr/joint_states`` (winch_1..n: motor angle, rate, torque from
 current), ``/cdpr/cable_tensions`` (cable_1..n: paid-out length, dynamometer tension),
 ``/cdpr/platform_pose`` (optional), ``/cdpr/reference`` (the pick-and-place s-curve of 001 sec.
-II-C, unless ``publish_reference`` is false and another node publishes it), the ground truth
-``/cdpr/ground_truth/{pose,payload}``, ``/clock`` and ``/plant_description``. Physics:
-:class:`cablelab.plants.cdpr.sim.CdprSim`.
+II-C, unless ``publish_reference`` is false), the ground truth ``/cdpr/ground_truth/{pose,payload}``,
+``/clock`` and ``/plant_description``, from pre-serialised templates (:mod:`cablelab.ros.rawmsg`).
 
-Modes: ``real_time`` true steps at ``rate`` Hz of wall time; false runs as fast as possible in
-lock-step with the controller (a step as soon as the command answering the last published state
-arrived, or after ``lockstep_timeout`` s without one). Without a fresh command the winch brakes
-lock the motor angles (the last torque + a stiff PD about the locked angles), reported as WARN on
-/diagnostics; slack cables are reported too.
-
-ROS parameters: :data:`PARAMETERS` (``cable_sim_node --plant cdpr --help``). Outgoing messages are pre-serialised templates
-(:class:`cablelab.ros.rawmsg.RawTemplate`): each step only patches stamps and numbers.
+When it steps and with which torques is :class:`cablelab.plants.cdpr.stepping.SimStepper`: real
+time at ``rate`` Hz of wall time, or lock-step with the controller as fast as possible. Without a
+fresh command the winch brakes lock the motor angles, reported as WARN on /diagnostics, as are
+slack cables. Parameters: ``cable_sim_node --plant cdpr --help``.
 """
 from __future__ import annotations
 
@@ -37,6 +32,7 @@ from ....ros.status import Latency, add_problem
 from .. import topics
 from ..geometry import check_pulley_radius
 from ..hardware import SimulatedCdpr
+from ..markers import sim_markers
 from ..sim import default_description_path, truth_from_parameters
 from ..stepping import SimStepper
 from ..trajectory import ReferenceTable, pick_and_place
@@ -127,20 +123,13 @@ class CdprSimNode(PlantNode):
             poll(self, sub)
         self.start_diagnostics()
         self.timer = self.create_timer(1.0 / self.rate if self.real_time else 0.0002, self.tick)
-        start_markers(self, topics.MARKERS, self._marker_frame, lambda: self.sim.time, v.markers_rate)
+        start_markers(self, topics.MARKERS, lambda: sim_markers(self.description, self.sim),
+                      lambda: self.sim.time, v.markers_rate)
         self.publish_state()
 
     @property
     def done(self) -> bool:
         return self.stepper.done
-
-    def _marker_frame(self):
-        """The 3D view: the platform at its true pose, the cables coloured by their true tension."""
-        from ..markers import cdpr_markers
-        from ....rotations import quat_to_matrix
-
-        p, q = self.sim.truth_pose()
-        return cdpr_markers(self.description, p, quat_to_matrix(q), self.sim.truth_state()["tension"])
 
     def extend_status(self, level, msg, values):
         values.update(self.stepper.values())
@@ -151,14 +140,10 @@ class CdprSimNode(PlantNode):
         return level, msg, values
 
     def on_command(self, msg: Float64MultiArray) -> None:
-        """An effort command (Float64MultiArray or its serialised bytes: the subscription takes
-        bytes, decoded by :func:`~cablelab.ros.rawmsg.command_arrays`)."""
-        try:
-            values, stamp = rawmsg.command_arrays(msg)
-        except ValueError:
-            values, stamp = None, None          # not a command: rejected and counted below
-        if self.accept("effort_commands", values):
-            self.stepper.command(values, stamp)
+        """An effort command (serialised bytes, :func:`~cablelab.ros.rawmsg.command_arrays`)."""
+        cmd = self.decode("effort_commands", rawmsg.command_arrays, msg)
+        if cmd is not None and self.accept("effort_commands", cmd[0]):
+            self.stepper.command(*cmd)
 
     def mass_changed(self, kg: float) -> None:
         self.out.payload(self.sim.truth.total_mass, self.sim.truth.total_com)

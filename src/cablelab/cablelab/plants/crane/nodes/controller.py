@@ -1,32 +1,25 @@
 """Crane controller node: joint PD + gravity compensation + reference-acceleration feedforward
-(002 sec. 5.3.1, :func:`cablelab.plants.crane.control.control_law`).
+(002 sec. 5.3.1, :func:`cablelab.plants.crane.control.joint_command`).
 
-On every ``/crane/joint_states`` message it computes the efforts and publishes
-``/crane/effort_commands`` [slew N m, luff N m, hoist N]. Gravity and inertia come from the
-``/plant_description`` (``slew_inertia``, ``luff_inertia`` parameters for what it does not
-hold) and the latest ``/crane/swing_estimate`` (optional; a hanging payload without it). The
-reference is ``/crane/reference`` (``reference_source: topic``) or the built-in multi-sine
-excitation (``reference_source: excitation``, published on ``/crane/reference`` too).
-Fallback: with a stale reference the node holds the crane where it is (gravity compensation +
-damping, :func:`~cablelab.plants.crane.control.hold_command`) and reports WARN.
-
-ROS parameters: :data:`PARAMETERS` (``pd_feedforward --plant crane --help``).
-
-Each command names the stamp of the state it answers (``layout.dim[0].label = 'joints stamp=<t>'``,
-:func:`cablelab.ros.convert.command_msg`): a lock-step simulator applies only the answer to its
-latest state.
+On every ``/crane/joint_states`` message it publishes ``/crane/effort_commands`` [slew N m, luff
+N m, hoist N] naming the stamp of the state it answers (:func:`cablelab.ros.convert.command_msg`:
+a lock-step simulator applies only the answer to its latest state). Gravity and inertia come from
+``/plant_description`` and the latest ``/crane/swing_estimate`` (optional; a hanging payload
+without it). The reference is ``/crane/reference``, the built-in multi-sine excitation or a
+``reference_bag`` (both published on ``/crane/reference``). With a stale reference the node holds
+the crane where it is (gravity compensation + damping) and reports WARN.
+Parameters: ``pd_feedforward --plant crane --help``.
 """
 from __future__ import annotations
 
 import time
 
-import numpy as np
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 from trajectory_msgs.msg import JointTrajectory
 
 from .. import topics
-from ..control import LIVE_GAINS, Gains, control_law, hold_command
+from ..control import LIVE_GAINS, Gains, joint_command
 from ..model import JOINTS, CraneParams
 from ..reference import reference_trajectory
 from ....ros import convert
@@ -117,22 +110,14 @@ class CraneController(PlantNode):
             return
         if not self.inputs.accept("joint_states", q, now) or self.params is None:
             return
-        if qd is None or qd.size != 3 or not np.isfinite(qd).all():
-            qd = np.zeros(3)
         swing = self.swing[None] if self.swing is not None and self.inputs.fresh("swing_estimate", now) else None
         if self.source in ("excitation", "bag"):
             ref = self.player(t, q)
-        elif self.ref is not None and self.inputs.fresh("reference", now):
-            ref = self.ref
         else:
-            self.fallbacks += 1
-            u = hold_command(q[None], qd[None], self.params, self.gains, swing)[0]
-            self.pub_cmd.publish(convert.command_msg(u, stamp=t, label="joints"))
-            return
-        u = control_law(q[None], qd[None], ref[0][None], ref[1][None], ref[2][None], self.params,
-                        self.gains, swing, self.feedforward)[0]
+            ref = self.ref if self.ref is not None and self.inputs.fresh("reference", now) else None
+            self.fallbacks += ref is None
+        u = joint_command(q, qd, ref, self.params, self.gains, swing, self.feedforward)
         self.pub_cmd.publish(convert.command_msg(u, stamp=t, label="joints"))
-
 
 def make_node() -> PlantNode:
     return CraneController()

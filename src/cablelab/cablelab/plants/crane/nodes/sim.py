@@ -1,25 +1,18 @@
-"""Crane simulator node: the MuJoCo boom crane of 002 driven by ``/crane/effort_commands``.
+"""Crane simulator node: the MuJoCo boom crane of 002 (:class:`cablelab.plants.crane.sim.CraneSim`)
+driven by ``/crane/effort_commands``.
 
 Publishes (CONTRACT sec. 2) ``/crane/joint_states`` (slew, luff, hoist: position, velocity, effort
 = applied command + sensor offset + noise), the motion-capture poses ``/crane/boom_tip_pose`` and
 ``/crane/payload_pose`` (noise, NaN dropouts), ``/crane/ground_truth/swing`` (theta1, theta2,
-rope_length), ``/clock`` and ``/plant_description`` (transient-local). Physics:
-:class:`cablelab.plants.crane.sim.CraneSim`.
+rope_length), ``/clock`` and ``/plant_description`` (transient-local).
 
-ROS parameters: :data:`PARAMETERS` (``cable_sim_node --plant crane --help``). ``lockstep``
-(default true): once commands flow, after publishing a state the simulation waits for the command
-that answers it before advancing, so a slow or loaded controller slows the simulation down
-instead of destabilising it with delayed commands; an answer is applied however late it comes;
-without an answer for ``lockstep_timeout`` s the simulation drops back to real time, holding the
-crane, until commands flow again. Without a fresh command the
-drives hold the crane (gravity compensation + damping, like a brake) and the node reports WARN
-on /diagnostics.
-
-Lock-step matching (:class:`cablelab.ros.lockstep.LockStep`, real time until commands flow): a
-command naming the stamp of the state it answers answers the latest state only if the stamps
-agree; answers to earlier states (e.g. to states published while the simulation still ran in
-real time) are counted and ignored, so they never add a control delay. A command naming no stamp
-answers the last published state.
+``lockstep`` (default true): once commands flow, a state is followed by the command answering it
+before the simulation advances (:class:`cablelab.ros.lockstep.LockStep` matches answers by stamp;
+an answer is applied however late), so a slow controller slows the simulation down instead of
+destabilising it; without an answer for ``lockstep_timeout`` s it runs in real time again until
+commands flow. Without a fresh command the drives hold the crane (gravity compensation + damping,
+like a brake: :func:`cablelab.plants.crane.control.sim_drive`), reported as WARN on /diagnostics.
+Parameters: ``cable_sim_node --plant crane --help``.
 """
 from __future__ import annotations
 
@@ -27,15 +20,16 @@ import os
 import time
 
 from geometry_msgs.msg import PoseStamped
-from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 
 from ....description import load_description
 from ....errors import CablelabError
 from .. import topics
-from ..control import LIVE_GAINS, hold_command
+from ..control import sim_drive
+from ..markers import state_markers
 from ..model import JOINTS, CraneParams
+from ....ros.clock import ClockPublisher
 from ....ros.markers import start_markers
 from ....ros import convert
 from ....ros.lockstep import ADVANCE, LockStep
@@ -44,7 +38,7 @@ from ....ros.plant_node import PlantNode
 from ....ros.inputs import ERROR
 from ....ros.qos import publisher_qos, stream_qos
 from ....ros.status import add_problem
-from ..sim import CraneSim, CraneTruth
+from ..sim import CraneSim, truth_from_parameters
 
 DEFAULT_DESCRIPTION = os.path.join(os.path.dirname(os.path.dirname(__file__)), "data", "crane.yaml")
 SWING = ["theta1", "theta2", "rope_length"]
@@ -87,14 +81,7 @@ class CraneSimNode(PlantNode):
             raise CablelabError("cable_sim_node --plant crane: the description has no crane section")
         params = CraneParams.from_description(self.description, slew_inertia=v.slew_inertia,
                                               luff_inertia=v.luff_inertia)
-        truth = CraneTruth(params=params, base_tilt=tuple(v.base_tilt), viscous=tuple(v.viscous),
-                           coulomb=tuple(v.coulomb), torque_offset=tuple(v.offset),
-                           mocap_noise=v.mocap_noise, mocap_dropout=v.mocap_dropout,
-                           timestep=v.timestep)
-        q0 = tuple(v.initial)
-        if q0[2] <= 0:
-            raise CablelabError(f"{self.get_name()}: parameter initial:={list(q0)}: expected a rope "
-                                "length (third value) > 0 [m]")
+        truth, q0 = truth_from_parameters(self.get_name(), params, v)
         self.rate = v.rate
         self.lock = LockStep(v.lockstep, wait_first=False, timeout=v.lockstep_timeout)
         self.start_gate()
@@ -102,18 +89,16 @@ class CraneSimNode(PlantNode):
         self.u = None
         self.fallbacks = 0
         self.inputs.add("effort_commands", timeout=v.command_timeout, length=3)
-
-        self.pub_js = self.create_publisher(JointState, topics.JOINT_STATES, publisher_qos())
-        self.pub_tip = self.create_publisher(PoseStamped, topics.TIP_POSE, publisher_qos())
-        self.pub_pay = self.create_publisher(PoseStamped, topics.PAYLOAD_POSE, publisher_qos())
-        self.pub_truth = self.create_publisher(JointState, topics.SWING_TRUTH, publisher_qos())
-        self.pub_clock = self.create_publisher(Clock, "/clock", publisher_qos())
+        pub = lambda kind, topic: self.create_publisher(kind, topic, publisher_qos())  # noqa: E731
+        self.pub_js = pub(JointState, topics.JOINT_STATES)
+        self.pub_tip = pub(PoseStamped, topics.TIP_POSE)
+        self.pub_pay = pub(PoseStamped, topics.PAYLOAD_POSE)
+        self.pub_truth = pub(JointState, topics.SWING_TRUTH)
+        self.clock = ClockPublisher(self)
         self.publish_description(self.description)
         self.create_subscription(Float64MultiArray, topics.EFFORT_COMMANDS, self.on_command, stream_qos())
         self.start_diagnostics()
         self.timer = self.create_timer(1.0 / self.rate, self.tick)
-        from ..markers import state_markers
-
         start_markers(self, topics.MARKERS, lambda: state_markers(self.description, self.sim.state()[1]),
                       lambda: self.sim.state()[0], v.markers_rate)
         self.publish_state()
@@ -133,21 +118,14 @@ class CraneSimNode(PlantNode):
             self.u = values.copy()       # (never applied late; lock-step starts with the next)
 
     def tick(self) -> None:
-        # no answer for lockstep_timeout s: FREE (hold) until commands flow
         step = self.may_step(self.lock, self.pub_js, self.publish_state)
         if step is None:
             return  # wait for the controller's answer to the last state
-        now = time.monotonic()
-        if step == ADVANCE:
-            u = self.u  # the answer to the last state, however late it came
-        elif (self.u is None or not self.inputs.fresh("effort_commands", now)
-                or self.lock.enabled):
-            _, q, qd = self.sim.state()
-            u = hold_command(q[None, :3], qd[None, :3], self.sim.truth.params, LIVE_GAINS,
-                             swing=q[None, 3:])[0]
-            self.fallbacks += 1
-        else:
-            u = self.u
+        _, q, qd = self.sim.state()
+        u, held = sim_drive(self.u, q, qd, self.sim.truth.params, answered=step == ADVANCE,
+                            fresh=self.inputs.fresh("effort_commands", time.monotonic()),
+                            lockstep=self.lock.enabled)
+        self.fallbacks += held
         self.sim.advance(u, 1.0 / self.rate)
         self.publish_state()
 
@@ -155,7 +133,7 @@ class CraneSimNode(PlantNode):
         t, q, qd = self.sim.state()
         self.lock.published(t)
         m = self.sim.measurement()
-        self.pub_clock.publish(convert.clock_msg(t))
+        self.clock.publish(t)
         self.pub_js.publish(convert.joint_state_msg(t, JOINTS, m["joints"], m["joint_rates"], m["effort"]))
         self.pub_tip.publish(convert.pose_msg(t, m["tip"], m["tip_quat"]))
         self.pub_pay.publish(convert.pose_msg(t, m["payload"], m["payload_quat"]))

@@ -1,20 +1,19 @@
 """Suspended simulator node: the virtual-joint model (``model:=virtual``) or the truth plant
-(``model:=truth``) of ``variant`` (:class:`~..sim.LiveSim`) in real time. Arm position servos
-follow ``/suspended/reference`` (arm joint names; unknown names / wrong lengths are rejected and
-counted); ``arm_input:=effort``: torque motors driven by ``/suspended/effort_commands`` instead
-(a command older than ``command_timeout`` s wall means zero torque and WARN). Publishes
-``/suspended/imu``, ``/suspended/platform_pose`` (``pose_noise`` m), ``/suspended/joint_states``
+(``model:=truth``) of ``variant`` (:class:`~..sim.LiveSim`) in real time.
+
+Arm position servos follow ``/suspended/reference`` (unknown joint names / wrong lengths are
+rejected and counted); ``arm_input:=effort``: torque motors driven by
+``/suspended/effort_commands`` (a command older than ``command_timeout`` s wall means zero torque
+and WARN). Publishes ``/suspended/imu``, ``/suspended/platform_pose``, ``/suspended/joint_states``
 (effort = actuator torque), ``/suspended/ground_truth/swing``,
 ``/suspended/ground_truth/virtual_joints`` (virtual model), ``/clock``, ``/plant_description``.
 
-``lockstep`` (needs ``arm_input:=effort``): after publishing a state the simulation waits for the
-command answering it and advances one period as soon as it arrives, so DDS latency and CPU load
-slow the run down instead of delaying the stiff arm loop (:class:`cablelab.ros.lockstep.LockStep`;
-the state is resent every ``lockstep_resend`` s while waiting; ``lockstep_timeout`` s without an
-answer: real time with zero torque until commands flow again). Use ``rate:=1000`` (one physics
-step per command): the LiCAS joint-3 loop (k_d / I ~ 1000 1/s) is unstable with a 10 ms hold.
-
-ROS parameters: :data:`PARAMETERS` (``cable_sim_node --plant suspended --help``).
+``lockstep`` (needs ``arm_input:=effort``, :class:`cablelab.ros.lockstep.LockStep`): a state is
+answered before the simulation advances one period, so DDS latency and CPU load slow the run
+instead of delaying the stiff arm loop (the state resent every ``lockstep_resend`` s while
+waiting; ``lockstep_timeout`` s unanswered: real time with zero torque until commands flow). Use
+``rate:=1000``: the LiCAS joint-3 loop (k_d / I ~ 1000 1/s) is unstable with a 10 ms hold.
+Parameters: ``cable_sim_node --plant suspended --help``.
 """
 from __future__ import annotations
 
