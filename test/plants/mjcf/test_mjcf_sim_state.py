@@ -45,3 +45,21 @@ def test_one_advance_of_many_steps_equals_the_steps_one_by_one():
     ref.ctrl[:] = ctrl
     mujoco.mj_step(a.model, ref, nstep=20)
     np.testing.assert_array_equal(a.state()[1], ref.qpos[: a.model.nv])
+
+
+def test_joint_effort_is_the_joint_actuators_generalised_force():
+    """The precomputed joint-actuator moments (gear at a hinge/slide dof) against MuJoCo's own
+    actuator moment matrix of the current state, on the arm (joint motors) and the gantry."""
+    from cablelab.plants.mjcf.examples import ARM3, GANTRY
+    from cablelab.plants.mjcf.sim import actuator_moments
+
+    for example in (ARM3, GANTRY):
+        sim = MjcfSim(load_description(description_yaml(text(example))).mjcf, 9.81)
+        rng = np.random.default_rng(2)
+        for _ in range(3):
+            sim.advance(rng.normal(0.0, 5.0, sim.model.nu), 0.01)
+            effort = sim.state()[3]
+            on = sim.model.actuator_trntype == mujoco.mjtTrn.mjTRN_JOINT
+            want = actuator_moments(sim.model, sim.data)[on].T @ sim.data.actuator_force[on]
+            np.testing.assert_allclose(effort, want, rtol=1e-12, atol=1e-12)
+            assert np.any(effort != 0)

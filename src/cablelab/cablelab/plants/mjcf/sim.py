@@ -270,6 +270,15 @@ class MjcfSim:
                               float).reshape(len(self.tendons), m.nu)             # mjTRN_TENDON
         self._step, self._dt, self._nv = mujoco.mj_step, float(m.opt.timestep), m.nv
         self._on_joint = m.actuator_trntype == 0                             # mjTRN_JOINT
+        # (nv, nu) generalised force of the joint actuators per unit actuator force: the gear at
+        # the joint's dof for hinge and slide joints (mjJNT_HINGE 3, SLIDE 2), else per step
+        self._joint_moment = np.zeros((m.nv, m.nu))
+        for a in np.flatnonzero(self._on_joint):
+            j = m.actuator_trnid[a, 0]
+            if m.jnt_type[j] not in (2, 3):
+                self._joint_moment = None
+                break
+            self._joint_moment[m.jnt_dofadr[j], a] = m.actuator_gear[a, 0]
         mujoco.mj_forward(self.model, self.data)
 
     @property
@@ -292,11 +301,10 @@ class MjcfSim:
         counted twice); the tension of a measured tendon is the pull of the actuators on it (N,
         >= 0 when pulling)."""
         d = self.data
-        if self._on_joint.any():
-            f = d.actuator_force[self._on_joint]
-            effort = actuator_moments(self.model, d)[self._on_joint].T @ f
+        if self._joint_moment is not None:          # hinge and slide joints: constant moments
+            effort = self._joint_moment @ d.actuator_force
         else:
-            effort = np.zeros(self._nv)
+            effort = actuator_moments(self.model, d)[self._on_joint].T @ d.actuator_force[self._on_joint]
         return (d.time, d.qpos[: self._nv].copy(), d.qvel.copy(), effort,
                 self._pull @ d.actuator_force)
 
