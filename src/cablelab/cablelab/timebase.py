@@ -241,3 +241,15 @@ def gap_mask(t, gaps, margin: float = 0.0) -> np.ndarray:
     k = np.searchsorted(lo, t, side="left") - 1  # the last gap starting before t
     inside = (k >= 0) & (t < reach[np.maximum(k, 0)])
     return keep & ~inside
+
+
+def interp_columns(t_new, t, x) -> np.ndarray:
+    """Linear interpolation of (M, k) samples ``x`` at times ``t`` onto ``t_new`` (held at the
+    ends): (len(t_new), k). Returns ``x`` itself when the times already agree."""
+    t = np.asarray(t, float)
+    x = np.asarray(x, float).reshape(len(t), -1)
+    if len(t) == len(t_new) and np.array_equal(t, t_new):
+        return x
+    order = np.argsort(t)
+    t, x = t[order], x[order]
+    return np.stack([np.interp(t_new, t, x[:, j]) for j in range(x.shape[1])], 1)

@@ -17,6 +17,7 @@ from ...errors import CablelabError
 from ...dataset import Dataset
 from ...plant_interface import DatasetOptions
 from ...rotations import quat_to_matrix, xyzw_to_wxyz
+from ...timebase import interp_columns
 from .geometry import cable_geometry, check_pulley_radius, wrench_matrix
 from .options import CdprOptions
 
@@ -50,16 +51,6 @@ class CdprArrays:
     truth_com: np.ndarray | None
     source: str
     scale: float
-
-
-def _interp(t_new: np.ndarray, t: np.ndarray, x: np.ndarray) -> np.ndarray:
-    """Linear interpolation of (M, k) samples onto t_new (held at the ends)."""
-    x = np.asarray(x, float).reshape(len(t), -1)
-    if len(t) == len(t_new) and np.array_equal(t, t_new):
-        return x
-    order = np.argsort(t)
-    t, x = t[order], x[order]
-    return np.stack([np.interp(t_new, t, x[:, j]) for j in range(x.shape[1])], 1)
 
 
 def _finite_rows(*arrays) -> np.ndarray:
@@ -120,9 +111,9 @@ def load_arrays(bag, description, tensions: str = "dynamometer", pose: str = "de
         qd = qd[jok].copy()
         distrusted = [i for i, nm in enumerate(js.names) if nm in set(derived_velocity)]
         qd[:, distrusted] = derived[:, distrusted]
-    motor_velocity = _interp(t, js.t[jok], qd)
+    motor_velocity = interp_columns(t, js.t[jok], qd)
     eok = jok & _finite_rows(js.effort)
-    motor_effort = _interp(t, js.t[eok], js.effort[eok]) if eok.sum() > 1 else np.full_like(tens, np.nan)
+    motor_effort = interp_columns(t, js.t[eok], js.effort[eok]) if eok.sum() > 1 else np.full_like(tens, np.nan)
     if tensions == "both" and eok.sum() < 2:
         raise CablelabError(f"{bag.path}: --tensions both: {JOINTS} has no motor torques (effort); "
                             "use --tensions dynamometer")
@@ -133,18 +124,18 @@ def load_arrays(bag, description, tensions: str = "dynamometer", pose: str = "de
         if rok.sum() < 2:
             raise CablelabError(f"{bag.path}: {REFERENCE} has no desired positions")
         tr = ref.t[rok]
-        position = _interp(t, tr, ref.position[rok])
+        position = interp_columns(t, tr, ref.position[rok])
         acc = ref.linear_acceleration[rok]
-        acc = _interp(t, tr, acc) if np.isfinite(acc).all() else np.zeros_like(position)
+        acc = interp_columns(t, tr, acc) if np.isfinite(acc).all() else np.zeros_like(position)
         vel = ref.linear_velocity[rok]
-        vel = _interp(t, tr, vel) if np.isfinite(vel).all() else np.gradient(position, t, axis=0)
+        vel = interp_columns(t, tr, vel) if np.isfinite(vel).all() else np.gradient(position, t, axis=0)
         quat = ref.quaternion[rok]
     elif bag.has(POSE):
         ps = bag.pose(POSE)
         pok = _finite_rows(ps.t, ps.position)
         if pok.sum() < 2:
             raise CablelabError(f"{bag.path}: {POSE} has no positions")
-        position = _interp(t, ps.t[pok], ps.position[pok])
+        position = interp_columns(t, ps.t[pok], ps.position[pok])
         vel = np.gradient(position, t, axis=0)
         acc = np.gradient(vel, t, axis=0)
         quat, tr = ps.quaternion[pok], ps.t[pok]
@@ -152,7 +143,7 @@ def load_arrays(bag, description, tensions: str = "dynamometer", pose: str = "de
         want = REFERENCE if pose == "desired" else POSE
         raise CablelabError(f"{bag.path}: no platform pose: topic {want} is not in the bag")
     if np.isfinite(quat).all() and not np.allclose(quat[:, :3], 0.0, atol=1e-9):
-        q = _interp(t, tr, xyzw_to_wxyz(quat))
+        q = interp_columns(t, tr, xyzw_to_wxyz(quat))
         R = quat_to_matrix(q)
     truth_m, truth_c = None, None
     if bag.has(TRUTH):

@@ -18,6 +18,7 @@ from ...errors import CablelabError
 from ...dataset import Dataset
 from ...model import KNOWN_OUTPUT
 from ...plant_interface import DatasetOptions
+from ...timebase import interp_columns
 from .description import section_of
 from .inverse import body_columns, inverse_record, point_mass_columns
 from .mjcf import HINGE, dof_joints, names
@@ -63,8 +64,7 @@ def dataset_from_arrays(t, q, effort, description, options: DatasetOptions | Non
     if with_tendons:
         tn = names(model, "tendon")
         idx = [tn.index(x) for x in sec.tendons]
-        tens = np.column_stack([np.interp(c["t"], np.asarray(t, float), np.asarray(tension, float)[:, k])
-                                for k in range(len(idx))])
+        tens = interp_columns(c["t"], t, np.asarray(tension, float)[:, : len(idx)])
         jt = ten_j[:, idx, :]                                   # (N, n_meas, nv)
         y = y - np.einsum("nkv,nk->nv", jt, tens)
         signals.update({"ten_J": jt, "tension": tens})
@@ -149,8 +149,7 @@ def dataset(bag, description, options: DatasetOptions | None = None) -> Dataset:
         if absent:
             raise CablelabError(f"{bag.path}: {ct} has no tendon {absent[0]!r} (bag names: "
                                 f"{', '.join(ts.names) or 'none'})")
-        tension = np.column_stack([np.interp(js.t, ts.t, ts.effort[:, ts.names.index(x)])
-                                   for x in sec.tendons])
+        tension = interp_columns(js.t, ts.t, ts.effort[:, [ts.names.index(x) for x in sec.tendons]])
         lengths = {x: _on_grid(js.t, ts.t, ts.position[:, ts.names.index(x)])
                    for x in sec.tendons if np.isfinite(ts.position[:, ts.names.index(x)]).any()}
     return dataset_from_arrays(js.t, q, eff, description, options, qd=qd, tension=tension,

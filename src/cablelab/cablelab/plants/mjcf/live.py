@@ -15,6 +15,7 @@ import numpy as np
 
 from ...errors import CablelabError
 from ...ros.status import SkipLog
+from ...timebase import interp_columns
 from .estimation import PayloadEstimate, payload_estimate
 from .mjcf import actuated_joints, dof_joints
 
@@ -107,7 +108,7 @@ class PayloadWindow:
         tt = np.array([s[0] for s in self.tensions])
         tv = np.array([s[1] for s in self.tensions])
         keep = (t >= tt[0] - 1e-9) & (t <= tt[-1] + 1e-9)
-        ten = np.column_stack([np.interp(t[keep], tt, tv[:, k]) for k in range(tv.shape[1])])
+        ten = interp_columns(t[keep], tt, tv)
         return t[keep], q[keep], eff[keep], ten
 
     def fit(self) -> PayloadEstimate | None:
