@@ -26,6 +26,7 @@ from .markers import start_markers
 from .qos import DESCRIPTION_QOS, stream_qos
 from .rawmsg import RawReader, joint_state_arrays, multidof_arrays
 from .reference import ReferencePlayer
+from .status import Latency
 
 PROBE_REPEAT = 5.0  # s wall: the start gate's probe state is published again (see waiting_for_subscribers)
 FINISH_ACK_TIMEOUT = 120.0  # s wall: a node that finished waits this long for acknowledgements (drain)
@@ -52,6 +53,7 @@ class PlantNode(Node):
         self._desc_pub = None
         self.polled = []     # subscriptions left out of the executor's wait set (subscribe(polled=True))
         self._raw_readers = {}
+        self.latency = Latency()  # per-sample processing time a node measures (latency.since(t0))
 
     # ------------------------------------------------------------------ parameters
     def declare_params(self, specs) -> SimpleNamespace:
@@ -341,12 +343,14 @@ class PlantNode(Node):
         self.diag = Diagnostics(self, update=self.status)
 
     def status(self):
-        """``(level, message, values)``: the inputs' status, extended by the node."""
+        """``(level, message, values)``: the inputs' status, extended by the node, and the p99
+        of the per-sample processing time when the node measures it (:attr:`latency`)."""
         level, msg, values = self.inputs.status(time.monotonic())
         if self.description_problem:
             level = max(level, 1)
             msg = self.description_problem if msg == "ok" else f"{msg}; {self.description_problem}"
-        return self.extend_status(level, msg, values)
+        level, msg, values = self.extend_status(level, msg, values)
+        return level, msg, self.latency.report(values)     # (nothing before the first sample)
 
     def extend_status(self, level: int, msg: str, values: dict):
         """Add the node's own values / raise the level (override)."""

@@ -27,7 +27,6 @@ from ....ros import convert
 from ....ros.plant_node import PlantNode
 from ....ros.qos import publisher_qos, stream_qos
 from ....ros.rawmsg import CommandTemplate
-from ....ros.status import Latency
 from ....rotations import xyzw_to_wxyz
 from .parameters import CONTROLLER as PARAMETERS
 
@@ -36,9 +35,8 @@ class CdprController(PlantNode):
     def __init__(self):
         super().__init__("pd_feedforward", start_parameter_services=False)  # smaller wait set
         v = self.v = self.declare_params(PARAMETERS)
-        self.feedforward = v.feedforward
         self.stream = CommandStream(v.feedforward, v.sync_wait, v.estimate_wait)
-        self.sent, self.latency = 0, Latency()
+        self.sent = 0
         self._cmd = CommandTemplate("winch")     # pre-serialised commands naming their state's stamp
         self.inputs.add("joint_states", timeout=v.state_timeout)
         self.inputs.add("reference", timeout=v.reference_timeout)
@@ -112,22 +110,14 @@ class CdprController(PlantNode):
         """One command for ``state`` = (t, names, position, velocity, effort), if any."""
         if state is None:
             return
-        t0, (t, _names, q, qd, _eff), skips = time.perf_counter(), state, self.stream.skips
-        if self.controller is None:
-            return skips.skip("waiting for /plant_description")
-        if not self.accept("joint_states", q) or qd is None or qd.size != q.size:
-            return skips.skip("bad motor state (NaN, empty or wrong length)")
-        if not self.stream.refs or not self.inputs.fresh("reference", time.monotonic()):
-            return skips.skip("no fresh reference: not commanding (brakes hold)")
-        if (tau := self.stream.torques(t, q, qd)) is not None:
-            self.pub_cmd.publish(self._cmd.data(tau, t))      # naming the state it answers (lock-step)
+        t0 = time.perf_counter()
+        if (tau := self.stream.command(state, self.inputs, time.monotonic())) is not None:
+            self.pub_cmd.publish(self._cmd.data(tau, state[0]))   # naming the state it answers (lock-step)
             self.sent += 1
             self.latency.since(t0)
 
     def extend_status(self, level, msg, values):
-        level, msg, values = self.stream.report(level, msg, values, "PDFF" if self.feedforward else "PD",
-                                                self.sent)
-        return level, msg, self.latency.report(values)
+        return self.stream.report(level, msg, values, "PDFF" if self.v.feedforward else "PD", self.sent)
 
 
 def make_node() -> PlantNode:

@@ -23,7 +23,6 @@ from ..streams import EstimateStream, estimator_config
 from ....ros import convert
 from ....ros.plant_node import PlantNode
 from ....ros.qos import publisher_qos, stream_qos
-from ....ros.status import Latency
 from ....rotations import xyzw_to_wxyz
 from .outputs import estimate_template, fill_estimate
 from .parameters import ESTIMATOR as PARAMETERS
@@ -35,7 +34,7 @@ class CdprPayloadEstimator(PlantNode):
         v = self.declare_params(PARAMETERS)
         self.config = estimator_config(v)
         self.stream = EstimateStream(self.config, batch=v.poll_period > 0)
-        self.published, self.latency, self.t_est = 0, Latency(), estimate_template()
+        self.published, self.t_est = 0, estimate_template()
         self.motor = motor = self.config.tensions == "motor"
         batch = self.stream.batch
         for name in ("tensions", "pose") + (("joint_states",) if motor else ()):
@@ -110,8 +109,7 @@ class CdprPayloadEstimator(PlantNode):
 
     def extend_status(self, level, msg, values):
         values["published"] = str(self.published)
-        level, msg, values = self.stream.report(level, msg, values)
-        return level, msg, self.latency.report(values)
+        return self.stream.report(level, msg, values)
 
 
 def make_node() -> PlantNode:

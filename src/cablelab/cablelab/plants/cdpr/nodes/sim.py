@@ -18,7 +18,6 @@ from ....description import load_description
 from ....ros import rawmsg
 from ....ros.plant_node import PlantNode
 from ....ros.qos import stream_qos
-from ....ros.status import Latency
 from .. import topics
 from ..markers import sim_markers
 from ..sim import default_description_path, truth_from_parameters  # noqa: F401 (control_loop's)
@@ -33,7 +32,7 @@ class CdprSimNode(PlantNode):
         v = self.declare_params(PARAMETERS)
         self.description = load_description(v.description or default_description_path())
         self.stepper = SimStepper.from_parameters(self.description, v, self.get_name(), self.mass_changed)
-        self.sim, self.real_time, self.latency = self.stepper.sim, v.real_time, Latency()
+        self.sim, self.real_time = self.stepper.sim, v.real_time
         self.publish_pose, self.extras_every = v.publish_pose, v.extras_every
         self.start_gate()
         self.out = CdprOutputs(self, self.sim.n, truth=True)
@@ -55,8 +54,7 @@ class CdprSimNode(PlantNode):
         return self.stepper.done
 
     def extend_status(self, level, msg, values):
-        level, msg, values = self.stepper.report(level, msg, values)
-        return level, msg, self.latency.report(values)
+        return self.stepper.report(level, msg, values)
 
     def on_command(self, msg: Float64MultiArray) -> None:
         """An effort command (serialised bytes, :func:`~cablelab.ros.rawmsg.command_arrays`)."""
