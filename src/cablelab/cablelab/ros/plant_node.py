@@ -200,9 +200,11 @@ class PlantNode(Node):
         return None if builtin is None else ReferencePlayer(self, topic, joints, builtin, platform)
 
     # ------------------------------------------------------------------ description
-    def listen_for_description(self, text: str = "") -> None:
+    def listen_for_description(self, text: str = "", keep_first: bool = False) -> None:
         """Subscribe to ``/plant_description`` (transient local); ``text`` (a ``description``
-        parameter) is used at once when given."""
+        parameter) is used at once when given. ``keep_first``: the first valid description
+        configures the node for good (:attr:`keep_first_description`)."""
+        self.keep_first_description = self.keep_first_description or keep_first
         self.create_subscription(String, "/plant_description", self.on_description, DESCRIPTION_QOS)
         if text:
             self.set_description(load_description(text))

@@ -42,13 +42,10 @@ class CdprController(PlantNode):
         self.inputs.add("reference", timeout=v.reference_timeout)
         self.inputs.add("payload_estimate", timeout=v.estimate_timeout, length=1, required=False)
         self.pub_cmd = self.create_publisher(Float64MultiArray, topics.EFFORT_COMMANDS, publisher_qos())
-        self.keep_first_description = True   # the first valid description configures the law
-        self.listen_for_description(v.description)
-        # the 1 kHz inputs arrive as bytes (decoded without rclpy message objects) in deep queues
-        # (a busy moment delays samples instead of dropping them). Only a state wakes the node:
-        # the reference (published before the state of its stamp) and the estimate wait queued
-        # until a state or the timer takes them (one wake-up per cycle instead of three); an
-        # awaited estimate (estimate_wait) still wakes it
+        self.listen_for_description(v.description, keep_first=True)     # it configures the law
+        # 1 kHz inputs as bytes in deep queues (a busy moment delays samples, drops none). Only a
+        # state wakes the node: the reference (published before its state) and the estimate wait
+        # queued until a state or the timer takes them; an awaited estimate still wakes it
         q = stream_qos(1000)
         self.subscribe(MultiDOFJointTrajectory, topics.REFERENCE, self.on_reference, q, raw=True, polled=True)
         self.subscribe(InertiaStamped, topics.PAYLOAD_ESTIMATE, self.on_estimate, q,
@@ -84,12 +81,11 @@ class CdprController(PlantNode):
         self.command(self.stream.ready())     # a state may have been waiting for this estimate
 
     def on_state(self, msg: JointState) -> None:
-        """Keep the state (JointState or its serialised bytes); command now if the reference of
-        its stamp is here (else a little later, see :meth:`on_timer`: DDS does not order samples
-        across topics). The state -> command path is kept short: the reference terms of this stamp
-        were prepared after the previous command when they could be
-        (:meth:`~cablelab.plants.cdpr.streams.CommandStream.prepare_next`), the law then being the
-        motor-state part only, and the queued reference and estimate are taken afterwards."""
+        """A motor state (JointState or its bytes): commanded now if the reference of its stamp is
+        here, else a little later (:meth:`on_timer`: DDS does not order samples across topics).
+        The queued reference and estimate are taken after the command when the reference terms
+        were prepared ahead (:meth:`CommandStream.prepare_next <cablelab.plants.cdpr.streams.
+        CommandStream.prepare_next>`): the state -> command path stays short."""
         state = self.decode_raw("joint_states", JointState, msg)
         if state is None:
             return

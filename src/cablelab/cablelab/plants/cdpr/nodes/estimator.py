@@ -1,14 +1,14 @@
 """CDPR payload estimator node: mass and CoM (x_G, y_G) per sample (001 eq. 12-13), live.
 
-Inputs: ``/cdpr/cable_tensions`` (dynamometers) or ``/cdpr/joint_states`` (motor torques,
-friction compensated, 001 eq. 15), only the one the ``tensions`` source needs, and the pose of
-the wrench matrix: ``/cdpr/reference`` (desired, 001's real-time choice) or
-``/cdpr/platform_pose`` (measured); the description from ``description`` or ``/plant_description``.
-Each tension sample gives one ``/cdpr/payload_estimate`` (pre-serialised InertiaStamped, m = total
-moving mass, com = (x_G, y_G, NaN), frame ``platform``) stamped like it: matching and counting in
-:class:`cablelab.plants.cdpr.streams.EstimateStream`, the law :class:`cablelab.plants.cdpr.live.LiveEstimator`.
-Bad input (NaN, wrong length, negative tension, ill-conditioned W, stale pose) publishes nothing
-and is reported on /diagnostics; slack cables as WARN. Parameters: :data:`.parameters.ESTIMATOR`.
+Each tension sample, ``/cdpr/cable_tensions`` (dynamometers) or ``/cdpr/joint_states`` (motor
+torques, friction compensated, 001 eq. 15), at the pose of its stamp, ``/cdpr/reference``
+(desired, 001's real-time choice) or ``/cdpr/platform_pose`` (measured), gives one
+``/cdpr/payload_estimate`` stamped like it (pre-serialised InertiaStamped: m = total moving mass,
+com = (x_G, y_G, NaN), frame ``platform``). Matching by stamp and counting:
+:class:`cablelab.plants.cdpr.streams.EstimateStream`; the law: :class:`cablelab.plants.cdpr.live.
+LiveEstimator`. Bad input (NaN, wrong length, negative tension, ill-conditioned W, stale pose)
+publishes nothing and is reported on /diagnostics, slack cables as WARN. Parameters:
+:data:`.parameters.ESTIMATOR`.
 """
 from __future__ import annotations
 
@@ -40,8 +40,7 @@ class CdprPayloadEstimator(PlantNode):
         for name in ("tensions", "pose") + (("joint_states",) if motor else ()):
             self.inputs.add(name, timeout=v.input_timeout)
         self.pub = self.create_publisher(InertiaStamped, topics.PAYLOAD_ESTIMATE, publisher_qos())
-        self.keep_first_description = True   # the first valid description configures the law
-        self.listen_for_description(v.description)
+        self.listen_for_description(v.description, keep_first=True)     # it configures the law
         # deep queues: a busy moment delays samples instead of dropping them. Batch mode: the
         # inputs wake nobody; every poll_period s a timer estimates the newest tension sample, the
         # only one a keep-last-1 queue keeps (never decoded in Python), with the poses around it
@@ -63,9 +62,8 @@ class CdprPayloadEstimator(PlantNode):
         self.stream.describe(desc.cdpr, desc.gravity)
         if desc.cdpr is not None:
             super().set_description(desc)
-            for name in ("tensions", "joint_states"):
-                if name in self.inputs.inputs:
-                    self.inputs.set_length(name, len(desc.cdpr.cables))
+            for name in self.inputs.inputs.keys() & {"tensions", "joint_states"}:
+                self.inputs.set_length(name, len(desc.cdpr.cables))
 
     def on_reference(self, msg: MultiDOFJointTrajectory) -> None:
         """A reference sample (MultiDOFJointTrajectory or its serialised bytes)."""
