@@ -48,11 +48,12 @@ class CdprPayloadEstimator(PlantNode):
         # the pose first: when both wait in one wake-up, a tension sample meets the pose of its
         # stamp (FastExecutor and rclpy's executor take ready topics in creation order)
         if self.config.pose == "desired":
-            self.subscribe(MultiDOFJointTrajectory, topics.REFERENCE, self.on_reference, q_pose, True, batch)
+            self.subscribe(MultiDOFJointTrajectory, topics.REFERENCE, self.on_reference, q_pose, raw=True,
+                           polled=batch)
         else:
             self.subscribe(PoseStamped, topics.PLATFORM_POSE, self.on_pose, q_pose, polled=batch)
         self.subscribe(JointState, topics.JOINT_STATES if motor else topics.CABLE_TENSIONS, self.on_tensions,
-                       q_tension, True, batch)
+                       q_tension, raw=True, polled=batch)
         if batch:
             self.create_timer(v.poll_period, self.on_poll)
         self.use_fast_executor()
