@@ -1,7 +1,10 @@
 """Leg simulator node: steps the hybrid plant (:class:`~..sim.LegSim`) at ``rate`` with the latest
 ``/leg/effort_commands`` torque (stale -> 0) and publishes ``/leg/joint_states`` (``body``: encoder
 height, backward-difference velocity, F_in; ``motor``: theta, 0, torque), ``/leg/contact``,
-``/leg/ground_truth/state``, ``/clock`` and ``/plant_description``.
+``/leg/ground_truth/state``, ``/clock`` and ``/plant_description``. ``lockstep``: once commands
+flow, a state is followed by the torque answering it (estimator and controller in between) before
+the simulation advances (:class:`cablelab.ros.lockstep.LockStep`), so a loaded machine slows the
+run down instead of delaying the stance torque by a whole flight.
 
 ROS parameters: :data:`PARAMETERS` (``cable_sim_node --plant leg --help``).
 """
@@ -21,6 +24,7 @@ from ..markers import sim_markers
 from ..sim import LegSim, motor_angle, quantise
 from ....ros import convert
 from ....ros.clock import ClockPublisher
+from ....ros.lockstep import ADVANCE, FREE, LockStep
 from ....ros.markers import start_markers
 from ....ros.params import Param, markers_rate
 from ....ros.plant_node import PlantNode
@@ -34,6 +38,10 @@ PARAMETERS = (
     Param("z0_offset", 0.03, "start height above touch-down height z_td", "m", ge=0.0, le=10.0),
     Param("rate", 1000.0, "simulation and publishing rate", "Hz", ge=1.0, le=100000.0),
     Param("command_timeout", 0.5, "a torque command older than this means zero torque",
+          "s wall", gt=0.0),
+    Param("lockstep", False, "once commands flow, advance only when the torque answering the last "
+          "state arrived"),
+    Param("lockstep_timeout", 10.0, "lock-step: without an answer for this long, back to real time",
           "s wall", gt=0.0),
     markers_rate(f"{topics.MARKERS}: body, links, spring coloured by its force, foot"),
 )
@@ -53,6 +61,7 @@ class LegSimNode(PlantNode):
         self.sim = LegSim(truth, nominal.z_td + v.z0_offset, 0.0, dt=1.0 / self.rate)
         self.tau = 0.0
         self._z_prev = None
+        self.lock = LockStep(v.lockstep, wait_first=False, timeout=v.lockstep_timeout)
         self.inputs.add("effort_commands", timeout=v.command_timeout, length=1, required=False)
         self.pub_js = self.create_publisher(JointState, topics.JOINT_STATES, publisher_qos())
         self.pub_contact = self.create_publisher(JointState, topics.CONTACT, publisher_qos())
@@ -70,12 +79,15 @@ class LegSimNode(PlantNode):
         return level, msg or "ok", values
 
     def on_command(self, msg: Float64MultiArray) -> None:
-        values = self.take_command("effort_commands", msg)
+        values = self.take_command("effort_commands", msg, self.lock)
         if values is not None:
             self.tau = float(values[0])
 
     def tick(self) -> None:
-        if not self.inputs.fresh("effort_commands", time.monotonic()):
+        step = self.lock.poll(time.monotonic())
+        if step not in (FREE, ADVANCE):
+            return
+        if step == FREE and not self.inputs.fresh("effort_commands", time.monotonic()):
             self.tau = 0.0
         s = self.sim
         s.step(self.tau if s.phase == STANCE else 0.0)
@@ -83,9 +95,11 @@ class LegSimNode(PlantNode):
         zd_m = 0.0 if self._z_prev is None else (zq - self._z_prev) * self.rate   # backward difference
         self._z_prev = zq
         self.clock.publish(s.t)
+        self.lock.published(s.t)
+        # the switch before the height: the estimator reads the phase of this sample with it
+        self.pub_contact.publish(convert.joint_state_msg(s.t, ["contact"], [float(s.phase)]))
         self.pub_js.publish(convert.joint_state_msg(s.t, ["body", "motor"], [zq, float(motor_angle(zq, s.p.L))],
                                                     [zd_m, 0.0], [s.f_in, self.tau]))
-        self.pub_contact.publish(convert.joint_state_msg(s.t, ["contact"], [float(s.phase)]))
         apex_time = s.events[-1].t if s.events else math.nan
         self.pub_truth.publish(hop_msg(s.t, s.z, s.zd, s.phase, math.nan, apex_time, s.grf()))
 
