@@ -1,14 +1,19 @@
 """The mjcf plant's linear fit (``identify``: MuJoCo inverse dynamics, one least-squares solve)
 against an independent oracle, :mod:`mujoco.sysid` (simulation error: Gauss-Newton over RK4
 rollouts of the same record, ``plants/mjcf/rollout_fit.py``), on a bag of the example arm made by
-the generator of ``bench/bench_mjcf_sysid.py`` (shorter): a separate forward simulation, close to
-continuous time, holding joint viscous friction, armature and a payload on the tool.
+the generator of ``bench/bench_mjcf_sysid.py`` (8 s instead of 12): a separate forward
+simulation, close to continuous time, holding joint viscous friction, armature and a payload on
+the tool.
 
-All ten parameters: the two values within their combined 95 % intervals (sysid's clustered by
-window: a rollout's position error drifts, driven by the measured efforts' noise), the linear
-fit's interval holding the truth, and both values near the truth."""
+All ten parameters: the linear fit's 95 % interval holds the truth; the two values agree within
+their combined intervals at a family-wise 95 % over the ten (Bonferroni: z = 2.81 instead of
+1.96; sysid's intervals clustered by window, a rollout's position error drifting under the
+measured efforts' noise); both values near the truth. sysid's values lean high (its noisy
+inputs: the noise-driven wander of a rollout shrinks as inertia and damping grow), which is why
+the agreement is the pair's, not each interval holding the other's value."""
 import numpy as np
 import pytest
+from scipy.stats import norm
 
 from cablelab import workbench
 from cablelab.bags import open_bag
@@ -21,12 +26,13 @@ ARMATURE = {"base_yaw": 0.05, "shoulder": 0.08, "elbow": 0.03}
 PAYLOAD = ("tool", 1.5, (0.04, 0.0, 0.0))
 EFFECTS = ("payload_mass", "joint_viscous_friction", "joint_armature")
 SUBSTEPS = 10                    # as the bench: RK4 at 0.2 ms, one sample per 2 ms
+Z_FAMILY = float(norm.ppf(1 - 0.05 / (2 * 10)))    # two-sided, ten parameters: 2.81
 
 
 def test_linear_fit_and_mujoco_sysid_agree_within_their_intervals(tmp_path):
     bag = write_bag(tmp_path / "arm3", text(ARM3),
                     Hidden(payload=PAYLOAD, damping=DAMPING, armature=ARMATURE),
-                    duration=6.0, seed=3, payload_body="tool", substeps=SUBSTEPS)
+                    duration=8.0, seed=3, payload_body="tool", substeps=SUBSTEPS)
     plant, desc, ds = workbench.load(bag)
     rep = workbench.identify_report(ds, workbench.build_model(plant, desc, list(EFFECTS)), folds=0)
     lin = {k: (v["value"], 1.96 * v["stderr"]) for k, v in rep.params.items()}
@@ -36,14 +42,15 @@ def test_linear_fit_and_mujoco_sysid_agree_within_their_intervals(tmp_path):
     truth = {**{f"Fv[{j}]": v for j, v in DAMPING.items()},
              **{f"armature[{j}]": v for j, v in ARMATURE.items()},
              "m": PAYLOAD[1], "com_x": PAYLOAD[2][0], "com_y": PAYLOAD[2][1], "com_z": PAYLOAD[2][2]}
+    joint = Z_FAMILY / 1.96                      # 95 % half-widths -> family-wise over ten
     for name, value in truth.items():
         (a, ca), b, cb = lin[name], fit.values[name], fit.ci95_windows[name]
-        assert abs(a - b) <= (ca**2 + cb**2) ** 0.5, (name, a, ca, b, cb)
+        assert abs(a - b) <= joint * (ca**2 + cb**2) ** 0.5, (name, a, ca, b, cb)
         assert abs(a - value) <= ca, (name, a, ca, value)
         if value:
             assert a == pytest.approx(value, rel=0.03) and b == pytest.approx(value, rel=0.05), (name, a, b)
-        else:                                           # a centre-of-mass offset of zero: within 5 mm
-            assert abs(a) < 5e-3 and abs(b) < 5e-3, (name, a, b)
+        else:                     # a centre-of-mass offset of zero, weakly excited sideways
+            assert abs(a) < 2e-3 and abs(b) <= cb, (name, a, b, cb)
 
 
 def test_window_clustered_intervals_match_the_spread_of_window_means():

@@ -96,7 +96,7 @@ def window_robust_ci(residuals, jac: np.ndarray, z: float = 1.96) -> np.ndarray:
 
 
 def sysid_fit(xml: str, t, q, effort, joints, *, payload_body: str | None = None,
-              window: float = 0.5, effects=EFFECTS, integrator: str = "rk4",
+              window: float = 0.25, effects=EFFECTS, integrator: str = "rk4",
               max_iters: int = 50) -> RolloutFit:
     """Fit ``effects`` with :mod:`mujoco.sysid` to a record of the model ``xml``.
 
