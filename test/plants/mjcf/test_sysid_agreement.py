@@ -19,7 +19,7 @@ from cablelab import workbench
 from cablelab.bags import open_bag
 from cablelab.plants.mjcf.examples import ARM3, text
 from cablelab.plants.mjcf.rollout_fit import sysid_fit, window_robust_ci
-from cablelab.plants.mjcf.sim import Hidden, write_bag
+from cablelab.plants.mjcf.sim import Hidden, record, truth_model, write_bag
 
 DAMPING = {"base_yaw": 0.8, "shoulder": 1.5, "elbow": 0.6}
 ARMATURE = {"base_yaw": 0.05, "shoulder": 0.08, "elbow": 0.03}
@@ -72,3 +72,19 @@ def test_window_clustered_intervals_match_the_spread_of_window_means():
     assert ci == pytest.approx(1.96 * se_means, rel=0.02)
     white = 1.96 * r.std() / np.sqrt(W * n)
     assert ci > 3 * white
+
+
+def test_sysid_rollouts_of_a_noise_free_continuous_record_are_exact():
+    """Without sensor noise, the oracle's discretisation alone: RK4 rollouts at the record's
+    2 ms with each step's mean effort as control, against a truth stepped at 0.2 ms. Holding each
+    sample's effort instead would delay the torque by half a step."""
+    hidden = Hidden(payload=PAYLOAD, damping=DAMPING, armature=ARMATURE)
+    model = truth_model(text(ARM3), hidden, substeps=SUBSTEPS)
+    t, q, effort, joints = record(model, hidden, duration=4.0, seed=3, encoder_bits=40,
+                                  effort_noise=0.0, effort_quantum=1e-12, substeps=SUBSTEPS)
+    fit = sysid_fit(text(ARM3), t, q, effort, joints, payload_body="tool", window=0.5)
+    truth = {**{f"Fv[{j}]": v for j, v in DAMPING.items()},
+             **{f"armature[{j}]": v for j, v in ARMATURE.items()}, "m": PAYLOAD[1], "com_x": PAYLOAD[2][0]}
+    for name, value in truth.items():
+        assert fit.values[name] == pytest.approx(value, rel=0.01), (name, fit.values[name])
+    assert abs(fit.values["com_y"]) < 5e-4 and abs(fit.values["com_z"]) < 5e-4
