@@ -425,7 +425,7 @@ def _identify_once(model: Model, ds: Dataset, *, on_deficient: str = "raise",
     # every `step` samples (parallel-filtered data: one sample per 1 / (2 f_c), else every one)
     step = sample_step(ds)
     r1 = lag1_autocorrelation(resid, step)
-    inflation = float(np.sqrt(resid.shape[0] / effective_samples(resid, step)))
+    inflation = float(np.sqrt(resid.shape[0] / effective_samples(resid, step, lag1=r1)))
     white = dict(stderr)
     stderr = {k: v * inflation for k, v in stderr.items()}
     return Identification(model, params, stderr, units, tuple(model.fixed), fit, y_hat, resid,
@@ -482,14 +482,15 @@ def sample_step(ds: Dataset) -> int:
     return max(1, int(ds.fs / (2.0 * float(ds.parallel_hz)))) if ds.parallel_hz else 1
 
 
-def effective_samples(residual: np.ndarray, step: int = 1) -> float:
+def effective_samples(residual: np.ndarray, step: int = 1, *, lag1: float | None = None) -> float:
     """AR(1) effective sample size of a residual (N,) or (N, C) taken every ``step`` samples:
     ``(n / step) (1 - r) / (1 + r)``, r the lag-``step`` autocorrelation
     (:func:`lag1_autocorrelation`), n the finite rows; at least 3. ``step`` = 1 is the plain
-    AR(1) formula; :func:`sample_step` gives the step of a parallel-filtered dataset."""
+    AR(1) formula; :func:`sample_step` gives the step of a parallel-filtered dataset. ``lag1``:
+    that autocorrelation when the caller has it already."""
     r = np.asarray(residual, dtype=float)
     n = int(np.isfinite(r.reshape(r.shape[0], -1)).all(axis=1).sum())
-    a = lag1_autocorrelation(r, step)
+    a = lag1_autocorrelation(r, step) if lag1 is None else float(lag1)
     return max(n / max(1, int(step)) * (1.0 - a) / (1.0 + a), 3.0)
 
 

@@ -133,7 +133,7 @@ def solve_linear(phi: np.ndarray, y: np.ndarray, params: Sequence[Param], *,
     if len(names) != p:
         raise ValueError(f"{len(names)} params for {p} regressor columns")
     mask = np.ones(n_s, dtype=bool) if valid is None else np.asarray(valid, dtype=bool).copy()
-    mask &= np.isfinite(y).all(axis=1) & np.isfinite(phi).all(axis=(1, 2))
+    mask &= np.isfinite(y).all(axis=1) & np.isfinite(phi.reshape(n_s, n_c * p)).all(axis=1)
     if isinstance(channel_scale, str):
         if channel_scale != "rms":
             raise ValueError(f"channel_scale {channel_scale!r}")
@@ -293,7 +293,7 @@ def unexcited_columns(phi: np.ndarray, y: np.ndarray, params: Sequence[Param], *
     phi, y = _as_channels(phi, y)
     n_s, n_c, p = phi.shape
     mask = np.ones(n_s, dtype=bool) if valid is None else np.asarray(valid, dtype=bool).copy()
-    mask &= np.isfinite(y).all(axis=1) & np.isfinite(phi).all(axis=(1, 2))
+    mask &= np.isfinite(y).all(axis=1) & np.isfinite(phi.reshape(n_s, n_c * p)).all(axis=1)
     if isinstance(channel_scale, str):
         rms = np.sqrt(np.mean(y[mask] ** 2, axis=0)) if mask.any() else np.ones(n_c)
         w = 1.0 / np.where(rms > 0, rms, 1.0) if n_c > 1 else np.ones(1)
