@@ -45,9 +45,11 @@ def play_designed(launcher, tmp_path):
     (the recorder, then ``nodes``: (role, executable, parameters) each, then ``pd_feedforward``
     playing the bag through its ``reference_bag`` parameter) until ``counts`` messages per topic
     are recorded, and check every process exits 0. Returns ``(bag, played, want, desc)``: the
-    recorded bag, its reference on the exciter's topic (``joints``), the bag's reference at the
+    recorded bag, its reference on the exciter's topic (``joints``; ``t`` and ``positions``, a
+    platform's x, y, z for a pose reference), the bag's reference at the
     same times since the first played sample, and the loaded description."""
     import sys
+    from types import SimpleNamespace
 
     from cablelab.bags import open_bag
     from cablelab.description import load_description
@@ -71,7 +73,11 @@ def play_designed(launcher, tmp_path):
         codes = launcher.stop_all()
         assert set(codes.values()) == {0} and "controller" in codes, codes
         bag = open_bag(bag_dir)
-        played = bag.joint_trajectory(exciter.reference_topic, joints)
+        if exciter.trajectory == "pose":      # a platform's x, y, z (MultiDOFJointTrajectory)
+            tr = bag.multidof_trajectory(exciter.reference_topic)
+            played = SimpleNamespace(t=tr.t, positions=tr.position)
+        else:
+            played = bag.joint_trajectory(exciter.reference_topic, joints)
         want = read_reference(ref, exciter.reference_topic, joints)(played.t - played.t[0])[0]
         return bag, played, want, desc
 
