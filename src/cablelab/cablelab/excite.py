@@ -146,7 +146,10 @@ def lead_in(start, limits: Limits, rate_hz: float):
     length = np.ceil(length * rate_hz - 1e-9) / rate_hz
 
     def fn(t):
-        w, wd, wdd = (v[:, None] for v in _smoothstep(np.asarray(t, float), max(length, 1e-300)))
+        t = np.asarray(t, float)
+        if length <= 0:                        # already at the centre
+            return np.tile(q0, (len(t), 1)), np.zeros((len(t), len(q0))), np.zeros((len(t), len(q0)))
+        w, wd, wdd = (v[:, None] for v in _smoothstep(t, length))
         return q0 + w * d, wd * d, wdd * d
 
     return length, fn
