@@ -10,6 +10,15 @@
 3. ``cablelab diagnose`` starting from Model I (pulleys unknown), and from motor torques without
    friction: which effect is missing; ``cablelab report`` (HTML) of the first, plus a CDPR page
    with the mass estimates and the z errors (``bags/demo/report/``).
+4. The loop closed for hidden dynamometer offsets (``tension_sensor_offset``): the lift at the
+   pick point (A -> B, the pick-and-place's first 6 s, offline MuJoCo CAROCA with 001's payload
+   M1 and eight hidden offsets) leaves the offsets confounded with the mass and the first moments
+   (W b nearly constant along a vertical lift, like the weight); ``cablelab excite`` designs a
+   platform motion for them from that recording, starting at A where the simulator starts;
+   ``pd_feedforward -p reference_bag:=REF`` plays it to ``cable_sim_node`` (same payload, offsets
+   hidden through ``tension_bias``) over DDS with the estimator and the recorder; the fit on that
+   run separates them and brings the offsets, the mass and the centre of mass back. Bags:
+   ``bags/demo/cdpr_lift``, ``bags/demo/cdpr_designed`` (reference ``bags/demo/cdpr_designed_ref``).
 """
 from __future__ import annotations
 
