@@ -170,8 +170,9 @@ LOOP_BIAS = (40.0, -30.0, 25.0, -20.0, 35.0, -45.0, 15.0, -10.0)
 LOOP_PAYLOAD, LOOP_COM, LOOP_NOISE = 122.0, (0.1, 0.05, -0.6), 2.0
 #: the parameters to separate: the offsets from the mass and its first moments
 LOOP_PARAMS = tuple(f"b[winch_{i}]" for i in range(1, 9)) + ("m", "mx", "my")
-#: the first recording: the pick-and-place's first 6 s (the lift A -> B at the pick point)
-LOOP_LIFT_S = 6.0
+#: the first recording: the pick-and-place's first 6 s (the lift A -> B at the pick point), and
+#: the designed one's length (s)
+LOOP_LIFT_S, LOOP_DESIGNED_S = 6.0, 60.0
 
 
 def loop_truth():
@@ -220,7 +221,8 @@ def close_loop(out: Path, *, designed_s: float, domain: int, max_iter: int = 30)
         + f": cablelab excite --params '{','.join(LOOP_PARAMS)}' --duration {designed_s:g} ...")
     d = design("cdpr", desc, LOOP_PARAMS, duration=designed_s, before_ds=ds0, max_iter=max_iter)
     write_reference(ref, d, get_exciter("cdpr"), desc.to_yaml(), overwrite=True)
-    log(f"cdpr: excite's condition number {d.condition_before:.4g} -> {d.condition_after:.4g} "
+    log(f"cdpr: excite's condition number (Model II + offsets) {d.condition_before:.4g} -> "
+        f"{d.condition_after:.4g} "
         f"({d.seconds:.1f} s; {d.lead_in:g} s from A to the box's centre); pd_feedforward -p "
         f"reference_bag:={ref} over DDS ...")
     designed = run_nodes(out, "cdpr_designed", True, designed_s, domain, sim={
@@ -277,8 +279,9 @@ def cdpr_runs(out: Path, a) -> tuple:
     pdff = run_nodes(out, "cdpr_pdff", True, a.duration, unique_domain_id(1))
     pd = None if a.skip_pd else run_nodes(out, "cdpr_pd", False, min(a.duration, 31.0),
                                           unique_domain_id(2))
-    loop = close_loop(out, designed_s=a.cdpr_loop, domain=unique_domain_id(4),
-                      max_iter=a.cdpr_design_iter) if a.cdpr_loop > 0 else None
+    loop_s = LOOP_DESIGNED_S if a.cdpr_loop is None else a.cdpr_loop
+    loop = close_loop(out, designed_s=loop_s, domain=unique_domain_id(4),
+                      max_iter=a.cdpr_design_iter) if loop_s > 0 else None
     return pdff, pd, loop
 
 
@@ -351,17 +354,21 @@ def cdpr_analysis(out: Path, a, runs: tuple) -> PartResult:
 def add_arguments(group) -> None:
     group.add_argument("--duration", type=float, default=61.0, help="CDPR: simulated s of the PDFF run")
     group.add_argument("--skip-pd", action="store_true", help="CDPR: only the PDFF run")
-    group.add_argument("--cdpr-loop", type=float, default=60.0, metavar="S",
-                       help="CDPR: simulated s of the designed recording that separates the hidden "
-                            "dynamometer offsets from the payload (0 skips that step)")
+    group.add_argument("--cdpr-loop", type=float, default=None, metavar="S",
+                       help=f"CDPR: simulated s of the designed recording that separates the hidden "
+                            f"dynamometer offsets from the payload (default {LOOP_DESIGNED_S:g}; "
+                            f"0 skips that step, as --quick does unless S is given)")
     group.add_argument("--cdpr-design-iter", type=int, default=30, metavar="N",
                        help="CDPR: optimiser iterations of that recording's design")
 
 
 def quick(a) -> None:
-    """--quick: a 12 s PDFF run only, and a 30 s designed recording (10 design iterations)."""
+    """--quick: a 12 s PDFF run only; the loop of step 4 only with ``--cdpr-loop S`` (it adds
+    about a minute of wall time on a busy 2-core machine at 30 s), then with 10 design
+    iterations."""
     a.duration, a.skip_pd = min(a.duration, 12.0), True
-    a.cdpr_loop, a.cdpr_design_iter = min(a.cdpr_loop, 30.0), min(a.cdpr_design_iter, 10)
+    a.cdpr_loop = 0.0 if a.cdpr_loop is None else a.cdpr_loop
+    a.cdpr_design_iter = min(a.cdpr_design_iter, 10)
 
 
 DEMO = DemoPart(plant="cdpr", title="CAROCA CDPR (001), payload M2, 615 kg", order=10,
