@@ -33,12 +33,13 @@ def test_designed_reference_over_dds_separates_offsets_from_payload(play_designe
 
     bag, played, want, _ = play_designed(
         "cdpr", open(default_description_path()).read(), list(demo.LOOP_PARAMS),
-        [("sim", "cable_sim_node", {**demo.loop_sim_params(), "real_time": False,
-                                    "publish_reference": False, "wait_for_subscribers": 2}),
+        [("sim", "cable_sim_node", {**demo.loop_sim_params(), "real_time": False, "publish_reference": False,
+                                    "wait_for_subscribers": 2, **demo.LOCKSTEP_PATIENCE["sim"]}),
          ("estimator", "payload_estimator", {"model": "II", "tensions": "dynamometer"})],
         {"/cdpr/joint_states": int(DESIGNED_S * 100), "/cdpr/reference": int(DESIGNED_S * 100) - 50,
          "/cdpr/cable_tensions": int(DESIGNED_S * 100)},
-        ["x", "y", "z"], duration=DESIGNED_S, max_iter=10, timeout=400)
+        ["x", "y", "z"], duration=DESIGNED_S, max_iter=10, timeout=400,
+        controller=demo.LOCKSTEP_PATIENCE["controller"])
     # the controller published the bag's trajectory, from the simulator's start pose on: the
     # platform (ground truth) is where the reference starts and follows it without a jump
     np.testing.assert_allclose(played.positions, want, atol=1e-6)
@@ -48,6 +49,10 @@ def test_designed_reference_over_dds_separates_offsets_from_payload(play_designe
     assert np.linalg.norm(true_at[0] - start_position()) < 0.01
     assert np.max(np.linalg.norm(true_at - played.positions, axis=1)) < 0.03
     assert np.ptp(played.positions, axis=0).min() > 0.3               # it moved the platform
+    # every cable taut in every sample (the dynamometers less their hidden offsets): no state
+    # stepped on the winch brakes
+    tensions = bag.joint_state("/cdpr/cable_tensions", [f"cable_{i}" for i in range(1, 9)]).effort
+    assert np.min(tensions - np.array(demo.LOOP_BIAS)) > 100.0
     # the fit on the designed recording: nothing confounded, the offsets and payload come back
     _, f1, conf1, c1 = demo.loop_fit(bag.path)
     assert conf1 == [] and c1 < 3e3 and c1 < c0 / 1e3

@@ -225,10 +225,18 @@ def close_loop(out: Path, *, designed_s: float, domain: int, max_iter: int = 30)
         f"{d.condition_after:.4g} "
         f"({d.seconds:.1f} s; {d.lead_in:g} s from A to the box's centre); pd_feedforward -p "
         f"reference_bag:={ref} over DDS ...")
-    designed = run_nodes(out, "cdpr_designed", True, designed_s, domain, sim={
-        **loop_sim_params(), "publish_reference": False},
-        controller={"reference_bag": str(ref)})
+    designed = run_nodes(out, "cdpr_designed", True, designed_s, domain,
+                         sim={**loop_sim_params(), "publish_reference": False, **LOCKSTEP_PATIENCE["sim"]},
+                         controller={"reference_bag": str(ref), **LOCKSTEP_PATIENCE["controller"]})
     return {"lift": lift, "designed": designed, "reference": ref, "design_s": d.seconds}
+
+
+#: lock-step runs of step 4: simulated time stands still while a process waits for the CPU, so
+#: wall-clock staleness means nothing there; with the defaults (0.5 s, 10 s) a busy machine can
+#: make the controller skip a state as stale and the simulator step that state on its brakes (a
+#: jolt of a few samples, slack cables, that pulls the fit of the offsets by 10 N)
+LOCKSTEP_PATIENCE = {"sim": {"lockstep_timeout": 120.0},
+                     "controller": {"reference_timeout": 120.0, "state_timeout": 120.0}}
 
 
 def loop_sim_params() -> dict:
