@@ -2,14 +2,17 @@
 
 ros2_control's shape: the hardware (a simulator or a driver, :mod:`cablelab.hardware`) and the
 controller law run in this one process, in one thread, on absolute deadlines; DDS only carries
-what other nodes observe. After each write (off the deadline path) the node publishes the
-period's state, command and reference for recorders and estimators, takes what arrived on its
-input topics without waiting (e.g. a live estimate: ``fastspin.take_newest`` on a keep-last-1
-queue that no executor waits on), and publishes /diagnostics once a second.
+what other nodes observe. After each write (off the deadline path) the node hands the period's
+state and command to its publisher (parameter ``publisher``: by default a child process fed
+through a shared-memory ring, :mod:`cablelab.sample_ring` and :mod:`cablelab.ros.loop_publisher`,
+so that publishing costs the loop's process one record copy and never holds its GIL at a
+deadline; or a thread of this process; or this thread), takes what arrived on its input topics
+without waiting (e.g. a live estimate: ``fastspin.take_newest`` on a keep-last-1 queue that no
+executor waits on), and publishes /diagnostics once a second.
 
 A plant's loop node (``plants/<plant>/nodes/control_loop.py``) subclasses :class:`ControlLoopNode`:
 it builds its hardware and law and calls :meth:`ControlLoopNode.setup_loop`, and overrides
-:meth:`~ControlLoopNode.publish_cycle` (its topics), :meth:`~ControlLoopNode.take_inputs` and
+:meth:`~ControlLoopNode.cycle_publisher` (its topics), :meth:`~ControlLoopNode.take_inputs` and
 :meth:`~ControlLoopNode.after_cycle` (e.g. prepare the next period's reference terms).
 
 The node is its own executor (:class:`LoopSpinner`: ``spin_once(timeout)`` runs the periods due

@@ -68,14 +68,15 @@ def run(config: dict, ros_args: list[str]) -> int:
     from rclpy.signals import SignalHandlerOptions
 
     from ..sample_ring import SampleRing, StateLayout
-    from .fastspin import set_background
 
     stop = []
     signal.signal(signal.SIGINT, signal.SIG_IGN)            # the loop ends us by closing the ring
     signal.signal(signal.SIGTERM, lambda *_: stop.append(1))  # the loop's process died: drain, end
     nice = int(config.get("niceness", 0))
     if nice > 0:
-        set_background(nice)
+        # this process only (its threads start later and inherit it); not fastspin.set_background,
+        # which also lowers the session's autogroup: the loop's own process is in that group
+        os.nice(nice)
     ring = SampleRing.attach(config["ring"])
     layout = StateLayout.from_dict(config["layout"])
     rclpy.init(args=["loop_publisher", *ros_args], signal_handler_options=SignalHandlerOptions.NO)
