@@ -1,6 +1,7 @@
 """Real time on an ordinary machine: offline CDPR simulation vs bare mj_step, the machine's floor,
 the 1 kHz control loop in one process and the 1 kHz loop of three node processes over DDS,
-without real-time privileges, in one run.
+in one run, by default without real-time privileges (``--rt-priority``: all of them under
+SCHED_FIFO alike).
 
 1. Offline: ``simulate`` (MuJoCo 2 ms physics, PDFF + live estimator at 100 Hz) of the 60 s test
    trajectory with 615 kg, and a bare loop of ``mujoco.mj_step`` on the simulator's own MjModel
@@ -32,9 +33,11 @@ without real-time privileges, in one run.
 ``--json`` prints one JSON object::
 
     {"offline_sim": {"plant": "cdpr", "realtime_factor", "bare_mj_step_realtime_factor"},
-     "floor": {"bare_timer_missed", "c_rcl_pair_missed", "seconds", "available"},
+     "floor": {"bare_timer_missed", "c_rcl_pair_missed", "seconds", "available", "rt_priority"},
      "control_loop": {"rate_hz": 1000, "seconds", "missed_cycles", "late", "dropped", "p99_ms",
-                      "realtime_factor", "cpu_per_cycle_ms", "placement"},
+                      "realtime_factor", "cpu_per_cycle_ms" (the loop's process), "wakeup_max_ms",
+                      "publisher", "publisher_cpu_per_cycle_ms" (its publisher process),
+                      "samples_lost", "rt_priority", "placement"},
      "three_process": {"rate_hz": 1000, "seconds", "realtime_factor", "missed_cycles",
                        "p99_ms": {"sim", "estimator", "controller"}, "rt_priority": false, ...},
      "rate_sweep": [{"rate_hz", "bare_timer_missed", "control_loop_missed", "p99_ms",
@@ -47,7 +50,11 @@ py-spy and prints each one's share of samples by innermost function (where the t
 Placement without privileges: ``--idle-estimator`` (the estimator in the SCHED_IDLE class),
 ``--pin`` (that, plus simulator and estimator on CPU 0, controller on CPU 1), ``--node-params
 JSON`` (any node parameters, e.g. ``'{"sim": {"sched_slice": 0.0001}}'``); the JSON's
-``placement`` says what was used.
+``placement`` says what was used; ``--loop-params JSON`` the control loop's (e.g. ``'{"loop":
+{"publisher": "thread"}}'``). ``--rt-priority PRIO`` runs the bare timer and the C rcl pair
+(``chrt -f PRIO``), the control loop's process (not its publisher process, nor the estimator)
+and the three-process simulator and controller (node parameter ``rt_priority``) under SCHED_FIFO
+PRIO, so that the ratios compare like with like (needs the privilege).
 """
 from __future__ import annotations
 
@@ -157,7 +164,8 @@ def control_loop(seconds: float, log, rate: float = 1000.0, pin: bool = False, e
             "late": r["late"], "dropped": r["dropped"], "cycles": r["cycles"], "p99_ms": r["p99_ms"],
             "p99_all_ms": r["p99_all_ms"], "median_ms": r["median_ms"],
             "realtime_factor": r["realtime_factor"], "cpu_per_cycle_ms": r.get("cpu_per_cycle_ms"),
-            "publisher": r.get("publisher"), "publisher_cpu_per_cycle_ms": r.get("publisher_cpu_per_cycle_ms"),
+            "wakeup_max_ms": r.get("wakeup_max_ms"), "publisher": r.get("publisher"),
+            "publisher_cpu_per_cycle_ms": r.get("publisher_cpu_per_cycle_ms"),
             "samples_lost": r.get("samples_lost"),
             "rt_priority": int(placement.get("loop", {}).get("rt_priority", 0)) > 0, "placement": placement or None}
 
@@ -269,7 +277,8 @@ def main(argv=None) -> int:
             rows.append(dict(case="floor (bare timer, C rcl pair)", value="unavailable: " + f["reason"].splitlines()[0],
                              unit="", target=""))
         else:
-            rows += [dict(case=f"floor: bare timer 1 kHz, {f['seconds']:.0f} s (missed = late + dropped)",
+            fifo = ", SCHED_FIFO" if f.get("rt_priority") else ""
+            rows += [dict(case=f"floor: bare timer 1 kHz{fifo}, {f['seconds']:.0f} s (missed = late + dropped)",
                           value=f"{f['bare_timer_missed']} (wake-up p99 {f['bare_timer']['p99_ms']['wake-up']:.3f} ms)",
                           unit=f"of {int(round(f['bare_timer']['seconds'] * 1000))}", target=""),
                      dict(case="floor: C rcl simulator/controller pair 1 kHz", value=f["c_rcl_pair_missed"],
@@ -277,7 +286,9 @@ def main(argv=None) -> int:
     if "control_loop" in out:
         c = out["control_loop"]
         bare = out.get("floor", {}).get("bare_timer_missed")
-        rows += [dict(case=f"control loop 1 kHz (control_loop + estimator), {c['seconds']:.0f} s: missed cycles "
+        prio = ", SCHED_FIFO" if c.get("rt_priority") else ""
+        rows += [dict(case=f"control loop 1 kHz (control_loop + estimator, publisher {c.get('publisher')}{prio}), "
+                           f"{c['seconds']:.0f} s: missed cycles "
                            f"(late {c['late']} + dropped {c['dropped']})",
                       value=c["missed_cycles"], unit=f"of {c['cycles'] + c['dropped']}",
                       target=f"<= {2 * bare} (2x bare timer)" if bare is not None else "<= 2x bare timer"),
