@@ -151,7 +151,8 @@ class ControlLoopNode(PlantNode):
         child = {"ring": self._ring.name, "layout": self._layout.to_dict(),
                  "publisher": f"{cls.__module__}:{cls.__qualname__}", "config": config,
                  "node": f"{self.get_name()}_publisher", "batch": self.publish_batch,
-                 "niceness": self.publisher_niceness, "parent": os.getpid()}
+                 "niceness": self.publisher_niceness, "parent": os.getpid(),
+                 "domain_id": self.context.get_domain_id()}
         self._child = loop_publisher.start(child, split_ros_args(sys.argv[1:])[1])
 
     def executor_factory(self):

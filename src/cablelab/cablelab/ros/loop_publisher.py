@@ -13,7 +13,7 @@ Run as ``python -m cablelab.ros.loop_publisher CONFIG_JSON [--ros-args ...]`` (t
 arguments, so that remappings apply to the child's publishers too). CONFIG_JSON keys: ``ring``
 (shared-memory name), ``layout`` (:meth:`StateLayout.to_dict`), ``publisher`` (class spec),
 ``config`` (its configuration), ``node`` (node name), ``batch`` (s), ``niceness``, ``parent``
-(pid of the loop), ``match_wait`` (s, :func:`wait_for_matches`).
+(pid of the loop), ``domain_id`` (the loop's ROS domain), ``match_wait`` (s, :func:`wait_for_matches`).
 """
 from __future__ import annotations
 
@@ -79,7 +79,8 @@ def run(config: dict, ros_args: list[str]) -> int:
         os.nice(nice)
     ring = SampleRing.attach(config["ring"])
     layout = StateLayout.from_dict(config["layout"])
-    rclpy.init(args=["loop_publisher", *ros_args], signal_handler_options=SignalHandlerOptions.NO)
+    rclpy.init(args=["loop_publisher", *ros_args], signal_handler_options=SignalHandlerOptions.NO,
+               domain_id=config.get("domain_id"))
     node = Node(config["node"])
     publisher = load_class(config["publisher"])(node, config["config"])
     parent, batch = int(config["parent"]), float(config["batch"])
