@@ -109,6 +109,40 @@ def test_loop_commands_equal_the_controller_node_on_a_recorded_stream(ros_contex
         ctl.destroy_node()
 
 
+def test_publisher_thread_publishes_every_sample_in_order(domain_id):
+    """``publisher:=thread``: the samples queued after each write are all published by the
+    thread, in the order of the periods, by the time the node shuts down."""
+    import rclpy
+    from sensor_msgs.msg import JointState
+    from std_msgs.msg import Float64MultiArray
+
+    from cablelab.plants.cdpr.nodes.control_loop import CdprControlLoop
+    from cablelab.ros import convert
+
+    rclpy.init(args=["test", "--ros-args", "-p", "publisher:=thread", "-p", "publish_batch:=0.002",
+                     "-p", "rate:=500.0"], domain_id=domain_id)
+    try:
+        node = CdprControlLoop()
+        js, cmds = [], []
+        node.cycle_pub.out.pub_js.publish = _capture(js, JointState)
+        node.cycle_pub.out.pub_cmd.publish = _capture(cmds, Float64MultiArray)
+        try:
+            node.loop.start()
+            states = []
+            for _ in range(300):
+                state, command = node.loop.cycle()
+                states.append(state)
+                node._after_write(state, command)
+            node.shutdown()
+            assert [convert.from_stamp(m.header.stamp) for m in js] == pytest.approx([s.t for s in states], abs=1e-9)
+            np.testing.assert_array_equal([m.position for m in js], [s.position for s in states])
+            assert [convert.command_stamp(m) for m in cmds] == pytest.approx([s.t for s in states], abs=1e-9)
+        finally:
+            node.destroy_node()
+    finally:
+        rclpy.try_shutdown()
+
+
 def test_hardware_seam():
     """The simulator satisfies the protocol; the stub stops with what a driver must implement;
     the loop counts a late wake-up like the bare timer does, and a write(None) brakes."""
