@@ -22,26 +22,10 @@ from trajectory_msgs.msg import JointTrajectory
 from .. import topics
 from ..control import pd_feedforward, sine_reference
 from ....ros import convert
-from ....ros.params import Param
 from ....ros.plant_node import PlantNode
 from ....ros.qos import publisher_qos, stream_qos
-from ....ros.reference import ReferencePlayer, reference_bag_param
-
-
-PARAMETERS = (
-    Param("kp", 400.0, "proportional gain", "N/m or N m/rad", ge=0.0, le=1e9),
-    Param("kd", 40.0, "derivative gain", "N s/m or N m s/rad", ge=0.0, le=1e9),
-    Param("inertia", float("nan"), "feedforward inertia M_ff (NaN = the description's axis.inertia "
-          "from /plant_description, else 0)", "kg or kg m^2", ge=0.0, le=1e6, nan=True),
-    Param("reference_source", "topic", "the reference: /axis/reference (topic) or a built-in sine "
-          "evaluated at the measurement stamp and published on /axis/reference (sine)",
-          choices=("topic", "sine")),
-    Param("amplitude", 0.2, "amplitude of the built-in sine", "m or rad", ge=0.0, le=1e3),
-    Param("frequency", 0.5, "frequency of the built-in sine", "Hz", gt=0.0, le=1e3),
-    Param("offset", 0.0, "offset of the built-in sine", "m or rad", ge=-1e3, le=1e3),
-    Param("reference_timeout", 0.5, "a reference older than this is stale", "s wall", gt=0.0),
-    reference_bag_param(topics.REFERENCE),
-)
+from ....ros.reference import ReferencePlayer
+from .parameters import CONTROLLER as PARAMETERS
 
 
 class AxisController(PlantNode):

@@ -21,18 +21,9 @@ from .. import topics
 from ..control import gravity_load, regressor
 from ....rls import RecursiveLeastSquares
 from ....ros import convert
-from ....ros.params import Param
 from ....ros.plant_node import PlantNode
 from ....ros.qos import catch_up_qos, publisher_qos
-
-
-PARAMETERS = (
-    Param("forgetting", 1.0, "forgetting factor lambda of the recursive least squares (1 = none)",
-          gt=0.0, le=1.0),
-    Param("publish_every", 20, "publish the estimate every this many samples", ge=1, le=10 ** 9),
-    Param("stiction_velocity", 1e-3, "|qd| below which sign(qd) counts as 0", "m/s or rad/s",
-          ge=0.0, le=1e3),
-)
+from .parameters import ESTIMATOR as PARAMETERS
 
 
 class AxisEstimator(PlantNode):

@@ -24,30 +24,12 @@ from ....ros import convert
 from ....ros.clock import ClockPublisher
 from ....ros.lockstep import FREE, LockStep
 from ....ros.markers import start_markers
-from ....ros.params import DESCRIPTION, START_GATE, Param, markers_rate, merge
 from ....ros.plant_node import PlantNode
 from ....ros.qos import publisher_qos, stream_qos
+from .parameters import SIM as PARAMETERS
 
 DEFAULT_DESCRIPTION = ("plant: axis\nname: simulated linear axis\ngravity: 9.81\n"
                        "axis:\n  joint_type: prismatic\n  inertia: 2.0\n")
-
-
-PARAMETERS = merge((
-    DESCRIPTION,
-    Param("inertia", float("nan"), "true inertia M (NaN = the description's axis.inertia, else 2)",
-          "kg or kg m^2", gt=0.0, le=1e6, nan=True),
-    Param("viscous", 5.0, "true viscous friction Fv", "N s/m or N m s/rad", ge=0.0, le=1e6),
-    Param("coulomb", 1.0, "true Coulomb friction Fc", "N or N m", ge=0.0, le=1e6),
-    Param("offset", 0.0, "bias added to the reported effort", "N or N m", ge=-1e6, le=1e6),
-    Param("timestep", 0.001, "physics step", "s", ge=1e-5, le=0.01),
-    Param("rate", 200.0, "publishing rate = command sampling", "Hz", ge=1.0, le=10000.0),
-    Param("command_timeout", 0.5, "a command older than this falls back to 0 (WARN)", "s wall", gt=0.0),
-    Param("lockstep", False, "advance one period only once the command answering the last state "
-          "arrived"),
-    Param("lockstep_resend", 0.25, "lock-step: the state is republished this often while waiting",
-          "s wall", gt=0.0, le=60.0),
-    markers_rate("/axis/markers: carriage on its rail or link and load"),
-), START_GATE)
 
 
 class AxisSimNode(PlantNode):

@@ -19,34 +19,16 @@ from std_msgs.msg import Float64MultiArray
 from trajectory_msgs.msg import JointTrajectory
 
 from .. import topics
-from ..control import LIVE_GAINS, Gains, joint_command
+from ..control import Gains, joint_command
 from ..model import JOINTS, CraneParams
 from ..reference import reference_trajectory
 from ....ros import convert
 from ....ros.inputs import WARN
-from ....ros.params import Param
 from ....ros.plant_node import PlantNode
 from ....ros.qos import publisher_qos, stream_qos
 from ....ros.status import add_problem
-from ....ros.reference import ReferencePlayer, reference_bag_param
-
-
-PARAMETERS = (
-    Param("kp", [float(x) for x in LIVE_GAINS.kp], "proportional gains [slew, luff, hoist]",
-          "N m/rad, N m/rad, N/m", length=(3,), ge=0.0, le=1e9),
-    Param("kd", [float(x) for x in LIVE_GAINS.kd], "derivative gains [slew, luff, hoist]",
-          "N m s/rad, N m s/rad, N s/m", length=(3,), ge=0.0, le=1e9),
-    Param("feedforward", True, "reference-acceleration feedforward"),
-    Param("slew_inertia", 0.05, "slew inertia the description does not hold", "kg m^2", gt=0.0, le=1e6),
-    Param("luff_inertia", 0.02, "luff inertia the description does not hold", "kg m^2", gt=0.0, le=1e6),
-    Param("reference_source", "topic", "the reference: /crane/reference (topic) or the built-in "
-          "multi-sine excitation, published on /crane/reference too (excitation)",
-          choices=("topic", "excitation")),
-    Param("excitation_seed", 0, "seed of the built-in multi-sine excitation", ge=0),
-    Param("reference_timeout", 0.5, "a reference older than this is stale: the crane is held",
-          "s wall", gt=0.0),
-    reference_bag_param(topics.REFERENCE),
-)
+from ....ros.reference import ReferencePlayer
+from .parameters import CONTROLLER as PARAMETERS
 
 
 class CraneController(PlantNode):

@@ -20,20 +20,11 @@ from ..swing import SwingTracker
 from ....ros import convert
 from ....ros.inputs import WARN
 from ....ros.status import add_problem
-from ....ros.params import Param
 from ....ros.plant_node import PlantNode
 from ....ros.qos import catch_up_qos, publisher_qos
+from .parameters import ESTIMATOR as PARAMETERS
 
 NAMES = ["theta1", "theta2", "rope_length"]
-
-
-PARAMETERS = (
-    Param("velocity_tau", 0.02, "time constant smoothing the swing rates", "s", gt=0.0, le=10.0),
-    Param("max_wait", 0.2, "a pose pair waits this long (in stamps) for the slew angle of its "
-          "stamp before the latest one is used", "s", ge=0.0, le=10.0),
-    Param("pose_timeout", 0.5, "a pose older than this is stale", "s wall", gt=0.0),
-    Param("slew_timeout", 0.5, "a slew angle older than this is stale", "s wall", gt=0.0),
-)
 
 
 class CraneSwingEstimator(PlantNode):

@@ -33,43 +33,15 @@ from ....ros.clock import ClockPublisher
 from ....ros.markers import start_markers
 from ....ros import convert
 from ....ros.lockstep import ADVANCE, LockStep
-from ....ros.params import DESCRIPTION, START_GATE, Param, markers_rate, merge
 from ....ros.plant_node import PlantNode
 from ....ros.inputs import ERROR
 from ....ros.qos import publisher_qos, stream_qos
 from ....ros.status import add_problem
 from ..sim import CraneSim, truth_from_parameters
+from .parameters import SIM as PARAMETERS
 
 DEFAULT_DESCRIPTION = os.path.join(os.path.dirname(os.path.dirname(__file__)), "data", "crane.yaml")
 SWING = ["theta1", "theta2", "rope_length"]
-
-
-PARAMETERS = merge((
-    DESCRIPTION,
-    Param("slew_inertia", 0.05, "slew inertia the description does not hold", "kg m^2", gt=0.0, le=1e6),
-    Param("luff_inertia", 0.02, "luff inertia the description does not hold", "kg m^2", gt=0.0, le=1e6),
-    Param("base_tilt", [0.0, 0.0], "true tilt of the base [about x, about y]", "rad", length=(2,),
-          ge=-0.5, le=0.5),
-    Param("viscous", [0.0, 0.0, 0.0], "true viscous friction [slew, luff, hoist]",
-          "N m s/rad, N m s/rad, N s/m", length=(3,), ge=0.0, le=1e6),
-    Param("coulomb", [0.0, 0.0, 0.0], "true Coulomb friction [slew, luff, hoist]", "N m, N m, N",
-          length=(3,), ge=0.0, le=1e6),
-    Param("offset", [0.0, 0.0, 0.0], "true effort sensor offset [slew, luff, hoist]", "N m, N m, N",
-          length=(3,), ge=-1e6, le=1e6),
-    Param("mocap_noise", 0.0, "standard deviation of the motion-capture positions", "m", ge=0.0, le=10.0),
-    Param("mocap_dropout", 0.0, "probability of a motion-capture dropout (NaN pose)", ge=0.0, le=1.0),
-    Param("timestep", 0.001, "physics step", "s", ge=1e-5, le=0.01),
-    Param("initial", [0.0, 0.5, 0.6], "initial [slew rad, luff rad, hoist rope length m]", length=(3,),
-          ge=-10.0, le=100.0),
-    Param("rate", 100.0, "publishing rate = command sampling", "Hz", ge=1.0, le=10000.0),
-    Param("command_timeout", 0.5, "a command older than this is stale: the drives hold (real time)",
-          "s wall", gt=0.0),
-    Param("lockstep", True, "once commands flow, advance only when the command answering the last "
-          "state arrived"),
-    Param("lockstep_timeout", 10.0, "lock-step: without an answer for this long, back to real time "
-          "holding the crane", "s wall", gt=0.0),
-    markers_rate("/crane/markers: mast, boom, rope, payload"),
-), START_GATE)
 
 
 class CraneSimNode(PlantNode):

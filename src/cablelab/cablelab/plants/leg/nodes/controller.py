@@ -14,29 +14,14 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 from trajectory_msgs.msg import JointTrajectory
 
-from . import DESCRIPTION
 from .. import topics
 from ..control import ApexController
 from ..description import leg_of, load_leg_description
 from ....ros import convert
-from ....ros.params import Param
 from ....ros.plant_node import PlantNode
 from ....ros.qos import publisher_qos, stream_qos
-from ....ros.reference import ReferencePlayer, reference_bag_param
-
-PARAMETERS = (
-    DESCRIPTION,
-    Param("h_des", 0.016, "desired apex height above z_td until a /leg/reference arrives", "m",
-          ge=0.0, le=10.0),
-    Param("T", 1.0, "initial stance torque", "N m", ge=0.0, le=1e4),
-    Param("P", 0.30, "stance torque duration", "s", gt=0.0, le=10.0),
-    Param("k_i", 10.0, "integral gain on the apex-height error", "N m/m", ge=0.0, le=1e6),
-    Param("k_ff", 0.5, "feedforward fraction of the model-based Newton step", ge=0.0, le=10.0),
-    Param("T_max", 4.0, "largest stance torque", "N m", gt=0.0, le=1e4),
-    Param("mode", "apex", "apex-height control or a constant open-loop torque",
-          choices=("apex", "open_loop")),
-    reference_bag_param(topics.REFERENCE, "the topic"),
-)
+from ....ros.reference import ReferencePlayer
+from .parameters import CONTROLLER as PARAMETERS
 
 
 class LegControllerNode(PlantNode):

@@ -13,7 +13,7 @@ import time
 from std_msgs.msg import Float64MultiArray
 from sensor_msgs.msg import JointState
 
-from . import DESCRIPTION, hop_msg
+from . import hop_msg
 from .. import topics
 from ..description import leg_of, load_leg_description
 from ..hybrid import STANCE
@@ -22,21 +22,9 @@ from ..sim import LegSim, motor_angle, quantise
 from ....ros import convert
 from ....ros.clock import ClockPublisher
 from ....ros.markers import start_markers
-from ....ros.params import Param, markers_rate
 from ....ros.plant_node import PlantNode
 from ....ros.qos import publisher_qos, stream_qos
-
-PARAMETERS = (
-    DESCRIPTION,
-    Param("mass_scale", 1.0, "true mass / the description's mass", gt=0.0, le=100.0),
-    Param("preload", float("nan"), "true spring preload F_0 (NaN = the description's)", "N",
-          ge=-1e5, le=1e5, nan=True),
-    Param("z0_offset", 0.03, "start height above touch-down height z_td", "m", ge=0.0, le=10.0),
-    Param("rate", 1000.0, "simulation and publishing rate", "Hz", ge=1.0, le=100000.0),
-    Param("command_timeout", 0.5, "a torque command older than this means zero torque",
-          "s wall", gt=0.0),
-    markers_rate(f"{topics.MARKERS}: body, links, spring coloured by its force, foot"),
-)
+from .parameters import SIM as PARAMETERS
 
 
 class LegSimNode(PlantNode):

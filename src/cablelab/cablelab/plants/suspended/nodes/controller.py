@@ -18,30 +18,16 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 from trajectory_msgs.msg import JointTrajectory
 
-from . import VARIANT, arm_reference
+from . import arm_reference
 from .. import topics
 from ..control import ArmLaw
 from ..mjcf import arm_joint_names
 from ..params import parameter_set
 from ....ros import convert
-from ....ros.params import Param, executor_params, merge
 from ....ros.plant_node import PlantNode
 from ....ros.qos import catch_up_qos, publisher_qos, stream_qos
 from ....rotations import quat_to_matrix, xyzw_to_wxyz
-
-PARAMETERS = merge((
-    VARIANT,
-    Param("excitation", "none", "built-in excitation of 000 Fig. 7 added to the reference",
-          choices=("none", "x", "y", "z"),
-          convert=lambda v: "y" if v is True else v),     # (YAML reads a bare y as true)
-    Param("excitation_level", 1, "level of the built-in excitation", ge=0, le=2),
-    Param("sway_damping", 0.0, "sway damping gain k_s on the r_y rate of /suspended/swing_estimate",
-          ge=0.0, le=1e3),
-    Param("estimate_stale", 0.2, "a swing estimate older than this (stamps) turns sway damping "
-          "off", "s", gt=0.0),
-    Param("pose_sync", False, "answer a joint state only once the pose of the same stamp "
-          "arrived (while poses flow)"),
-), executor_params(True))
+from .parameters import CONTROLLER as PARAMETERS
 
 
 class SuspendedController(PlantNode):

@@ -16,30 +16,13 @@ from geometry_msgs.msg import PoseStamped
 from sensor_msgs.msg import Imu, JointState
 
 from .. import topics
-from ..params import parameter_set
 from ..swing import CHANNELS, SwingEstimator
 from ....ros import convert
 from ....ros.inputs import WARN
-from ....ros.params import Param, executor_params, merge
 from ....ros.plant_node import PlantNode
 from ....ros.qos import catch_up_qos, publisher_qos
 from ....ros.status import add_problem
-
-PARAMETERS = merge((
-    Param("suspension_point", [float(x) for x in parameter_set("licas").S], "suspension point "
-          "S [x, y, z] (default: the LiCAS repo set)", "m", length=(3,), ge=-1e3, le=1e3),
-    Param("rest_position", [float("nan")] * 3, "rest position [x, y, z] (NaN: the mean over the "
-          "first rest_window s)", "m", length=(3,), ge=-1e3, le=1e3, nan=True),
-    Param("rest_yaw", float("nan"), "rest yaw (NaN: the mean over the first rest_window s)", "rad",
-          ge=-10.0, le=10.0, nan=True),
-    Param("rest_window", 2.0, "time the rest pose is averaged over", "s", gt=0.0, le=3600.0),
-    Param("imu_max_lag", 0.05, "yaw and yaw rate come from the IMU for poses within this of an "
-          "IMU sample (stamps)", "s", ge=0.0, le=10.0),
-    Param("velocity_tau", 0.05, "time constant smoothing the swing rates", "s", gt=0.0, le=10.0),
-    Param("pose_timeout", 0.5, "a pose older than this is stale", "s wall", gt=0.0),
-    Param("imu_timeout", 0.5, "an IMU sample older than this is stale (once the IMU was seen)",
-          "s wall", gt=0.0),
-), executor_params(True))
+from .parameters import ESTIMATOR as PARAMETERS
 
 
 class SuspendedSwingEstimator(PlantNode):

@@ -25,7 +25,7 @@ from sensor_msgs.msg import Imu, JointState
 from std_msgs.msg import Float64MultiArray
 from trajectory_msgs.msg import JointTrajectory
 
-from . import VARIANT, arm_reference
+from . import arm_reference
 from .. import topics
 from ..bag import description_yaml
 from ..markers import state_markers
@@ -39,38 +39,10 @@ from ....ros import convert
 from ....ros.clock import ClockPublisher
 from ....ros.lockstep import FREE, LockStep
 from ....ros.markers import start_markers
-from ....ros.params import START_GATE, Param, executor_params, markers_rate, merge
 from ....ros.plant_node import PlantNode
 from ....ros.qos import publisher_qos, stream_qos
 from ....rotations import wxyz_to_xyzw
-
-PARAMETERS = merge((
-    VARIANT,
-    Param("model", "virtual", "the virtual-joint model or the four-tendon truth plant",
-          choices=("virtual", "truth")),
-    Param("start_swing_x", 0.0, "initial swing about x", "rad", ge=-1.5, le=1.5),
-    Param("start_swing_y", 0.0, "initial swing about y", "rad", ge=-1.5, le=1.5),
-    Param("start_yaw", 0.0, "initial yaw", "rad", ge=-3.2, le=3.2),
-    Param("arm_input", "reference", "arm drives: position servos following /suspended/reference "
-          "or torque motors driven by /suspended/effort_commands", choices=("reference", "effort")),
-    Param("pose_noise", 0.0, "standard deviation of the measured platform position", "m",
-          ge=0.0, le=10.0),
-    Param("rate", 100.0, "publishing rate = command sampling (use 1000 with arm_input effort)",
-          "Hz", ge=1.0, le=10000.0),
-    Param("duration", 0.0, "simulated time after which the node exits (0 = run for ever)", "s",
-          ge=0.0),
-    Param("lockstep", False, "after a state, wait for the command answering it (needs "
-          "arm_input effort)"),
-    Param("lockstep_timeout", 10.0, "lock-step: without an answer for this long, real time with "
-          "zero torque until commands flow again", "s wall", gt=0.0),
-    Param("lockstep_resend", 0.25, "lock-step: the state is resent this often while waiting",
-          "s wall", gt=0.0, le=60.0),
-    Param("command_timeout", 0.5, "an effort command older than this means zero torque (WARN)",
-          "s wall", gt=0.0),
-    Param("imu", True, "publish /suspended/imu (orientation, gyro, accelerometer in the "
-          "platform frame)"),
-    markers_rate(f"{topics.MARKERS}: cables coloured by tension, platform, arms"),
-), START_GATE, executor_params(True))
+from .parameters import SIM as PARAMETERS
 
 
 class SuspendedSimNode(PlantNode):
