@@ -233,7 +233,7 @@ def test_controller_and_estimator_ignore_bad_states(ros_context):
     try:
         ctl.on_state(convert.joint_state_msg(1.0, ["joint"], [0.0], [0.0], [0.0]))
         assert not sent  # no reference yet: no command
-        ctl.on_reference(convert.joint_trajectory_msg(1.0, ["joint"], [0.1], [0.0], [0.0]))
+        ctl.reference.on_message(convert.joint_trajectory_msg(1.0, ["joint"], [0.1], [0.0], [0.0]))
         ctl.on_state(convert.joint_state_msg(1.0, ["joint"], [0.0], [0.0], [0.0]))
         assert len(sent) == 1 and sent[0].data[0] == pytest.approx(ctl.kp * 0.1)
         ctl.on_state(convert.joint_state_msg(1.0, ["joint"], [float("nan")], [0.0], [0.0]))
@@ -241,7 +241,7 @@ def test_controller_and_estimator_ignore_bad_states(ros_context):
         assert len(sent) == 1 and ctl.inputs.inputs["joint_states"].rejected == 2
         for m in (JointState(), convert.joint_state_msg(1.0, ["joint"], [0.0], [0.0], None)):
             est.on_state(m)
-        assert est.inputs.inputs["joint_states"].rejected == 2 and est.rls.n == 0
+        assert est.inputs.inputs["joint_states"].rejected == 2 and est.est.rls.n == 0
     finally:
         ctl.destroy_node()
         est.destroy_node()

@@ -7,8 +7,7 @@ sensor offset; the command held over the period that ends at that state),
 ``/plant_description`` (transient-local). ``lockstep``: the simulation advances one period only
 after the command answering the last published state arrived, so a loaded machine slows the run
 down instead of delaying the control loop (:class:`cablelab.ros.lockstep.LockStep`, ``wait_first``:
-answers to earlier states are counted on /diagnostics and ignored).
-Parameters: ``cable_sim_node --plant axis --help``.
+answers to earlier states are counted on /diagnostics and ignored). Parameters: :data:`.parameters.SIM`.
 """
 from __future__ import annotations
 
@@ -18,54 +17,37 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 
 from .. import topics
+from ..markers import axis_markers
+from ..sim import DEFAULT_DESCRIPTION, AxisSim, truth_from_parameters
 from ....description import load_description
-from ..sim import AxisSim, AxisTruth
 from ....ros import convert
-from ....ros.clock import ClockPublisher
 from ....ros.lockstep import FREE, LockStep
-from ....ros.markers import start_markers
 from ....ros.plant_node import PlantNode
-from ....ros.qos import publisher_qos, stream_qos
+from ....ros.qos import stream_qos
+from ....ros.simulator import start_simulation, state_publishers
+from ....ros.status import sim_values
 from .parameters import SIM as PARAMETERS
-
-DEFAULT_DESCRIPTION = ("plant: axis\nname: simulated linear axis\ngravity: 9.81\n"
-                       "axis:\n  joint_type: prismatic\n  inertia: 2.0\n")
 
 
 class AxisSimNode(PlantNode):
     def __init__(self):
         super().__init__("cable_sim_node")
         v = self.declare_params(PARAMETERS)
-        self.description = load_description(v.description or DEFAULT_DESCRIPTION)
-        nominal = self.description.axis.inertia if self.description.axis else None
-        inertia = v.inertia if v.inertia == v.inertia else float(nominal or 2.0)
-        truth = AxisTruth(inertia=inertia, viscous=v.viscous, coulomb=v.coulomb, offset=v.offset,
-                          timestep=v.timestep)
-        self.rate = v.rate
-        self.resend = v.lockstep_resend
+        desc = load_description(v.description or DEFAULT_DESCRIPTION)
+        self.sim = AxisSim(desc, truth_from_parameters(desc, v))
+        self.rate, self.resend, self.u = v.rate, v.lockstep_resend, 0.0
         self.lock = LockStep(v.lockstep, wait_first=True, resend=self.resend)
         self.start_gate()
-        self.sim = AxisSim(self.description, truth)
-        self.u = 0.0
         self.inputs.add("effort_command", timeout=v.command_timeout, length=1)
-
-        self.pub_js = self.create_publisher(JointState, topics.JOINT_STATES, publisher_qos())
-        self.pub_truth = self.create_publisher(JointState, topics.GROUND_TRUTH, publisher_qos())
-        self.clock = ClockPublisher(self)
-        self.publish_description(self.description)
+        self.pub_js, self.pub_truth = state_publishers(self, (JointState, topics.JOINT_STATES),
+                                                       (JointState, topics.GROUND_TRUTH))
         self.create_subscription(Float64MultiArray, topics.EFFORT_COMMAND, self.on_command, stream_qos())
-        self.start_diagnostics()
-        self.timer = self.create_timer(1.0 / self.rate, self.tick)
-        from ..markers import axis_markers
-
-        start_markers(self, "/axis/markers", lambda: axis_markers(self.description, self.sim.state()[1], truth.inertia),
-                      lambda: self.sim.t, v.markers_rate)
-        self.publish_state()
+        start_simulation(self, desc, 1.0 / self.rate, topics.MARKERS,
+                         lambda: axis_markers(desc, self.sim.state()[1], self.sim.truth.inertia),
+                         lambda: self.sim.t, v.markers_rate)
 
     def extend_status(self, level, msg, values):
-        values["sim time s"] = f"{self.sim.t:.3f}"
-        values["stale answers ignored (lock-step)"] = str(self.lock.stale_answers)
-        return level, msg, values
+        return level, msg, sim_values(values, self.sim.t, self.lock)
 
     def on_command(self, msg: Float64MultiArray) -> None:
         values = self.take_command("effort_command", msg, self.lock)
