@@ -1,13 +1,11 @@
 """Crane swing estimator node: theta1, theta2 and rope length from motion capture, live.
 
 Inputs: ``/crane/boom_tip_pose`` and ``/crane/payload_pose`` (PoseStamped, same stamps) and the
-slew angle from ``/crane/joint_states``. For each pose pair it runs
-:class:`cablelab.plants.crane.swing.SwingTracker` (the exact inverse of CONTRACT sec. 2 in the
-slewing frame, 002 sec. 6.3; velocities by smoothed differences) and publishes
-``/crane/swing_estimate`` (names theta1, theta2, rope_length; position and velocity) stamped like
-the poses. Dropouts (NaN poses), frozen stamps and gaps are counted and reported on /diagnostics.
-
-ROS parameters: :data:`PARAMETERS` (``payload_estimator --plant crane --help``).
+slew angle from ``/crane/joint_states``, paired by stamp (:class:`..posepairs.PosePairs`). Each pair
+goes through :class:`..swing.SwingTracker` (the exact inverse of CONTRACT sec. 2 in the slewing
+frame, 002 sec. 6.3; velocities by smoothed differences) to ``/crane/swing_estimate`` (names
+theta1, theta2, rope_length; position and velocity) stamped like the poses. Dropouts (NaN poses),
+frozen stamps and gaps are counted and reported on /diagnostics. Parameters: :data:`.parameters.ESTIMATOR`.
 """
 from __future__ import annotations
 
@@ -19,9 +17,9 @@ from ..posepairs import PosePairs
 from ..swing import SwingTracker
 from ....ros import convert
 from ....ros.inputs import WARN
-from ....ros.status import add_problem
 from ....ros.plant_node import PlantNode
 from ....ros.qos import catch_up_qos, publisher_qos
+from ....ros.status import add_problem
 from .parameters import ESTIMATOR as PARAMETERS
 
 NAMES = ["theta1", "theta2", "rope_length"]
@@ -31,8 +29,7 @@ class CraneSwingEstimator(PlantNode):
     def __init__(self):
         super().__init__("payload_estimator")
         v = self.declare_params(PARAMETERS)
-        self.tracker = SwingTracker(tau=v.velocity_tau)
-        self.pairs = PosePairs(v.max_wait)
+        self.tracker, self.pairs = SwingTracker(tau=v.velocity_tau), PosePairs(v.max_wait)
         self.inputs.add("boom_tip_pose", timeout=v.pose_timeout, length=3)
         self.inputs.add("payload_pose", timeout=v.pose_timeout, length=3)
         self.inputs.add("slew", timeout=v.slew_timeout, length=1)
@@ -54,12 +51,9 @@ class CraneSwingEstimator(PlantNode):
 
     def on_joints(self, msg: JointState) -> None:
         t, names, q, _qd, _eff = convert.joint_state_arrays(msg)
-        if q is None or "slew" not in names or len(names) != q.size:
-            self.accept("slew", None)
-            return
-        val = q[names.index("slew")]
-        if self.accept("slew", [val]):
-            self.pairs.slew(t, val)
+        ok = q is not None and "slew" in names and len(names) == q.size
+        if self.accept("slew", [q[names.index("slew")]] if ok else None):
+            self.pairs.slew(t, q[names.index("slew")])
             self.process()
 
     def on_tip(self, msg: PoseStamped) -> None:
@@ -77,7 +71,7 @@ class CraneSwingEstimator(PlantNode):
         """Estimate every pose pair whose slew angle is known (:meth:`PosePairs.ready
         <cablelab.plants.crane.posepairs.PosePairs.ready>`) and publish the estimates."""
         for t, tip, pay, slew in self.pairs.ready():
-            status, x, v = self.tracker.update(t, tip, pay, slew)
+            _status, x, v = self.tracker.update(t, tip, pay, slew)
             if x is not None:
                 self.pub.publish(convert.joint_state_msg(t, NAMES, x, v))
 
