@@ -257,6 +257,8 @@ class CraneSim:
     def time(self) -> float:
         return float(self.data.time)
 
+    t = time    #: the sim time, s (as the other plants' simulators name it)
+
     def advance(self, u, duration: float) -> None:
         u = np.asarray(u, dtype=float).reshape(3)
         self.u = u

@@ -11,8 +11,6 @@ answers to earlier states are counted on /diagnostics and ignored). Parameters: 
 """
 from __future__ import annotations
 
-import time
-
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 
@@ -21,47 +19,39 @@ from ..markers import axis_markers
 from ..sim import DEFAULT_DESCRIPTION, AxisSim, truth_from_parameters
 from ....description import load_description
 from ....ros import convert
-from ....ros.lockstep import FREE, LockStep
-from ....ros.plant_node import PlantNode
+from ....ros.lockstep import LockStep
 from ....ros.qos import stream_qos
-from ....ros.simulator import start_simulation, state_publishers
-from ....ros.status import sim_values
+from ....ros.simulator import FREE, SimulatorNode
 from .parameters import SIM as PARAMETERS
 
 
-class AxisSimNode(PlantNode):
+class AxisSimNode(SimulatorNode):
+    command = "effort_command"
+
     def __init__(self):
-        super().__init__("cable_sim_node")
+        super().__init__()
         v = self.declare_params(PARAMETERS)
         desc = load_description(v.description or DEFAULT_DESCRIPTION)
         self.sim = AxisSim(desc, truth_from_parameters(desc, v))
-        self.rate, self.resend, self.u = v.rate, v.lockstep_resend, 0.0
-        self.lock = LockStep(v.lockstep, wait_first=True, resend=self.resend)
+        self.rate, self.republish_every, self.u = v.rate, v.lockstep_resend, 0.0
+        self.lock = LockStep(v.lockstep, wait_first=True, resend=v.lockstep_resend)
         self.start_gate()
         self.inputs.add("effort_command", timeout=v.command_timeout, length=1)
-        self.pub_js, self.pub_truth = state_publishers(self, (JointState, topics.JOINT_STATES),
-                                                       (JointState, topics.GROUND_TRUTH))
+        self.pub_js, self.pub_truth = self.state_publishers((JointState, topics.JOINT_STATES),
+                                                            (JointState, topics.GROUND_TRUTH))
         self.create_subscription(Float64MultiArray, topics.EFFORT_COMMAND, self.on_command, stream_qos())
-        start_simulation(self, desc, 1.0 / self.rate, topics.MARKERS,
-                         lambda: axis_markers(desc, self.sim.state()[1], self.sim.truth.inertia),
-                         lambda: self.sim.t, v.markers_rate)
-
-    def extend_status(self, level, msg, values):
-        return level, msg, sim_values(values, self.sim.t, self.lock)
+        self.start_simulation(desc, 1.0 / self.rate, topics.MARKERS, lambda: axis_markers(
+            desc, self.sim.state()[1], self.sim.truth.inertia), v.markers_rate)
 
     def on_command(self, msg: Float64MultiArray) -> None:
         values = self.take_command("effort_command", msg, self.lock)
         if values is not None:
             self.u = float(values[0])
 
-    def tick(self) -> None:
-        step = self.may_step(self.lock, self.pub_js, self.publish_state, self.resend)
-        if step is None:
-            return
-        if step == FREE and not self.inputs.fresh("effort_command", time.monotonic()):
+    def step(self, kind: str, fresh: bool) -> None:
+        if kind == FREE and not fresh:
             self.u = 0.0  # no (fresh) command: the drive is switched off
         self.sim.advance(self.u, 1.0 / self.rate)
-        self.publish_state()
 
     def publish_state(self) -> None:
         t, q, qd = self.sim.state()
@@ -71,5 +61,5 @@ class AxisSimNode(PlantNode):
         self.pub_truth.publish(convert.joint_state_msg(t, ["joint"], [q], [qd], [self.u]))
 
 
-def make_node() -> PlantNode:
+def make_node() -> SimulatorNode:
     return AxisSimNode()

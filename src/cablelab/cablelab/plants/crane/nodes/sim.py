@@ -14,8 +14,6 @@ fresh command the drives hold the crane like a brake (:meth:`..sim.CraneSim.driv
 """
 from __future__ import annotations
 
-import time
-
 from geometry_msgs.msg import PoseStamped
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
@@ -26,30 +24,28 @@ from ..model import JOINTS
 from ..sim import live_sim
 from ....ros import convert
 from ....ros.inputs import ERROR
-from ....ros.lockstep import ADVANCE, LockStep
-from ....ros.plant_node import PlantNode
+from ....ros.lockstep import LockStep
 from ....ros.qos import stream_qos
-from ....ros.simulator import start_simulation, state_publishers
-from ....ros.status import add_problem, sim_values
+from ....ros.simulator import ADVANCE, SimulatorNode
+from ....ros.status import add_problem
 from .parameters import SIM as PARAMETERS
 
 
-class CraneSimNode(PlantNode):
+class CraneSimNode(SimulatorNode):
     def __init__(self):
-        super().__init__("cable_sim_node")
+        super().__init__()
         v = self.declare_params(PARAMETERS)
         desc, self.sim = live_sim(self.get_name(), v)
         self.rate, self.u = v.rate, None
         self.lock = LockStep(v.lockstep, wait_first=False, timeout=v.lockstep_timeout)
         self.start_gate()
         self.inputs.add("effort_commands", timeout=v.command_timeout, length=3)
-        self.pub_js, self.pub_tip, self.pub_pay, self.pub_truth = state_publishers(
-            self, (JointState, topics.JOINT_STATES), (PoseStamped, topics.TIP_POSE),
+        self.pub_js, self.pub_tip, self.pub_pay, self.pub_truth = self.state_publishers(
+            (JointState, topics.JOINT_STATES), (PoseStamped, topics.TIP_POSE),
             (PoseStamped, topics.PAYLOAD_POSE), (JointState, topics.SWING_TRUTH))
         self.create_subscription(Float64MultiArray, topics.EFFORT_COMMANDS, self.on_command, stream_qos())
-        start_simulation(self, desc, 1.0 / self.rate, topics.MARKERS,
-                         lambda: state_markers(desc, self.sim.state()[1]), lambda: self.sim.state()[0],
-                         v.markers_rate)
+        self.start_simulation(desc, 1.0 / self.rate, topics.MARKERS,
+                              lambda: state_markers(desc, self.sim.state()[1]), v.markers_rate)
 
     def extend_status(self, level, msg, values):
         s = self.sim
@@ -57,19 +53,16 @@ class CraneSimNode(PlantNode):
         if s.resets:
             level, msg = add_problem(level, msg, ERROR, f"simulation diverged {s.resets} times "
                                      "(restored at rest): commands too large?")
-        return level, msg, sim_values(values, lock=self.lock)
+        return super().extend_status(level, msg, values)
 
     def on_command(self, msg: Float64MultiArray) -> None:
         values = self.take_command("effort_commands", msg, self.lock)
         if values is not None:
             self.u = values.copy()       # (never applied late; lock-step starts with the next)
 
-    def tick(self) -> None:
-        step = self.may_step(self.lock, self.pub_js, self.publish_state)
-        if step is not None:              # (None: waiting for the answer to the last state)
-            self.sim.drive(self.u, 1.0 / self.rate, answered=step == ADVANCE, lockstep=self.lock.enabled,
-                           fresh=self.inputs.fresh("effort_commands", time.monotonic()))
-            self.publish_state()
+    def step(self, kind: str, fresh: bool) -> None:
+        self.sim.drive(self.u, 1.0 / self.rate, answered=kind == ADVANCE, fresh=fresh,
+                       lockstep=self.lock.enabled)
 
     def publish_state(self) -> None:
         t, q, qd = self.sim.state()
@@ -83,5 +76,5 @@ class CraneSimNode(PlantNode):
                                                        [q[3], q[4], q[2]], [qd[3], qd[4], qd[2]]))
 
 
-def make_node() -> PlantNode:
+def make_node() -> SimulatorNode:
     return CraneSimNode()

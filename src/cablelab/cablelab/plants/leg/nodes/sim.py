@@ -7,7 +7,6 @@ Parameters: :data:`.parameters.SIM`.
 from __future__ import annotations
 
 import math
-import time
 
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
@@ -18,45 +17,41 @@ from ..description import load_leg_description
 from ..live import LiveLeg
 from ..markers import sim_markers
 from ....ros import convert
-from ....ros.plant_node import PlantNode
 from ....ros.qos import stream_qos
-from ....ros.simulator import start_simulation, state_publishers
-from ....ros.status import sim_values
+from ....ros.simulator import SimulatorNode
 from .parameters import SIM as PARAMETERS
 
 
-class LegSimNode(PlantNode):
+class LegSimNode(SimulatorNode):
     def __init__(self):
-        super().__init__("cable_sim_node")
+        super().__init__()
         v = self.declare_params(PARAMETERS)
         desc = load_leg_description(v.description)
         self.leg = LiveLeg(desc, v.mass_scale, v.preload, v.z0_offset, v.rate)
-        self.sim, self.tau = self.leg.sim, 0.0
+        self.sim, self.tau, self.reading = self.leg.sim, 0.0, None
         self.inputs.add("effort_commands", timeout=v.command_timeout, length=1, required=False)
-        self.pub_js, self.pub_contact, self.pub_truth = state_publishers(
-            self, (JointState, topics.JOINT_STATES), (JointState, topics.CONTACT),
-            (JointState, topics.GROUND_TRUTH))
+        self.pub_js, self.pub_contact, self.pub_truth = self.state_publishers(
+            (JointState, topics.JOINT_STATES), (JointState, topics.CONTACT), (JointState, topics.GROUND_TRUTH))
         self.create_subscription(Float64MultiArray, topics.EFFORT_COMMANDS, self.on_command, stream_qos())
-        start_simulation(self, desc, 1.0 / v.rate, topics.MARKERS, lambda: sim_markers(self.sim),
-                         lambda: self.sim.t, v.markers_rate, publish_first=False)
+        self.start_simulation(desc, 1.0 / v.rate, topics.MARKERS, lambda: sim_markers(self.sim),
+                              v.markers_rate, publish_first=False)
 
     def extend_status(self, level, msg, values):
         values["events"] = str(len(self.sim.events))
-        return level, msg or "ok", sim_values(values, self.sim.t)
+        return super().extend_status(level, msg or "ok", values)
 
     def on_command(self, msg: Float64MultiArray) -> None:
         values = self.take_command("effort_commands", msg)
         if values is not None:
             self.tau = float(values[0])
 
-    def tick(self) -> None:
-        if not self.inputs.fresh("effort_commands", time.monotonic()):
+    def step(self, kind: str, fresh: bool) -> None:
+        if not fresh:
             self.tau = 0.0
-        self.publish_state(*self.leg.step(self.tau))
+        self.reading = self.leg.step(self.tau)      # (z, zd, theta) of the encoder
 
-    def publish_state(self, z: float, zd: float, theta: float) -> None:
-        """Publish the measured state (:meth:`LiveLeg.step <..live.LiveLeg.step>`) and the truth."""
-        s = self.sim
+    def publish_state(self) -> None:
+        s, (z, zd, theta) = self.sim, self.reading
         self.clock.publish(s.t)
         self.pub_js.publish(convert.joint_state_msg(s.t, ["body", "motor"], [z, theta], [zd, 0.0],
                                                     [s.f_in, self.tau]))
@@ -65,5 +60,5 @@ class LegSimNode(PlantNode):
         self.pub_truth.publish(hop_msg(s.t, s.z, s.zd, s.phase, math.nan, apex_time, s.grf()))
 
 
-def make_node() -> PlantNode:
+def make_node() -> SimulatorNode:
     return LegSimNode()

@@ -7,9 +7,10 @@ from __future__ import annotations
 
 from .. import topics
 from ..params import VARIANTS, parameter_set
+from ....errors import CablelabError
 from ....ros.params import START_GATE, Param, executor_params, markers_rate, merge
 
-__all__ = ["SIM", "ESTIMATOR", "CONTROLLER", "VARIANT"]
+__all__ = ["SIM", "ESTIMATOR", "CONTROLLER", "VARIANT", "check_sim"]
 
 #: the simulator's and the controller's ``variant``
 VARIANT = Param("variant", "licas", "which platform: LiCAS or CRANEbot", choices=VARIANTS)
@@ -42,6 +43,16 @@ SIM = merge((
           "platform frame)"),
     markers_rate(f"{topics.MARKERS}: cables coloured by tension, platform, arms"),
 ), START_GATE, executor_params(True))
+
+
+
+def check_sim(v) -> None:
+    """The rule between :data:`SIM`'s validated values ``v``: lock-step waits for effort
+    commands, so ``lockstep`` needs ``arm_input:=effort`` (one-line error otherwise)."""
+    if v.lockstep and v.arm_input != "effort":
+        raise CablelabError("cable_sim_node suspended: parameter lockstep=true needs "
+                            "arm_input=effort (lock-step waits for effort commands)")
+
 
 #: ``payload_estimator --plant suspended``: the swing estimator and its inputs' timeouts
 ESTIMATOR = merge((
