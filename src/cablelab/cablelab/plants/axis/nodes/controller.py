@@ -17,7 +17,7 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 
 from .. import topics
-from ..control import pd_feedforward, sine_reference
+from ..control import pd_feedforward, sine_trajectory
 from ....ros import convert
 from ....ros.plant_node import PlantNode
 from ....ros.qos import publisher_qos, stream_qos
@@ -31,8 +31,7 @@ class AxisController(PlantNode):
         v = self.declare_params(PARAMETERS)
         self.kp, self.kd, self.inertia_param = v.kp, v.kd, v.inertia
         self.inertia = 0.0 if np.isnan(v.inertia) else v.inertia
-        sine = None if v.reference_source != "sine" else lambda t, _q0: tuple(
-            np.reshape(x, (-1, 1)) for x in sine_reference(t, v.amplitude, v.frequency, v.offset))
+        sine = sine_trajectory(v.amplitude, v.frequency, v.offset) if v.reference_source == "sine" else None
         self.reference = FollowedReference(self, topics.REFERENCE, ["joint"], v.reference_bag, sine,
                                            v.reference_timeout, absolute=True, any_names=True)
         self.inputs.add("joint_states", timeout=0.5, length=1)
