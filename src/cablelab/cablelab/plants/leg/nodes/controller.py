@@ -1,8 +1,8 @@
 """Leg controller node: ``/leg/hop_estimate`` (+ ``/leg/reference`` apex height, or a schedule
 written by ``cablelab excite``: ``reference_bag``, played from the first estimate on and published
-on ``/leg/reference``) -> :class:`~..controller.ApexController` -> ``/leg/effort_commands``.
+on ``/leg/reference``) -> :class:`~..control.ApexController` -> ``/leg/effort_commands``.
 
-ROS parameters: :data:`PARAMETERS` (``pd_feedforward --plant leg --help``).
+Parameters: :data:`.parameters.CONTROLLER`.
 """
 from __future__ import annotations
 
@@ -32,7 +32,6 @@ class LegControllerNode(PlantNode):
         params = leg_of(self.description).params(self.description.gravity)
         self.ctl = ApexController(params, params.z_td + v.h_des, T=v.T, P=v.P, k_i=v.k_i, k_ff=v.k_ff,
                                   T_max=v.T_max, mode=v.mode)
-        self.last_apex = math.nan
         self.player = ReferencePlayer.from_bag(self, v.reference_bag, topics.REFERENCE, ["apex_height"]) \
             if v.reference_bag else None
         self.inputs.add("hop_estimate", timeout=0.5)
@@ -60,11 +59,7 @@ class LegControllerNode(PlantNode):
         if self.player is not None:
             self.ctl.h_des = float(self.player(t, pos)[0][0])
         ia = names.index("apex_height")
-        h, ta = float(pos[ia]), float(vel[ia])
-        if math.isfinite(ta) and ta != self.last_apex:
-            self.last_apex = ta
-            self.ctl.on_apex(h)
-        tau = self.ctl.torque(t, int(round(pos[names.index("phase")])))
+        tau = self.ctl.step(t, int(round(pos[names.index("phase")])), float(pos[ia]), float(vel[ia]))
         self.pub.publish(convert.command_msg([tau], stamp=t))
 
 

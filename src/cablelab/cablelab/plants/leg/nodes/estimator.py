@@ -2,7 +2,7 @@
 :class:`~..estimator.HopEstimator` -> ``/leg/hop_estimate``; /diagnostics reports the phase
 source, chattering flips, switch/height disagreements and dropouts.
 
-ROS parameters: :data:`PARAMETERS` (``payload_estimator --plant leg --help``).
+Parameters: :data:`.parameters.ESTIMATOR`.
 """
 from __future__ import annotations
 
