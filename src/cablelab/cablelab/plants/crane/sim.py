@@ -314,7 +314,7 @@ class CraneSim:
 
 def truth_from_parameters(node: str, params: CraneParams, v) -> tuple[CraneTruth, tuple]:
     """The simulated crane's truth and initial ``(slew, luff, rope length)`` from the validated
-    simulator node parameters ``v`` (:data:`cablelab.plants.crane.nodes.sim.PARAMETERS`); a
+    simulator node parameters ``v`` (:data:`cablelab.plants.crane.nodes.parameters.SIM`); a
     one-line error naming ``node`` for a rope length that is not positive."""
     q0 = tuple(v.initial)
     if q0[2] <= 0:
