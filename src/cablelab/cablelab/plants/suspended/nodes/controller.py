@@ -14,9 +14,7 @@ import numpy as np
 from geometry_msgs.msg import PoseStamped
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
-from trajectory_msgs.msg import JointTrajectory
 
-from . import arm_reference
 from .. import topics
 from ..control import ArmLaw
 from ..mjcf import arm_joint_names
@@ -24,7 +22,8 @@ from ..params import parameter_set
 from ..posesync import PoseSync
 from ....ros import convert
 from ....ros.plant_node import PlantNode
-from ....ros.qos import catch_up_qos, publisher_qos, stream_qos
+from ....ros.qos import catch_up_qos, publisher_qos
+from ....ros.reference import FollowedReference
 from .parameters import CONTROLLER as PARAMETERS
 
 
@@ -38,18 +37,17 @@ class SuspendedController(PlantNode):
         self.law = ArmLaw(params, v.excitation, v.excitation_level, v.sway_damping, v.estimate_stale)
         self.use_fast_executor()
         self.sync = PoseSync(v.pose_sync)
-        self.q_ref, self.qd_ref = np.zeros(n), np.zeros(n)
+        self.at_rest = (np.zeros(n), np.zeros(n))      # the reference until one arrives
         self.v_swing, self.t_swing = np.nan, -np.inf
         self.inputs.add("joint_states", timeout=0.5, length=n)
         self.inputs.add("platform_pose", timeout=0.5, length=3)
-        self.inputs.add("reference", timeout=1e9, length=n)
         self.pub = self.create_publisher(Float64MultiArray, topics.EFFORT_COMMANDS, publisher_qos())
         # (pose first: an executor taking one sample per topic per round in creation order then
         # has the attitude of a state before the state, as the simulator publishes them)
         self.create_subscription(PoseStamped, topics.PLATFORM_POSE, self.on_pose, catch_up_qos())
         self.create_subscription(JointState, topics.JOINT_STATES, self.on_joints, catch_up_qos())
         self.create_subscription(JointState, topics.SWING_ESTIMATE, self.on_swing, catch_up_qos())
-        self.create_subscription(JointTrajectory, topics.REFERENCE, self.on_reference, stream_qos())
+        self.reference = FollowedReference(self, topics.REFERENCE, self.names, timeout=1e9)
         self.start_diagnostics()
 
     def on_pose(self, msg: PoseStamped) -> None:
@@ -62,11 +60,6 @@ class SuspendedController(PlantNode):
         if qd is not None and "r_y" in names and len(qd) == len(names) and np.isfinite(qd[names.index("r_y")]):
             self.v_swing, self.t_swing = float(qd[names.index("r_y")]), t
 
-    def on_reference(self, msg: JointTrajectory) -> None:
-        ref = arm_reference(self, msg, self.names)
-        if ref is not None:
-            self.q_ref, self.qd_ref = ref
-
     def on_joints(self, msg: JointState) -> None:
         t, names, q, qd, _ = convert.joint_state_arrays(msg)
         ok = q is not None and qd is not None and names == self.names and len(q) == len(names)
@@ -77,7 +70,8 @@ class SuspendedController(PlantNode):
         """Publish the command answering the joint state ``(t, q, qd)`` (nothing for None)."""
         if state is not None:
             t, q, qd = state
-            tau = self.law.torque(t, q, qd, self.q_ref, self.qd_ref, self.sync.R, self.v_swing, t - self.t_swing)
+            q_ref, qd_ref = (self.reference(t, q) or self.at_rest)[:2]
+            tau = self.law.torque(t, q, qd, q_ref, qd_ref, self.sync.R, self.v_swing, t - self.t_swing)
             self.pub.publish(convert.command_msg(tau, t))
 
 
