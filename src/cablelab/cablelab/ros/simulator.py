@@ -51,6 +51,7 @@ class SimulatorNode(PlantNode):
         super().__init__(name, **node_kwargs)
         self.done = False
         self.pub_gate = None       # the state publisher the start gate counts subscribers of
+        self.wait_subs = 0         # no start gate unless the node calls start_gate()
 
     def state_publishers(self, *kinds_topics) -> list:
         """A publisher (the state QoS, :func:`~cablelab.ros.qos.publisher_qos`) per ``(message
