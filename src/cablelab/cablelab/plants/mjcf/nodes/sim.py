@@ -19,9 +19,7 @@ from std_msgs.msg import Float64MultiArray
 from ....description import load_description
 from ....errors import CablelabError
 from ....ros import convert
-from ....ros.clock import ClockPublisher
-from ....ros.plant_node import PlantNode
-from ....ros.qos import publisher_qos
+from ....ros.simulator import SimulatorNode
 from ..description import section_of
 from ..markers import sim_markers
 from ..sim import MjcfSim, default_description, hidden_payload, publish_period
@@ -29,40 +27,34 @@ from ..topics import topic
 from .parameters import SIM as PARAMETERS
 
 
-class MjcfSimNode(PlantNode):
+class MjcfSimNode(SimulatorNode):
     def __init__(self):
-        super().__init__("cable_sim_node")
+        super().__init__()
         v = self.declare_params(PARAMETERS)
         self.description = load_description(v.description or default_description())
         sec = section_of(self.description)
         self.sim = MjcfSim(sec, self.description.gravity, hidden_payload(sec, v.payload_mass))
-        self.period = publish_period(self.sim.model.opt.timestep, v.rate)
         self.ctrl = [0.0] * self.sim.model.nu
         self.start_gate()
-        pub = lambda key: self.create_publisher(JointState, topic(sec, key), publisher_qos())  # noqa: E731
-        self.pub_js, self.pub_truth = pub("joint_states"), pub("ground_truth_joint_states")
-        self.pub_ten = pub("cable_tensions") if sec.tendons else None
-        self.clock = ClockPublisher(self)
-        self.publish_description(self.description)
+        self.pub_js, self.pub_truth, self.pub_ten = self.state_publishers(
+            (JointState, topic(sec, "joint_states")), (JointState, topic(sec, "ground_truth_joint_states")),
+            (JointState, topic(sec, "cable_tensions") if sec.tendons else None))
         self.command_input(topic(sec, "effort_commands"), self.sim.model.nu, v.command_timeout)
-        self.start_stepping(self.period, topic(sec, "markers"), lambda: sim_markers(self.sim),
-                            lambda: self.sim.t, v.markers_rate)
-
-    def extend_status(self, level, msg, values):
-        values["sim time s"] = f"{self.sim.t:.3f}"
-        return level, msg, values
+        self.start_simulation(self.description, publish_period(self.sim.model.opt.timestep, v.rate),
+                              topic(sec, "markers"), lambda: sim_markers(self.sim), v.markers_rate)
 
     def on_command(self, msg: Float64MultiArray) -> None:
         if (values := self.take_command("effort_commands", msg)) is not None:
             self.ctrl = [float(x) for x in values]
 
     def tick(self) -> None:
-        if self.waiting_for_subscribers(self.pub_js, self.last_publish, self.publish_state):
-            return
-        if not self.inputs.fresh("effort_commands", time.monotonic()):
+        if not self.waiting_for_subscribers(self.pub_js, self.last_publish, self.publish_state):
+            super().tick()
+
+    def step(self, kind: str, fresh: bool) -> None:
+        if not fresh:
             self.ctrl = [0.0] * self.sim.model.nu       # no (fresh) command: drives off
         self.sim.advance(self.ctrl, self.period)
-        self.publish_state()
 
     def publish_state(self) -> None:
         self.last_publish = time.monotonic()
@@ -76,5 +68,5 @@ class MjcfSimNode(PlantNode):
             self.pub_ten.publish(convert.joint_state_msg(t, self.sim.tendons, None, None, tension))
 
 
-def make_node() -> PlantNode:
+def make_node() -> SimulatorNode:
     return MjcfSimNode()
