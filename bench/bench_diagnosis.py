@@ -280,9 +280,11 @@ def main() -> None:
                               help="designed-experiment cases instead of the others (crane=N, cdpr=N: "
                                    "draw_designed_case of bench/cases_<plant>.py, seeds from "
                                    + ", ".join(f"{v} ({k})" for k, v in DESIGNED_SEEDS.items()) + ")")
+    bench.parser.add_argument("--workers", type=int, default=1,
+                              help="processes for the --designed cases (default 1)")
     args = bench.parse()
     if args.designed:
-        designed(bench, args.designed)
+        designed(bench, args.designed, args.workers)
         bench.done()
         return
     n_cases = 30 if args.quick else args.cases
@@ -317,10 +319,9 @@ def main() -> None:
 DESIGNED_SEEDS = {"crane": 6000, "cdpr": 7000}
 
 
-def designed(bench, spec: str) -> None:
+def designed(bench, spec: str, workers: int = 1) -> None:
     """Run the designed-experiment cases ``spec`` (``crane=N,cdpr=M``) and print their tables."""
     from tqdm import tqdm
-    import importlib
 
     jobs = []
     for item in filter(None, spec.split(",")):
@@ -328,12 +329,28 @@ def designed(bench, spec: str) -> None:
         if name.strip() not in DESIGNED_SEEDS:
             bench.parser.error(f"--designed: no designed cases for {name!r} (have: {', '.join(DESIGNED_SEEDS)})")
         jobs += [(name.strip(), k) for k in range(int(num))]
-    results = []
     with tempfile.TemporaryDirectory() as d:
-        for p, k in tqdm(jobs, desc="designed cases", file=sys.stderr):
-            gen = importlib.import_module(PLANT_CASES[p][0])
-            results.append(run_designed_case(gen.draw_designed_case(DESIGNED_SEEDS[p] + k), gen, d))
+        if workers > 1:                  # cases in parallel processes, results in job order
+            from concurrent.futures import ProcessPoolExecutor
+
+            with ProcessPoolExecutor(workers) as pool:
+                results = list(tqdm(pool.map(_designed_job, jobs, [d] * len(jobs)), total=len(jobs),
+                                    desc="designed cases", file=sys.stderr))
+        else:
+            results = [_designed_job(job, d) for job in tqdm(jobs, desc="designed cases", file=sys.stderr)]
     summarise_designed(bench, results)
+
+
+def _designed_job(job, workdir: str) -> dict:
+    """One designed case ``job = (plant, k)``; the result without the case's reference function
+    (so that it crosses a process boundary)."""
+    import importlib
+
+    p, k = job
+    gen = importlib.import_module(PLANT_CASES[p][0])
+    r = run_designed_case(gen.draw_designed_case(DESIGNED_SEEDS[p] + k), gen, workdir)
+    r["case"].truth.pop("reference", None)
+    return r
 
 
 def _rates(rs) -> dict:

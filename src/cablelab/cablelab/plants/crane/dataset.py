@@ -92,15 +92,17 @@ def dataset_from_arrays(t, q_joints, effort, t_mocap, tip, payload, description,
     if parallel:
         from ...parallel_filter import edge_mask, parallel_filter
 
+        # the drives' speeds in the band of the efforts decide their zero-speed zones (below)
         ds = ds.replace(y=parallel_filter(ds.y, ds.t, parallel), parallel_hz=parallel,
-                        valid=ds.valid & edge_mask(ds.t, parallel))
+                        valid=ds.valid & edge_mask(ds.t, parallel),
+                        signals={**ds.signals, "rest_velocity": parallel_filter(qd[:, :3], ds.t, parallel)})
     # drives that stop (issue 10): samples in the zero-speed zone of slew, luff or hoist are not
     # fitted, as for the axis (cablelab.velocity): there the smooth friction band holds any
     # effort and the sign of a filtered, quantized encoder velocity is noise
     from ...velocity import exclude_zero_speed, position_quantum, speed_resolution
 
     ok_q = q_joints[ok]
-    floor = np.array([speed_resolution(position_quantum(ok_q[:, j]), c["cutoff_hz"]) for j in range(3)])
+    floor = np.array([speed_resolution(position_quantum(ok_q[:, j]), parallel or c["cutoff_hz"]) for j in range(3)])
     return exclude_zero_speed(ds, floor=floor)
 
 
