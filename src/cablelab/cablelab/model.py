@@ -105,21 +105,25 @@ class Model:
             from .parallel_filter import parallel_filter
 
             phi = parallel_filter(phi, ds.t, ds.parallel_hz)
-        y_known = np.zeros((ds.n, ds.n_channels))
+        if known:
+            phi_known, phi = phi[:, :, known], phi[:, :, free]
+        # (every column free: phi, built above, is returned as it is, not copied again)
         nominal = ds.signals.get(KNOWN_OUTPUT)
         if nominal is not None:
             # the plant's own parameter-free prediction (e.g. MuJoCo's inverse dynamics of the
-            # given model), filtered like the columns
+            # given model), filtered like the columns; a copy (the dataset's signal stays its own)
             nominal = np.asarray(nominal, dtype=float).reshape(ds.n, ds.n_channels)
             if ds.parallel_hz:
                 from .parallel_filter import parallel_filter
 
                 nominal = parallel_filter(nominal[:, :, None], ds.t, ds.parallel_hz)[:, :, 0]
-            y_known = y_known + nominal
+            y_known = nominal + 0.0
+        else:
+            y_known = np.zeros((ds.n, ds.n_channels))
         if known:
             vals = np.array([self.fixed[names[i]] for i in known])
-            y_known = y_known + phi[:, :, known] @ vals
-        return phi[:, :, free], [cols[i] for i in free], y_known
+            y_known = y_known + phi_known @ vals
+        return phi, [cols[i] for i in free], y_known
 
     def evaluate(self, ds: Dataset, values: Mapping[str, float]) -> "Evaluation":
         """The model on a dataset at given nonlinear parameter values: the transformed dataset

@@ -85,10 +85,19 @@ def derived_regimes(ds: Dataset) -> dict[str, np.ndarray]:
     return out
 
 
-def residual_by_regime(residual: np.ndarray, y: np.ndarray, regimes: dict[str, np.ndarray],
-                       channels) -> list[dict]:
+def factorise_regimes(regimes: dict[str, np.ndarray]) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """Each regime's label array as ``(sorted distinct labels, (N,) index into them)``: what
+    :func:`residual_by_regime` works on, computed once when it is called for many residuals of
+    the same dataset (string labels are slow to compare and sort)."""
+    return {k: np.unique(np.asarray(v), return_inverse=True) for k, v in regimes.items()}
+
+
+def residual_by_regime(residual: np.ndarray, y: np.ndarray, regimes: dict, channels) -> list[dict]:
     """Residual RMS and mean per regime label, normalised by the channel RMS.
 
+    Args:
+        regimes: name -> (N,) label array, or the ``(labels, index)`` pair of
+            :func:`factorise_regimes`.
     Returns:
         ``[{"regime", "label", "channel", "n", "rms", "mean", "nrmse"}]``.
     """
@@ -96,9 +105,12 @@ def residual_by_regime(residual: np.ndarray, y: np.ndarray, regimes: dict[str, n
     rms_y = np.sqrt(np.mean(y[ok] ** 2, axis=0))
     out = []
     for rname, labels in regimes.items():
-        labels = np.asarray(labels)
-        for lab in np.unique(labels[ok]):
-            m = ok & (labels == lab)
+        uniq, code = labels if isinstance(labels, tuple) else \
+            np.unique(np.asarray(labels), return_inverse=True)
+        code = np.asarray(code).reshape(-1)
+        for k in np.flatnonzero(np.bincount(code[ok], minlength=len(uniq))):
+            lab = uniq[k]
+            m = ok & (code == k)
             r = residual[m]
             for c, ch in enumerate(channels):
                 rms = float(np.sqrt(np.mean(r[:, c] ** 2)))

@@ -34,7 +34,7 @@ from ..fit.identification import lag1_autocorrelation
 from ..fit.threads import blas_single
 from ..dataset import Dataset
 from ..model import Model
-from .localise import derived_regimes, residual_by_regime
+from .localise import derived_regimes, factorise_regimes, residual_by_regime
 from .result import Candidate, Diagnosis, Step
 from .score import channel_nrmse, heldout_error, lr_significance, practical_gain
 
@@ -262,7 +262,7 @@ def rank_candidates(model: Model, ds: Dataset, candidates, *, folds: int = FOLDS
     prog = _Progress(len(cands) + 1, "diagnose", quiet)
     base_full = identify(model, ds)
     err0, ym0, yh0 = cv_error(model, ds, folds, start=base_full.params)
-    regimes = derived_regimes(ds)
+    regimes = factorise_regimes(derived_regimes(ds))
     y_ref = base_full.residual + base_full.y_hat
     by_regime0 = residual_by_regime(base_full.residual, y_ref, regimes, ds.channels)
     prog.step("baseline")

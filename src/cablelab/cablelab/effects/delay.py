@@ -53,7 +53,12 @@ def shift_weights(t: np.ndarray, tau: float) -> tuple[np.ndarray, np.ndarray, np
 def shift_array(x: np.ndarray, i: np.ndarray, w: np.ndarray) -> np.ndarray:
     """Linear interpolation of an (N, ...) array with :func:`shift_weights` along axis 0."""
     wb = w.reshape((-1,) + (1,) * (x.ndim - 1))
-    return x[i] * (1.0 - wb) + x[i + 1] * wb
+    out = x.take(i, axis=0)
+    out *= 1.0 - wb
+    upper = x.take(i + 1, axis=0)
+    upper *= wb
+    out += upper
+    return out
 
 
 def _time_indexed(v, n: int) -> bool:

@@ -23,6 +23,12 @@ from .linear import LinearFit, RankDeficient, solve_linear, unexcited_columns
 
 #: grid points per nonlinear parameter for the start of the outer search
 OUTER_GRID = 11
+#: the outer search stops when this many residual evaluations in a row found no lower cost than
+#: the best so far and returns the best point: at a kink of the cost (a delay at a whole number
+#: of samples, where linear interpolation switches neighbours) the finite-difference step never
+#: reduces it and the optimiser would otherwise raise its damping through its whole range, one
+#: evaluation per step (about 140 evaluations that all return the start)
+OUTER_STALL = 24
 
 
 @dataclass
@@ -262,6 +268,10 @@ def held_warning(held: Mapping[str, float], units: Mapping[str, str] | None = No
             f"neutral values: {vals}; record motion that excites them, or --strict to refuse")
 
 
+class _Stalled(Exception):
+    """The outer search found no lower cost in :data:`OUTER_STALL` evaluations in a row."""
+
+
 def _outer_search(model: Model, ds: Dataset, nl_params: list, valid: np.ndarray, channel_scale,
                   outer_grid: int, start: Mapping[str, float] | None):
     """The outer problem of the separable least squares: the nonlinear parameter values that
@@ -277,10 +287,14 @@ def _outer_search(model: Model, ds: Dataset, nl_params: list, valid: np.ndarray,
     lo = np.array([p.lower for p in nl_params])
     hi = np.array([p.upper for p in nl_params])
     outer = _OuterProblem(model, ds, valid, names, channel_scale)
+    costs: dict[bytes, float] = {}      # cost by point: the checks below re-read evaluated ones
 
     def cost(x):
-        r = outer.residual(x)
-        return float(r @ r)
+        key = np.asarray(x, dtype=float).tobytes()
+        if key not in costs:
+            r = outer.residual(x)
+            costs[key] = float(r @ r)
+        return costs[key]
 
     grid = [np.linspace(a, b, outer_grid) for a, b in zip(lo, hi)]
     if start is not None and all(k in start for k in names):
@@ -291,15 +305,34 @@ def _outer_search(model: Model, ds: Dataset, nl_params: list, valid: np.ndarray,
         pts = np.array(list(itertools.product(*grid)))
         x0 = pts[int(np.argmin([cost(x) for x in pts]))]
 
+    best = {"cost": np.inf, "x": x0, "stale": 0}
+
+    def one(x):
+        r = outer.residual(x)
+        c = costs[np.asarray(x, dtype=float).tobytes()] = float(r @ r)
+        if c < best["cost"]:
+            best.update(cost=c, x=np.array(x, dtype=float), stale=0)
+        else:
+            best["stale"] += 1
+        return r
+
     def residual(xs):
         xs = np.asarray(xs).reshape(len(names), -1)
-        return np.stack([outer.residual(xs[:, k]) for k in range(xs.shape[1])], axis=1)
+        cols = []
+        for k in range(xs.shape[1]):
+            cols.append(one(xs[:, k]))
+            if best["stale"] >= OUTER_STALL:
+                raise _Stalled
+        return np.stack(cols, axis=1)
 
     import mujoco.minimize as mjmin
 
     grid_step = np.array([(b - a) / (outer_grid - 1) for a, b in zip(lo, hi)])
-    x_best, _ = mjmin.least_squares(x0, residual, bounds=[lo, hi], verbose=0,
-                                    x_scale=grid_step, max_iter=20, xtol=1e-4)
+    try:
+        x_best, _ = mjmin.least_squares(x0, residual, bounds=[lo, hi], verbose=0,
+                                        x_scale=grid_step, max_iter=20, xtol=1e-4)
+    except _Stalled:
+        x_best = best["x"]
     x_best = np.clip(np.asarray(x_best).reshape(-1), lo, hi)
     if cost(x_best) > cost(x0):
         x_best = x0
@@ -392,7 +425,7 @@ def _identify_once(model: Model, ds: Dataset, *, on_deficient: str = "raise",
     # every `step` samples (parallel-filtered data: one sample per 1 / (2 f_c), else every one)
     step = sample_step(ds)
     r1 = lag1_autocorrelation(resid, step)
-    inflation = float(np.sqrt(resid.shape[0] / effective_samples(resid, step)))
+    inflation = float(np.sqrt(resid.shape[0] / effective_samples(resid, step, lag1=r1)))
     white = dict(stderr)
     stderr = {k: v * inflation for k, v in stderr.items()}
     return Identification(model, params, stderr, units, tuple(model.fixed), fit, y_hat, resid,
@@ -449,14 +482,15 @@ def sample_step(ds: Dataset) -> int:
     return max(1, int(ds.fs / (2.0 * float(ds.parallel_hz)))) if ds.parallel_hz else 1
 
 
-def effective_samples(residual: np.ndarray, step: int = 1) -> float:
+def effective_samples(residual: np.ndarray, step: int = 1, *, lag1: float | None = None) -> float:
     """AR(1) effective sample size of a residual (N,) or (N, C) taken every ``step`` samples:
     ``(n / step) (1 - r) / (1 + r)``, r the lag-``step`` autocorrelation
     (:func:`lag1_autocorrelation`), n the finite rows; at least 3. ``step`` = 1 is the plain
-    AR(1) formula; :func:`sample_step` gives the step of a parallel-filtered dataset."""
+    AR(1) formula; :func:`sample_step` gives the step of a parallel-filtered dataset. ``lag1``:
+    that autocorrelation when the caller has it already."""
     r = np.asarray(residual, dtype=float)
     n = int(np.isfinite(r.reshape(r.shape[0], -1)).all(axis=1).sum())
-    a = lag1_autocorrelation(r, step)
+    a = lag1_autocorrelation(r, step) if lag1 is None else float(lag1)
     return max(n / max(1, int(step)) * (1.0 - a) / (1.0 + a), 3.0)
 
 

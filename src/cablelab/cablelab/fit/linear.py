@@ -3,7 +3,9 @@
 ``solve_linear(phi, y, params)`` solves ``y = phi @ theta`` over N samples and C channels with:
 
 * channel weighting (each channel divided by its RMS so torques and forces weigh alike),
-* column scaling, SVD rank and condition number on the scaled regressor,
+* column scaling, SVD rank and condition number on the scaled regressor (for a well-conditioned
+  regressor from the small ``p x p`` Gram matrix of the scaled columns, see :func:`_solve_gram`;
+  otherwise, and for every rank decision near the threshold, from the SVD of the tall regressor),
 * unidentifiable directions named as parameter combinations (null space of the scaled regressor)
   instead of returning nonsense; optionally base parameters by QR with column pivoting
   (002 sec. 5.3: dependent columns regrouped into the independent ones),
@@ -27,6 +29,10 @@ from ..effects.base import Param
 RANK_TOL = 1e-8
 #: columns with a norm below ZERO_COLUMN * the largest column norm count as not excited
 ZERO_COLUMN = 1e-7
+#: largest condition number (2-norm, column-scaled) solved through the Gram matrix; above it the
+#: SVD of the tall regressor decides rank and solution (the Gram matrix squares the condition
+#: number: at 1e5 its smallest eigenvalue still carries about 6 correct digits)
+GRAM_COND = 1e5
 
 
 class RankDeficient(CablelabError):
@@ -127,7 +133,7 @@ def solve_linear(phi: np.ndarray, y: np.ndarray, params: Sequence[Param], *,
     if len(names) != p:
         raise ValueError(f"{len(names)} params for {p} regressor columns")
     mask = np.ones(n_s, dtype=bool) if valid is None else np.asarray(valid, dtype=bool).copy()
-    mask &= np.isfinite(y).all(axis=1) & np.isfinite(phi).all(axis=(1, 2))
+    mask &= np.isfinite(y).all(axis=1) & np.isfinite(phi.reshape(n_s, n_c * p)).all(axis=1)
     if isinstance(channel_scale, str):
         if channel_scale != "rms":
             raise ValueError(f"channel_scale {channel_scale!r}")
@@ -148,6 +154,17 @@ def solve_linear(phi: np.ndarray, y: np.ndarray, params: Sequence[Param], *,
         rss = float(b @ b)
         return LinearFit((), (), np.zeros(0), np.zeros(0), np.zeros((0, 0)), 0, 1.0, n, rss,
                          rss / n, channel_scale=w)
+
+    lo = np.array([pp.lower for pp in params])
+    hi = np.array([pp.upper for pp in params])
+    fast = _solve_gram(a, b, lo, hi, bounded)
+    if fast is not None:
+        theta, active_mask, rss, cov, cond = fast
+        active = [names[i] for i in range(p) if active_mask[i] != 0]
+        sigma2 = rss / (n - p)
+        cov = sigma2 * cov
+        return LinearFit(names, units, theta, np.sqrt(np.clip(np.diag(cov), 0, None)), cov, p,
+                         cond, n, rss, sigma2, active_bounds=active, channel_scale=w)
 
     s = np.linalg.norm(a, axis=0)
     # a column at round-off level next to the others (e.g. an acceleration differentiated from a
@@ -170,8 +187,6 @@ def solve_linear(phi: np.ndarray, y: np.ndarray, params: Sequence[Param], *,
 
     theta_s = vt.T @ ((u.T @ b) / sv)
     theta = theta_s / s_safe
-    lo = np.array([pp.lower for pp in params])
-    hi = np.array([pp.upper for pp in params])
     active: list[str] = []
     if bounded and (np.any(theta < lo) or np.any(theta > hi)):
         res = scipy.optimize.lsq_linear(a_s, b, bounds=(lo * s_safe, hi * s_safe), method="bvls")
@@ -185,6 +200,59 @@ def solve_linear(phi: np.ndarray, y: np.ndarray, params: Sequence[Param], *,
     stderr = np.sqrt(np.clip(np.diag(cov), 0, None))
     return LinearFit(names, units, theta, stderr, cov, rank, cond, n, rss, sigma2,
                      active_bounds=active, channel_scale=w)
+
+
+def _solve_gram(a: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarray, bounded: bool):
+    """The least squares of :func:`solve_linear` through the Gram matrix of the column-scaled
+    regressor, for a full-rank, well-conditioned ``a`` (N x p, N >> p): one pass ``a^T a`` instead
+    of an SVD of the tall matrix (about 15-30x less work for a few parameters).
+
+    Numerical safety: the columns are scaled to unit norm before the eigendecomposition; the
+    solution gets one step of iterative refinement from the true residual (corrected
+    semi-normal equations, accurate like QR while eps cond^2 << 1); bounded LS runs on the
+    equivalent p x p problem ``[R; 0] x ~ [z; rho]`` (``R^T R`` the scaled Gram matrix, ``rho``
+    the unconstrained residual norm), whose cost and gradient equal the tall problem's.
+
+    Returns:
+        ``(theta, active_mask, rss, cov_unit, cond)`` (``cov_unit = (a^T a)^-1``), or None when a
+        column is at round-off level, the condition number exceeds :data:`GRAM_COND` or the
+        Gram matrix is not finite: then the SVD path decides (rank, null space, base parameters).
+    """
+    p = a.shape[1]
+    gram = a.T @ a
+    s2 = np.diag(gram).copy()
+    if not np.all(np.isfinite(gram)) or s2.max() <= 0:
+        return None
+    s = np.sqrt(s2)
+    if np.any(s <= ZERO_COLUMN * s.max()):
+        return None
+    gram_s = gram / np.outer(s, s)
+    lam, vec = np.linalg.eigh(gram_s)
+    if not (lam[0] > 0 and lam[-1] > 0 and lam[0] * GRAM_COND ** 2 > lam[-1]):
+        return None
+
+    def solve(rhs_s):
+        return vec @ ((vec.T @ rhs_s) / lam)
+
+    g_s = (a.T @ b) / s
+    theta_s = solve(g_s)
+    r = b - a @ (theta_s / s)
+    theta_s = theta_s + solve((a.T @ r) / s)     # one refinement step from the true residual
+    theta = theta_s / s
+    active_mask = np.zeros(p)
+    if bounded and (np.any(theta < lo) or np.any(theta > hi)):
+        r = b - a @ theta
+        rho = float(np.sqrt(r @ r))
+        root = np.sqrt(lam)
+        r_small = np.vstack([root[:, None] * vec.T, np.zeros((1, p))])
+        z_small = np.append((vec.T @ g_s) / root, rho)
+        res = scipy.optimize.lsq_linear(r_small, z_small, bounds=(lo * s, hi * s), method="bvls")
+        theta = res.x / s
+        active_mask = res.active_mask
+    r = b - a @ theta
+    rss = float(r @ r)
+    cov_unit = ((vec / lam) @ vec.T) / np.outer(s, s)
+    return theta, active_mask, rss, cov_unit, float(np.sqrt(lam[-1] / lam[0]))
 
 
 def _solve_base(a, b, s, names, units, rank, cond, dirs, w) -> LinearFit:
@@ -225,7 +293,7 @@ def unexcited_columns(phi: np.ndarray, y: np.ndarray, params: Sequence[Param], *
     phi, y = _as_channels(phi, y)
     n_s, n_c, p = phi.shape
     mask = np.ones(n_s, dtype=bool) if valid is None else np.asarray(valid, dtype=bool).copy()
-    mask &= np.isfinite(y).all(axis=1) & np.isfinite(phi).all(axis=(1, 2))
+    mask &= np.isfinite(y).all(axis=1) & np.isfinite(phi.reshape(n_s, n_c * p)).all(axis=1)
     if isinstance(channel_scale, str):
         rms = np.sqrt(np.mean(y[mask] ** 2, axis=0)) if mask.any() else np.ones(n_c)
         w = 1.0 / np.where(rms > 0, rms, 1.0) if n_c > 1 else np.ones(1)

@@ -4,9 +4,21 @@ This is deliberately a separate path from the workbench's inverse dynamics: the 
 the user's model *changed through MuJoCo's own model editor* (:class:`mujoco.MjSpec`: a payload
 body added, joint damping, Coulomb friction (``frictionloss``) or armature set, a wrong torque
 constant on the effort sensor), stepped forward by ``mj_step`` under a PD tracking controller,
-and recorded with encoder quantisation and effort noise. The explicit Euler integrator (with
-implicit damping disabled) makes the recorded positions' second difference the acceleration
-MuJoCo computed, so the record is the machine's motion and nothing of the workbench's code.
+and recorded with encoder quantisation and effort noise, so the record is the machine's motion
+and nothing of the workbench's code.
+
+Two ways of stepping it:
+
+- one physics step per sample (default): MuJoCo's explicit Euler with implicit damping disabled,
+  the control held over the step. The recorded positions' second difference is then exactly the
+  acceleration MuJoCo computed, but the state's velocity is the backward difference
+  ``(q[k] - q[k-1]) / dt``, half a step behind the positions' own velocity: the damping of that
+  discrete machine acts on a velocity ``dt/2 qdd`` late, which a continuous-time fit reads as an
+  inertia ``damping x dt/2`` lower. A property of the integrator, not of a machine.
+- ``substeps`` > 1: close to continuous time, as a real machine behaves: MuJoCo's RK4 at
+  ``timestep / substeps``, the controller (a drive whose torque loop is much faster than its
+  published samples) updated every physics step, and one sample published per model timestep
+  holding the state and the torque at that instant.
 """
 from __future__ import annotations
 
@@ -60,17 +72,21 @@ def _set(joint, attr: str, value: float) -> None:
 
 
 def truth_model(xml: str, hidden: Hidden = Hidden(), timestep: float | None = None, *,
-                euler: bool = True):
+                euler: bool = True, substeps: int = 1):
     """The truth :class:`mujoco.MjModel`: ``xml`` edited with MjSpec to hold ``hidden``;
-    ``euler``: explicit Euler without implicit damping (else the model's own integrator)."""
+    ``euler``: explicit Euler without implicit damping (else the model's own integrator);
+    ``substeps`` > 1: RK4 at 1/substeps of the (model's or given) timestep instead, close to
+    continuous time (:func:`simulate` publishes one sample per ``substeps`` physics steps)."""
     import mujoco
 
     spec = mujoco.MjSpec.from_string(xml)
-    if euler:
+    if substeps > 1:
+        spec.option.integrator = mujoco.mjtIntegrator.mjINT_RK4
+    elif euler:
         spec.option.integrator = mujoco.mjtIntegrator.mjINT_EULER
         spec.option.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_EULERDAMP)
-    if timestep:
-        spec.option.timestep = float(timestep)
+    if timestep or substeps > 1:
+        spec.option.timestep = float(timestep or spec.option.timestep) / max(1, int(substeps))
     if hidden.payload is not None:
         body, mass, pos = hidden.payload
         b = spec.body(body).add_body(name="hidden_payload", pos=list(pos))
@@ -118,12 +134,16 @@ def actuator_moments(model, data) -> np.ndarray:
 
 
 def simulate(model, duration: float = 12.0, seed: int = 0, kp: float = 400.0, kd: float = 40.0,
-             amplitude: float = 0.8, pretension: float = 30.0, lengths: bool = False):
-    """Run the truth model under PD + bias feedback tracking a multisine (one sample per step).
+             amplitude: float = 0.8, pretension: float = 30.0, lengths: bool = False,
+             substeps: int = 1):
+    """Run the truth model under PD + bias feedback tracking a multisine.
 
     The wanted generalised force is spread over the actuators by least squares around a
     pretension of ``pretension`` N on every tendon actuator (cables must pull), exactly on the
-    joints an actuator drives (joint actuators: the force itself).
+    joints an actuator drives (joint actuators: the force itself). With ``substeps`` 1, one
+    sample per physics step (:func:`mujoco.mj_step1` / ``mj_step2``: the control computed between
+    them); else the controller acts every physics step and one sample is kept per ``substeps``
+    steps (:func:`_simulate_substeps`).
 
     Returns:
         ``t (T,), q (T, nv), qd (T, nv), effort (T, nv), act (T, nu)``: the state each step
@@ -132,6 +152,9 @@ def simulate(model, duration: float = 12.0, seed: int = 0, kp: float = 400.0, kd
     """
     import mujoco
 
+    if substeps > 1:
+        return _simulate_substeps(model, duration, seed, kp, kd, amplitude, pretension, lengths,
+                                  int(substeps))
     d = mujoco.MjData(model)
     dt = model.opt.timestep
     t, qr, qdr, _ = excitation(duration, dt, model.nv, seed, amplitude)
@@ -159,25 +182,69 @@ def simulate(model, duration: float = 12.0, seed: int = 0, kp: float = 400.0, kd
     return (t, q, qd, eff, act, ten_len) if lengths else (t, q, qd, eff, act)
 
 
+def _simulate_substeps(model, duration, seed, kp, kd, amplitude, pretension, lengths, substeps):
+    """:func:`simulate` close to continuous time: ``mj_step`` (any integrator, RK4 included,
+    which the split step does not support) with the controller updated before every physics
+    step, one sample kept every ``substeps`` steps: the state at that instant and the torque
+    there. The drive's torque steps at each physics step, so at a step's instant it is the mean
+    of the torque held over the step before and the one after (the torque held from the instant
+    on would lead the motion by half a physics step, which a fit reads as damping)."""
+    import mujoco
+
+    d = mujoco.MjData(model)
+    dt = model.opt.timestep
+    t_all, qr, qdr, _ = excitation(duration, dt, model.nv, seed, amplitude)
+    T = len(t_all) // substeps
+    q = np.empty((T, model.nv))
+    qd = np.empty((T, model.nv))
+    eff = np.empty((T, model.nv))
+    act = np.empty((T, model.nu))
+    ten_len = np.empty((T, model.ntendon))
+    mujoco.mj_forward(model, d)
+    mass = np.maximum(np.array(model.dof_M0), 0.05)
+    kp_v, kd_v = kp * mass, kd * mass
+    tendon = model.actuator_trntype == int(mujoco.mjtTrn.mjTRN_TENDON)
+    c0 = np.where(tendon, -pretension / np.maximum(np.abs(model.actuator_gear[:, 0]), 1e-12), 0.0)
+    before = None                                            # (qfrc_actuator, actuator_force)
+    for i in range(T * substeps):
+        mujoco.mj_forward(model, d)
+        tau = kp_v * (qr[i] - d.qpos[: model.nv]) + kd_v * (qdr[i] - d.qvel) + d.qfrc_bias
+        A = actuator_moments(model, d).T                     # (nv, nu)
+        d.ctrl[:] = c0 + np.linalg.lstsq(A, tau - A @ c0, rcond=None)[0]
+        mujoco.mj_fwdActuation(model, d)                    # the forces of the new controls
+        after = (d.qfrc_actuator.copy(), d.actuator_force.copy())
+        if i % substeps == 0:
+            k = i // substeps
+            q[k], qd[k], ten_len[k] = d.qpos[: model.nv], d.qvel, d.ten_length
+            b = after if before is None else before
+            eff[k], act[k] = 0.5 * (b[0] + after[0]), 0.5 * (b[1] + after[1])
+        before = after
+        mujoco.mj_step(model, d)
+    t = t_all[: T * substeps: substeps]
+    return (t, q, qd, eff, act, ten_len) if lengths else (t, q, qd, eff, act)
+
+
 def record(model, hidden: Hidden = Hidden(), *, duration: float = 12.0, seed: int = 0,
-           encoder_bits: int = 18, effort_noise: float = 0.02, effort_quantum: float = 1e-3):
+           encoder_bits: int = 18, effort_noise: float = 0.02, effort_quantum: float = 1e-3,
+           substeps: int = 1):
     """A simulated record as a sensor sees it: positions quantised to ``2 pi / 2^bits``, efforts
     times the hidden gain plus white noise (N m) and quantised; NaN for a joint no actuator
     drives. Returns ``(t, q, effort, joint names)``; :func:`record_all` also the tensions."""
     r = record_all(model, hidden, duration=duration, seed=seed, encoder_bits=encoder_bits,
-                   effort_noise=effort_noise, effort_quantum=effort_quantum)
+                   effort_noise=effort_noise, effort_quantum=effort_quantum, substeps=substeps)
     return r["t"], r["q"], r["effort"], r["joints"]
 
 
 def record_all(model, hidden: Hidden = Hidden(), *, duration: float = 12.0, seed: int = 0,
                encoder_bits: int = 18, effort_noise: float = 0.02, effort_quantum: float = 1e-3,
-               tension_noise: float = 0.2, length_quantum: float = 1e-5) -> dict:
+               tension_noise: float = 0.2, length_quantum: float = 1e-5, substeps: int = 1) -> dict:
     """:func:`record` plus ``tension`` (T, n_tendons): per tendon the pull of the actuators on
     it (N) with white noise ``tension_noise``, ``length`` (T, n_tendons): the length its winch
     encoder reads (m, quantised to ``length_quantum``: MuJoCo's tendon length, less the stretch
     of a ``hidden.tendon_stiffness`` cable under its true tension, plus the encoder's zero), and
-    ``tendons`` their names."""
-    t, q, qd, eff, act, ten_len = simulate(model, duration, seed, lengths=True)
+    ``tendons`` their names. ``substeps``: physics steps per sample (:func:`simulate`; the
+    model's timestep is the physics step, :func:`truth_model` divides it)."""
+    t, q, qd, eff, act, ten_len = simulate(model, duration, seed, lengths=True, substeps=substeps)
     rng = np.random.default_rng(seed + 1)
     quantum = 2 * np.pi / 2**encoder_bits
     q_meas = np.round(q / quantum) * quantum
@@ -214,15 +281,17 @@ def description_yaml(xml: str, **section) -> str:
 
 
 def write_bag(path, xml: str, hidden: Hidden = Hidden(), *, duration: float = 12.0, seed: int = 0,
-              overwrite: bool = True, cable_lengths: bool = False, **section) -> str:
+              overwrite: bool = True, cable_lengths: bool = False, substeps: int = 1,
+              **section) -> str:
     """Simulate the truth (``xml`` + ``hidden``) and write a contract bag of it: the description
     (the user's model, without the hidden effect), ``/mjcf/joint_states`` and, for the section's
     ``tendons``, ``/mjcf/cable_tensions`` (with the winch encoders' lengths as ``position`` when
-    ``cable_lengths``)."""
+    ``cable_lengths``). ``substeps`` > 1: recorded close to continuous time (RK4 at
+    1/substeps of the model's timestep, one sample per model timestep; see the module)."""
     from ...bags import BagWriter
 
-    model = truth_model(xml, hidden)
-    r = record_all(model, hidden, duration=duration, seed=seed)
+    model = truth_model(xml, hidden, substeps=substeps)
+    r = record_all(model, hidden, duration=duration, seed=seed, substeps=substeps)
     desc = description_yaml(xml, **section)
     t0 = 1000.0
     with BagWriter(path, overwrite=overwrite) as w:
