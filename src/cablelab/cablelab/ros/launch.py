@@ -197,6 +197,14 @@ class Launcher:
             self._probe = None
         return codes
 
+    def stop_all_checked(self, label: str, logs, grace: float = 15.0) -> None:
+        """:meth:`stop_all`; RuntimeError naming ``label``, the processes that exited with an
+        error code and where their ``logs`` are when any did."""
+        codes = self.stop_all(grace)
+        bad = {k: v for k, v in codes.items() if v != 0}
+        if bad:
+            raise RuntimeError(f"{label}: processes exited with {bad}; logs in {logs}")
+
     def check_alive(self) -> None:
         """CablelabError naming a process that failed (exit code != 0), with the end of its log."""
         for proc in self.procs.values():

@@ -25,7 +25,7 @@ from .lockstep import ADVANCE, FREE, RESEND
 from .markers import start_markers
 from .qos import DESCRIPTION_QOS, stream_qos
 from .rawmsg import RawReader, joint_state_arrays, multidof_arrays
-from .reference import ReferencePlayer
+from .reference import played_reference
 from .status import Latency
 
 PROBE_REPEAT = 5.0  # s wall: the start gate's probe state is published again (see waiting_for_subscribers)
@@ -191,13 +191,9 @@ class PlantNode(Node):
         return self.decode(name, lambda m: arrays(m, reader), msg)
 
     def play_reference(self, bag: str, topic: str, joints, builtin=None, platform: bool = False):
-        """The reference a controller plays itself and publishes on ``topic``
-        (:class:`~cablelab.ros.reference.ReferencePlayer`): the one in ``bag`` (a
-        ``reference_bag`` parameter) when given, else the ``builtin`` trajectory when given; None
-        when the controller follows the reference topic instead."""
-        if bag:
-            return ReferencePlayer.from_bag(self, bag, topic, joints, platform)
-        return None if builtin is None else ReferencePlayer(self, topic, joints, builtin, platform)
+        """:func:`~cablelab.ros.reference.played_reference` of this node: the reference it
+        plays itself from ``bag`` or ``builtin``, None when it follows the topic."""
+        return played_reference(self, bag, topic, joints, builtin, platform)
 
     # ------------------------------------------------------------------ description
     def listen_for_description(self, text: str = "", keep_first: bool = False) -> None:
@@ -291,16 +287,18 @@ class PlantNode(Node):
         self.inputs.add("effort_commands", timeout=timeout, length=length)
         return self.subscribe(Float64MultiArray, topic, self.on_command, qos or stream_qos(), raw, polled)
 
-    def start_stepping(self, period: float, markers_topic: str, frame, stamp, markers_rate: float) -> None:
+    def start_stepping(self, period: float, markers_topic: str, frame, stamp, markers_rate: float,
+                       publish_first: bool = True) -> None:
         """A simulator's last call in ``__init__``: /diagnostics (:meth:`start_diagnostics`), the
         timer calling ``self.tick`` every ``period`` s wall (:attr:`timer`), the 3D view ``frame()``
         on ``markers_topic`` stamped ``stamp()`` at ``markers_rate`` Hz wall
-        (:func:`~cablelab.ros.markers.start_markers`), and the initial state
-        (``self.publish_state()``)."""
+        (:func:`~cablelab.ros.markers.start_markers`), and, with ``publish_first``, the initial
+        state (``self.publish_state()``)."""
         self.start_diagnostics()
         self.timer = self.create_timer(period, self.tick)
         start_markers(self, markers_topic, frame, stamp, markers_rate)
-        self.publish_state()
+        if publish_first:
+            self.publish_state()
 
     def may_step(self, lock, publisher, republish, every: float = 0.5) -> str | None:
         """A simulator's timer: the start gate (:meth:`waiting_for_subscribers` on ``publisher``),

@@ -21,7 +21,7 @@ from . import convert
 from .params import Param
 from .qos import publisher_qos, stream_qos
 
-__all__ = ["ReferencePlayer", "reference_bag_param", "FollowedReference"]
+__all__ = ["ReferencePlayer", "reference_bag_param", "played_reference", "FollowedReference"]
 
 
 def reference_bag_param(topic: str, overrides: str = "reference_source") -> Param:
@@ -77,6 +77,19 @@ class ReferencePlayer:
         return ref
 
 
+def played_reference(node, bag: str, topic: str, joints: Sequence[str], trajectory: Callable | None = None,
+                     platform: bool = False, absolute: bool = False) -> ReferencePlayer | None:
+    """The reference a controller plays itself and publishes on ``topic``
+    (:class:`ReferencePlayer`): the one in ``bag`` (a ``reference_bag`` parameter) when given,
+    else the built-in ``trajectory`` when given (``platform``, ``absolute`` as there); None when
+    the controller follows the reference topic instead."""
+    if bag:
+        return ReferencePlayer.from_bag(node, bag, topic, joints, platform)
+    if trajectory is None:
+        return None
+    return ReferencePlayer(node, topic, joints, trajectory, platform, absolute=absolute)
+
+
 class FollowedReference:
     """The reference a controller follows: played by the controller itself (the bag of a
     ``reference_bag`` parameter, else a built-in ``trajectory``; :class:`ReferencePlayer`,
@@ -100,11 +113,7 @@ class FollowedReference:
                  any_names: bool = False):
         self.node, self.joints, self.any_names = node, list(joints), any_names
         self.source = "bag" if bag else "topic" if trajectory is None else "builtin"
-        self.player = None
-        if bag:
-            self.player = ReferencePlayer.from_bag(node, bag, topic, joints)
-        elif trajectory is not None:
-            self.player = ReferencePlayer(node, topic, joints, trajectory, absolute=absolute)
+        self.player = played_reference(node, bag, topic, joints, trajectory, absolute=absolute)
         self.point = None
         node.inputs.add("reference", timeout=timeout, length=len(self.joints), required=self.player is None)
         if self.player is None:

@@ -24,7 +24,6 @@ import time
 
 from .clock import ClockPublisher
 from .lockstep import ADVANCE, FREE
-from .markers import start_markers
 from .plant_node import PlantNode
 from .qos import publisher_qos
 from .status import sim_values
@@ -65,18 +64,14 @@ class SimulatorNode(PlantNode):
     def start_simulation(self, desc, period: float, markers_topic: str, frame, markers_rate: float,
                          publish_first: bool = True) -> None:
         """The last call in ``__init__``: ``self.clock`` (/clock), ``desc`` published on
-        /plant_description, /diagnostics, ``self.timer`` calling :meth:`tick` every ``period``
-        s wall, the 3D view ``frame()`` on ``markers_topic`` stamped with the sim time at
-        ``markers_rate`` Hz wall (:func:`~cablelab.ros.markers.start_markers`) and, with
-        ``publish_first``, the initial state."""
+        /plant_description, then :meth:`PlantNode.start_stepping` (/diagnostics, ``self.timer``
+        calling :meth:`tick` every ``period`` s wall, the 3D view ``frame()`` on
+        ``markers_topic`` stamped with the sim time at ``markers_rate`` Hz wall and, with
+        ``publish_first``, the initial state)."""
         self.period = period
         self.clock = ClockPublisher(self)
         self.publish_description(desc)
-        self.start_diagnostics()
-        self.timer = self.create_timer(period, self.tick)
-        start_markers(self, markers_topic, frame, lambda: self.sim.t, markers_rate)
-        if publish_first:
-            self.publish_state()
+        self.start_stepping(period, markers_topic, frame, lambda: self.sim.t, markers_rate, publish_first)
 
     def tick(self) -> None:
         """The timer: with a ``lock``, the start gate and lock-step decide whether time moves

@@ -79,10 +79,7 @@ def run_nodes(out: Path, name: str, feedforward: bool, duration: float, domain: 
                 if time.monotonic() - t0 > 20 * duration + 60:
                     raise RuntimeError(f"{name}: simulator did not finish; logs in {logs}")
         time.sleep(1.5)                     # let the recorder take the last messages
-        codes = launch.stop_all()
-    bad = {k: v for k, v in codes.items() if v != 0}
-    if bad:
-        raise RuntimeError(f"{name}: processes exited with {bad}; logs in {logs}")
+        launch.stop_all_checked(name, logs)
     log(f"{name}: recorded {bag} in {time.monotonic() - t0:.0f} s")
     return bag
 

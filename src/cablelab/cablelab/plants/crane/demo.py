@@ -89,10 +89,7 @@ def run_over_dds(bag: Path, logs: Path, duration: float, domain: int, *, sim: di
         with SimProgress(launch.probe(), duration, "crane") as bar:
             bar.wait_for(launch, duration - 0.5 / rate, "crane", logs)
         time.sleep(1.0)
-        codes = launch.stop_all()
-    bad = {k: v for k, v in codes.items() if v != 0}
-    if bad:
-        raise RuntimeError(f"crane: processes exited with {bad}; logs in {logs}")
+        launch.stop_all_checked("crane", logs)
     log(f"crane: recorded {bag} in {time.monotonic() - t0:.0f} s")
     return bag
 

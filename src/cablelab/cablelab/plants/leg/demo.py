@@ -162,10 +162,7 @@ def run_over_dds(bag: Path, logs: Path, duration: float, domain: int, reference:
         with SimProgress(launch.probe(), duration, "leg designed") as bar:
             bar.wait_for(launch, duration, "leg", logs)
         time.sleep(1.0)                     # let the recorder take the last messages
-        codes = launch.stop_all()
-    bad = {k: v for k, v in codes.items() if v != 0}
-    if bad:
-        raise RuntimeError(f"leg: processes exited with {bad}; logs in {logs}")
+        launch.stop_all_checked("leg", logs)
     log(f"leg: recorded {bag} in {time.monotonic() - t0:.0f} s")
     return bag
 

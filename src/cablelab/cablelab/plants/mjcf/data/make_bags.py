@@ -135,9 +135,7 @@ def record_case(name: str, case: Case, work: Path) -> Path:
         with SimProgress(launch.probe(), case.duration, name) as bar:
             bar.wait_for(launch, case.duration, name, work)
         time.sleep(0.5)
-        codes = launch.stop_all()
-    if any(codes.values()):
-        raise RuntimeError(f"{name}: processes exited with {codes}; logs in {work}")
+        launch.stop_all_checked(name, work)
     return raw
 
 
