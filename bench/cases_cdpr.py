@@ -38,6 +38,12 @@ one, or two, or none (control). The nominal model is the plant's (``cdpr_gravity
 ``pulley_geometry`` when the description gives a sheave radius]) + ``platform_inertia``
 (``--effects``), except when the inertia is the hidden effect. The described sheave radius is
 known (``--fix r_p``).
+
+Designed-experiment cases (:func:`draw_designed_case`): a payload with its centre of mass off the
+platform origin (the truth's cable moment is then ``r_G x m (a - g)``), dynamometers alone, and a
+first recording that only sways slowly near one pose, where the hidden offsets and the mass and
+its first moments are confounded; the benchmark designs the separating motion with
+``cablelab excite`` and plays it through this generator (``truth["reference"]``).
 """
 from __future__ import annotations
 
@@ -159,11 +165,75 @@ def delay_visibility(case: PlantCase) -> float:
 def _motion(case: PlantCase, rng):
     """Time grid, reference (p, v, a) on it and the reference function, drawn from ``rng``."""
     tr = case.truth
-    ref, _ = moves_and_rests(rng, [0.0, 0.0, 0.85], LIMITS, tr["duration"], tr["rest_fraction"], tr["profile"],
-                             move_time=tr.get("move_time", 4.0), chirp_amp=[0.12, 0.06, 0.05],
-                             chirp_f0=(0.1, 0.2), chirp_f1=(0.4, 0.7))
+    ref = tr.get("reference")                     # a given reference (designed-experiment cases)
+    if ref is None:
+        ref, _ = moves_and_rests(rng, [0.0, 0.0, 0.85], LIMITS, tr["duration"], tr["rest_fraction"], tr["profile"],
+                                 move_time=tr.get("move_time", 4.0), chirp_amp=[0.12, 0.06, 0.05],
+                                 chirp_f0=(0.1, 0.2), chirp_f1=(0.4, 0.7))
     t = np.arange(int(round(tr["duration"] * case.fs))) / case.fs
     return t, ref(t), ref
+
+
+# ----------------------------------------------------------------------------- designed experiments
+
+#: what a recording near one pose confounds: the dynamometer offsets b_i reach the wrench as
+#: W(p) b, nearly constant when the platform hardly moves, like the weight m g and its moments
+#: (m x_G, m y_G) g; what ``cablelab excite`` is asked to separate
+PAIR = tuple(f"b[{n}]" for n in WINCHES) + ("m", "mx", "my")
+
+
+def draw_designed_case(seed: int, kind: str | None = None) -> PlantCase:
+    """A case whose first recording does not separate what is hidden: the platform carries an
+    unknown payload (total mass m, centre of mass x_G, y_G off the platform origin, in the
+    platform's plane) and only sways slowly by ``sway`` m along x around the workspace centre for
+    ``first_s`` s (a short test move before the pick-and-place); the tensions come from the
+    dynamometers alone (``--tensions dynamometer``) and, unless ``kind`` is "control" (default:
+    every fourth seed), their offsets are hidden. The benchmark then designs an excitation for
+    :data:`PAIR` on that recording and simulates it with :func:`simulate` (``reference``)."""
+    rng = np.random.default_rng(seed + 104729)
+    if kind is None:
+        kind = "control" if seed % 4 == 3 else "pair"
+    case = draw_case(seed, kind="control")
+    tr = case.truth
+    m = tr["m"]
+    com = np.append(rng.choice([-1, 1], 2) * rng.uniform(0.03, 0.12, 2), 0.0)
+    tr["com"] = com
+    true = {"payload mass": {"m": m}, "centre of mass": {"mx": m * com[0], "my": m * com[1]}}
+    if kind == "pair":
+        tr["b"] = rng.choice([-1, 1], 8) * rng.uniform(0.03, 0.1, 8) * mean_tension(m)
+        case.hidden = ("tension_sensor_offset",)
+        true = {"tension_sensor_offset": {f"b[{n}]": v for n, v in zip(WINCHES, tr["b"])}, **true}
+    case.true_params = true
+    case.options = {"tensions": "dynamometer"}
+    case.family = f"designed {kind}"
+    sway, first_s = float(rng.uniform(0.03, 0.08)), 30.0
+    tr.update(first_s=first_s, designed_s=60.0, sway=sway, reference=_sway(sway, first_s))
+    return case
+
+
+def _sway(amp: float, period: float, centre=(0.0, 0.0, 0.85)):
+    """``fn(t) -> (p, v, a)``: x = x0 + amp (1 - cos(2 pi t / period)) / 2, y and z held."""
+    w = 2 * np.pi / period
+
+    def fn(t):
+        t = np.atleast_1d(np.asarray(t, float))
+        p = np.tile(np.asarray(centre, float), (t.size, 1))
+        v, a = np.zeros_like(p), np.zeros_like(p)
+        p[:, 0] += 0.5 * amp * (1 - np.cos(w * t))
+        v[:, 0], a[:, 0] = 0.5 * amp * w * np.sin(w * t), 0.5 * amp * w * w * np.cos(w * t)
+        return p, v, a
+
+    return fn
+
+
+def tabulated(t_ref, q, qd, qdd):
+    """Reference ``fn(t) -> (p, v, a)`` interpolating a designed platform motion (held at its
+    last point after the end)."""
+    def fn(t):
+        t = np.atleast_1d(np.asarray(t, float))
+        return tuple(np.column_stack([np.interp(t, t_ref, x[:, j]) for j in range(3)]) for x in (q, qd, qdd))
+
+    return fn
 
 
 def _description(m: float, r_p: float) -> str:
@@ -240,6 +310,8 @@ def _winch_truth(tr: dict, p, v, a, t):
     W = structure_matrix(u)
     w = np.zeros((t.size, 6))
     w[:, :3] = tr["m"] * (a + [0.0, 0.0, G])              # m (a - g), g = (0, 0, -G)
+    if np.any(tr.get("com", 0.0)):                         # moment about the origin: r_G x m (a - g)
+        w[:, 3:] = np.cross(np.asarray(tr["com"], float), w[:, :3])
     t0 = np.full(8, mean_tension(tr["m"]))
     Wp = np.linalg.pinv(W)                                 # (N, 8, 6)
     ten = t0 + np.einsum("nij,nj->ni", Wp, w - np.einsum("nij,j->ni", W, t0))

@@ -311,7 +311,8 @@ def block_conditions(model, ds, blocks: int, params: Sequence[str]) -> np.ndarra
 
 
 def design(plant_name: str, desc, params: Sequence[str], *, duration: float = 60.0,
-           before_ds=None, seed: int = 0, starts: int = 1, max_iter: int = 30) -> Design:
+           before_ds=None, seed: int = 0, starts: int = 1, max_iter: int = 30,
+           effects: Sequence[str] = (), fixed: dict | None = None) -> Design:
     """Design an excitation of ``duration`` s for the named parameters (module doc).
 
     The cost (log condition number on a grid of 10 samples per period of the highest harmonic)
@@ -325,6 +326,11 @@ def design(plant_name: str, desc, params: Sequence[str], *, duration: float = 60
         params: parameter names as the fit reports them.
         before_ds: the dataset of the recording that confounds them (condition_before), or None.
         seed, starts: random starts of the local optimiser (the best is kept).
+        effects, fixed: the model the designed run will be fitted with, when it is more than the
+            nominal model and the parameters' effects: further effects (``--effects``, e.g. the
+            CDPR's ``platform_inertia``, whose acceleration column a designed motion can confound
+            with the named parameters) and known parameter values (``--fix``: no column, so the
+            design spends no information on them). The condition numbers are those of this model.
     """
     import scipy.optimize
 
@@ -345,6 +351,13 @@ def design(plant_name: str, desc, params: Sequence[str], *, duration: float = 60
     t = np.arange(0.0, duration, 1.0 / fs)
     probe = ex.motion_dataset(t, *scaled_motion(np.ones(shape), t, lim, ex.base_hz, duration), desc)
     model, _ = model_for(plant, desc, params, probe)
+    if effects or fixed:
+        from .model import Model
+
+        model = Model(plant.name, tuple(dict.fromkeys(tuple(model.effects) + tuple(effects))), dict(fixed or {}))
+        for name in params:
+            if name in model.fixed:
+                raise CablelabError(f"--params {name!r} is also fixed; name free parameters")
     n = n_j * 2 * h
     basis = fourier_basis(t, ex.base_hz, h, duration)
 
