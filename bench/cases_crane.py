@@ -166,7 +166,7 @@ def draw_delay_case(seed: int, kind: str | None = None) -> PlantCase:
         tr["tau"] = 0.0
         case.true_params = {}
     case.family = f"designed {kind}"
-    hz = rng.uniform(0.02, 0.05, 3)
+    hz = rng.uniform(0.015, 0.035, 3)
     amp = rng.uniform(0.3, 0.6, 3) * 0.5 * np.array([hi - lo for lo, hi in LIMITS])
     phase = rng.uniform(0, 2 * np.pi, 3)
     tr.update(first_s=60.0, designed_s=60.0, pair=DELAY_PAIR, diagnose_first=True,
