@@ -123,7 +123,8 @@ print(count[0], flush=True)
 PIN = {"sim": [0], "ctrl": [1], "listener": [0]}
 
 
-def run_floor(exe: Path, mjb: Path, state: Path, seconds: float, listener: bool, pin: bool, log) -> dict:
+def run_floor(exe: Path, mjb: Path, state: Path, seconds: float, listener: bool, pin: bool, log,
+              rt: int = 0) -> dict:
     from cablelab.ros.launch import Launcher
 
     tmp = Path(tempfile.mkdtemp(prefix="bench-floor-"))
@@ -131,8 +132,9 @@ def run_floor(exe: Path, mjb: Path, state: Path, seconds: float, listener: bool,
         log(f"ROS_DOMAIN_ID {launch.domain_id}, logs in {launch.log_dir}")
         procs = {}
 
-        def placed(name, argv):   # taskset: every thread of the process on that CPU
-            return (["taskset", "-c", ",".join(map(str, PIN[name]))] if pin else []) + argv
+        def placed(name, argv):   # taskset: every thread of the process on that CPU; chrt: SCHED_FIFO
+            return ((["chrt", "-f", str(rt)] if rt > 0 and name != "listener" else [])
+                    + (["taskset", "-c", ",".join(map(str, PIN[name]))] if pin else []) + argv)
         if pin and not shutil.which("taskset"):
             raise SystemExit("bench_rcl_floor: --pin needs taskset (util-linux)")
         if listener:
@@ -153,7 +155,7 @@ def run_floor(exe: Path, mjb: Path, state: Path, seconds: float, listener: bool,
             "missed_cycles": sim["missed_cycles"], "late": sim["late"], "stale": sim["stale"],
             "dropped": sim["dropped"], "p99_ms": {"sim": sim["p99_ms"], "controller": ctrl["p99_ms"]},
             "cpu_per_step_ms": {"sim": sim["cpu_per_step_ms"], "controller": ctrl["cpu_per_answer_ms"]},
-            "listener": listener, "pinned": pin, "rt_priority": False}
+            "listener": listener, "pinned": pin, "rt_priority": rt > 0}
 
 
 def run_timer(exe: Path, seconds: float, pin: bool, rt: int, rate: float = 1000.0) -> dict:

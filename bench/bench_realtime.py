@@ -1,6 +1,7 @@
 """Real time on an ordinary machine: offline CDPR simulation vs bare mj_step, the machine's floor,
 the 1 kHz control loop in one process and the 1 kHz loop of three node processes over DDS,
-without real-time privileges, in one run.
+in one run, by default without real-time privileges (``--rt-priority``: all of them under
+SCHED_FIFO alike).
 
 1. Offline: ``simulate`` (MuJoCo 2 ms physics, PDFF + live estimator at 100 Hz) of the 60 s test
    trajectory with 615 kg, and a bare loop of ``mujoco.mj_step`` on the simulator's own MjModel
@@ -32,9 +33,11 @@ without real-time privileges, in one run.
 ``--json`` prints one JSON object::
 
     {"offline_sim": {"plant": "cdpr", "realtime_factor", "bare_mj_step_realtime_factor"},
-     "floor": {"bare_timer_missed", "c_rcl_pair_missed", "seconds", "available"},
+     "floor": {"bare_timer_missed", "c_rcl_pair_missed", "seconds", "available", "rt_priority"},
      "control_loop": {"rate_hz": 1000, "seconds", "missed_cycles", "late", "dropped", "p99_ms",
-                      "realtime_factor", "cpu_per_cycle_ms", "placement"},
+                      "realtime_factor", "cpu_per_cycle_ms" (the loop's process), "wakeup_max_ms",
+                      "publisher", "publisher_cpu_per_cycle_ms" (its publisher process),
+                      "samples_lost", "rt_priority", "placement"},
      "three_process": {"rate_hz": 1000, "seconds", "realtime_factor", "missed_cycles",
                        "p99_ms": {"sim", "estimator", "controller"}, "rt_priority": false, ...},
      "rate_sweep": [{"rate_hz", "bare_timer_missed", "control_loop_missed", "p99_ms",
@@ -47,7 +50,11 @@ py-spy and prints each one's share of samples by innermost function (where the t
 Placement without privileges: ``--idle-estimator`` (the estimator in the SCHED_IDLE class),
 ``--pin`` (that, plus simulator and estimator on CPU 0, controller on CPU 1), ``--node-params
 JSON`` (any node parameters, e.g. ``'{"sim": {"sched_slice": 0.0001}}'``); the JSON's
-``placement`` says what was used.
+``placement`` says what was used; ``--loop-params JSON`` the control loop's (e.g. ``'{"loop":
+{"publisher": "thread"}}'``). ``--rt-priority PRIO`` runs the bare timer and the C rcl pair
+(``chrt -f PRIO``), the control loop's process (not its publisher process, nor the estimator)
+and the three-process simulator and controller (node parameter ``rt_priority``) under SCHED_FIFO
+PRIO, so that the ratios compare like with like (needs the privilege).
 """
 from __future__ import annotations
 
@@ -111,17 +118,19 @@ def build_floor(log):
     return (exe, mjb, state), None
 
 
-def floor(built, seconds: float, log, pin: bool = False) -> dict:
-    """The bare timer and the C rcl pair at 1 kHz, ``seconds`` each (bench_rcl_floor)."""
+def floor(built, seconds: float, log, pin: bool = False, rt: int = 0) -> dict:
+    """The bare timer and the C rcl pair at 1 kHz, ``seconds`` each (bench_rcl_floor), under
+    SCHED_FIFO ``rt`` if > 0."""
     from bench_rcl_floor import run_floor, run_timer
 
     exe, mjb, state = built
     log(f"floor: bare timer, {seconds:g} s ...")
-    timer = run_timer(exe, seconds, pin, 0)
+    timer = run_timer(exe, seconds, pin, rt)
     log(f"floor: rcl loop in C, {seconds:g} s ...")
-    pair = run_floor(exe, mjb, state, seconds, False, pin, log)
+    pair = run_floor(exe, mjb, state, seconds, False, pin, log, rt)
     return {"available": True, "seconds": seconds, "bare_timer_missed": timer["missed_cycles"],
-            "c_rcl_pair_missed": pair["missed_cycles"], "bare_timer": timer, "c_rcl_pair": pair}
+            "c_rcl_pair_missed": pair["missed_cycles"], "rt_priority": rt > 0, "bare_timer": timer,
+            "c_rcl_pair": pair}
 
 
 def control_loop(seconds: float, log, rate: float = 1000.0, pin: bool = False, extra: dict | None = None) -> dict:
@@ -155,7 +164,10 @@ def control_loop(seconds: float, log, rate: float = 1000.0, pin: bool = False, e
             "late": r["late"], "dropped": r["dropped"], "cycles": r["cycles"], "p99_ms": r["p99_ms"],
             "p99_all_ms": r["p99_all_ms"], "median_ms": r["median_ms"],
             "realtime_factor": r["realtime_factor"], "cpu_per_cycle_ms": r.get("cpu_per_cycle_ms"),
-            "placement": placement or None}
+            "wakeup_max_ms": r.get("wakeup_max_ms"), "publisher": r.get("publisher"),
+            "publisher_cpu_per_cycle_ms": r.get("publisher_cpu_per_cycle_ms"),
+            "samples_lost": r.get("samples_lost"),
+            "rt_priority": int(placement.get("loop", {}).get("rt_priority", 0)) > 0, "placement": placement or None}
 
 
 def _fmt(x, digits: int = 4) -> str:
@@ -189,6 +201,10 @@ def main(argv=None) -> int:
     bench.parser.add_argument("--loop-params", default=None, metavar="JSON",
                               help='extra parameters of the control-loop runs\' processes, e.g. '
                                    '\'{"loop": {"publish_thread": true}}\' (keys loop, estimator)')
+    bench.parser.add_argument("--rt-priority", type=int, default=0, metavar="PRIO",
+                              help="SCHED_FIFO at PRIO (needs the privilege) for the bare timer, the C rcl "
+                                   "pair, the control loop's process (not its publisher process nor the "
+                                   "estimator) and the three-process simulator and controller (0: off)")
     bench.parser.add_argument("--sweep-seconds", type=float, default=20.0,
                               help="s per rate of the sweep's 100, 250, 500 Hz runs (20)")
     args = bench.parse(argv)
@@ -198,12 +214,16 @@ def main(argv=None) -> int:
         out["offline_sim"] = offline_sim(repeat=args.repeat)
     built = None
     loop_extra = json.loads(args.loop_params) if args.loop_params else None
+    rt = max(0, args.rt_priority)
+    if rt:
+        loop_extra = loop_extra or {}
+        loop_extra.setdefault("loop", {}).setdefault("rt_priority", rt)
     if not args.skip_loop and not (args.skip_floor and args.skip_sweep):
         built, why = build_floor(bench.log)
         if built is None:
             out["floor"] = {"available": False, "reason": why, "bare_timer_missed": None, "c_rcl_pair_missed": None}
     if not args.skip_loop and not args.skip_floor and built is not None:
-        out["floor"] = floor(built, args.seconds, bench.log, args.pin)
+        out["floor"] = floor(built, args.seconds, bench.log, args.pin, rt)
     if not args.skip_loop and not args.skip_control_loop:
         out["control_loop"] = control_loop(args.seconds, bench.log, 1000.0, args.pin, loop_extra)
     if not args.skip_loop and not args.skip_sweep:
@@ -214,7 +234,7 @@ def main(argv=None) -> int:
             row = {"rate_hz": rate, "seconds": args.sweep_seconds, "bare_timer_missed": None}
             if built is not None:
                 bench.log(f"sweep: bare timer {rate:g} Hz, {args.sweep_seconds:g} s ...")
-                row["bare_timer_missed"] = run_timer(built[0], args.sweep_seconds, args.pin, 0, rate)["missed_cycles"]
+                row["bare_timer_missed"] = run_timer(built[0], args.sweep_seconds, args.pin, rt, rate)["missed_cycles"]
             c = control_loop(args.sweep_seconds, bench.log, rate, args.pin, loop_extra)
             row.update(control_loop_missed=c["missed_cycles"], p99_ms=c["p99_ms"], realtime_factor=c["realtime_factor"])
             sweep.append(row)
@@ -231,6 +251,8 @@ def main(argv=None) -> int:
         if args.transports:
             env["FASTDDS_BUILTIN_TRANSPORTS"] = args.transports
         extra = json.loads(args.node_params) if args.node_params else {}
+        for name in ("sim", "controller") if rt else ():
+            extra.setdefault(name, {}).setdefault("rt_priority", rt)
         r = closed_loop(args.seconds, bench.log, env, args.py_spy, args.pin, extra or None, args.idle_estimator)
         out["three_process"] = {"rate_hz": r["rate_hz"], "seconds": r["seconds"],
                               "realtime_factor": r["realtime_factor"], "missed_cycles": r["missed_cycles"],
@@ -255,7 +277,8 @@ def main(argv=None) -> int:
             rows.append(dict(case="floor (bare timer, C rcl pair)", value="unavailable: " + f["reason"].splitlines()[0],
                              unit="", target=""))
         else:
-            rows += [dict(case=f"floor: bare timer 1 kHz, {f['seconds']:.0f} s (missed = late + dropped)",
+            fifo = ", SCHED_FIFO" if f.get("rt_priority") else ""
+            rows += [dict(case=f"floor: bare timer 1 kHz{fifo}, {f['seconds']:.0f} s (missed = late + dropped)",
                           value=f"{f['bare_timer_missed']} (wake-up p99 {f['bare_timer']['p99_ms']['wake-up']:.3f} ms)",
                           unit=f"of {int(round(f['bare_timer']['seconds'] * 1000))}", target=""),
                      dict(case="floor: C rcl simulator/controller pair 1 kHz", value=f["c_rcl_pair_missed"],
@@ -263,7 +286,9 @@ def main(argv=None) -> int:
     if "control_loop" in out:
         c = out["control_loop"]
         bare = out.get("floor", {}).get("bare_timer_missed")
-        rows += [dict(case=f"control loop 1 kHz (control_loop + estimator), {c['seconds']:.0f} s: missed cycles "
+        prio = ", SCHED_FIFO" if c.get("rt_priority") else ""
+        rows += [dict(case=f"control loop 1 kHz (control_loop + estimator, publisher {c.get('publisher')}{prio}), "
+                           f"{c['seconds']:.0f} s: missed cycles "
                            f"(late {c['late']} + dropped {c['dropped']})",
                       value=c["missed_cycles"], unit=f"of {c['cycles'] + c['dropped']}",
                       target=f"<= {2 * bare} (2x bare timer)" if bare is not None else "<= 2x bare timer"),

@@ -35,10 +35,17 @@ def section() -> str:
             node = f"{package} --plant {plant}"
             parts += [f"### `{node}`", "", f"<!-- parameters: {node} -->",
                       markdown_table(parameters_of(module)), "<!-- end parameters -->", ""]
-    from cablelab.ros.monitor_node import PARAMETERS as MONITOR
+    from cablelab.registry import get_plant
+    from cablelab.ros.monitor_node import PARAMETERS as MONITOR, plant_parameters
 
     parts += ["### `model_monitor --plant P` (any plant)", "", "<!-- parameters: model_monitor -->",
               markdown_table(MONITOR), "<!-- end parameters -->", ""]
+    for plant in available_plants():       # a plant's own options its dataset takes
+        own = plant_parameters(get_plant(plant))
+        if own:
+            node = f"model_monitor --plant {plant}"
+            parts += [f"### `{node}`: the plant's own options, besides the above", "",
+                      f"<!-- parameters: {node} -->", markdown_table(own), "<!-- end parameters -->", ""]
     parts.append(END)
     return "\n".join(parts)
 

@@ -43,17 +43,21 @@ def play_designed(launcher, tmp_path):
     """``run(plant, description, params, nodes, counts, joints, ...)``: design an excitation of
     ``params`` (``cablelab.excite.design``), write it as a reference bag, record the plant over DDS
     (the recorder, then ``nodes``: (role, executable, parameters) each, then ``pd_feedforward``
-    playing the bag through its ``reference_bag`` parameter) until ``counts`` messages per topic
+    playing the bag through its ``reference_bag`` parameter, and ``controller``'s other
+    parameters) until ``counts`` messages per topic
     are recorded, and check every process exits 0. Returns ``(bag, played, want, desc)``: the
-    recorded bag, its reference on the exciter's topic (``joints``), the bag's reference at the
+    recorded bag, its reference on the exciter's topic (``joints``; ``t`` and ``positions``, a
+    platform's x, y, z for a pose reference), the bag's reference at the
     same times since the first played sample, and the loaded description."""
     import sys
+    from types import SimpleNamespace
 
     from cablelab.bags import open_bag
     from cablelab.description import load_description
     from cablelab.excite import design, get_exciter, read_reference, write_reference
 
-    def run(plant, description, params, nodes, counts, joints, duration=12.0, max_iter=5, timeout=180):
+    def run(plant, description, params, nodes, counts, joints, duration=12.0, max_iter=5, timeout=180,
+            controller=None):
         desc = load_description(description)
         exciter = get_exciter(plant)
         ref = tmp_path / "ref"
@@ -66,12 +70,16 @@ def play_designed(launcher, tmp_path):
                                       node_name="cablelab_recorder")
         for role, executable, parameters in nodes:
             launcher.node(role, executable, plant, parameters)
-        launcher.node("controller", "pd_feedforward", plant, {"reference_bag": str(ref)})
+        launcher.node("controller", "pd_feedforward", plant, {"reference_bag": str(ref), **(controller or {})})
         launcher.wait_for_recorded(bag_dir, counts, timeout=timeout)
         codes = launcher.stop_all()
         assert set(codes.values()) == {0} and "controller" in codes, codes
         bag = open_bag(bag_dir)
-        played = bag.joint_trajectory(exciter.reference_topic, joints)
+        if exciter.trajectory == "pose":      # a platform's x, y, z (MultiDOFJointTrajectory)
+            tr = bag.multidof_trajectory(exciter.reference_topic)
+            played = SimpleNamespace(t=tr.t, positions=tr.position)
+        else:
+            played = bag.joint_trajectory(exciter.reference_topic, joints)
         want = read_reference(ref, exciter.reference_topic, joints)(played.t - played.t[0])[0]
         return bag, played, want, desc
 

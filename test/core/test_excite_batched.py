@@ -61,7 +61,7 @@ def test_pose_reference_round_trip(tmp_path):
     from cablelab.plants.cdpr.topics import REFERENCE
 
     desc = default_description()
-    d = E.design("cdpr", desc, ["b[winch_1]", "m"], duration=10.0, max_iter=2)
+    d = E.design("cdpr", desc, ["b[winch_1]", "m"], duration=16.0, max_iter=2)
     E.write_reference(tmp_path / "ref", d, E.get_exciter("cdpr"))
     tr = open_bag(tmp_path / "ref").multidof_trajectory(REFERENCE)
     assert tr.quaternion[:, 3] == pytest.approx(1.0) and np.allclose(tr.quaternion[:, :3], 0.0)

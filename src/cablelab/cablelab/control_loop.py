@@ -92,6 +92,7 @@ class LoopStats:
         self.keep = int(keep)
         self.worst_p99 = 0.0
         self.last_p99 = 0.0
+        self.wakeup_max = 0.0       # s: the latest start after a deadline
         self._win = np.empty(self.window)
         self._nwin = 0
         self._first = None          # (wall, stamp) of the first counted cycle
@@ -107,10 +108,13 @@ class LoopStats:
             return None
         return (self._last[1] - self._first[1]) / (self._last[0] - self._first[0])
 
-    def record(self, late: bool, body: float, wall: float, stamp: float) -> None:
-        """One counted cycle: late or not, its body time (s), wake-up wall time and stamp."""
+    def record(self, late: bool, body: float, wall: float, stamp: float, behind: float = 0.0) -> None:
+        """One counted cycle: late or not, its body time (s), wake-up wall time and stamp, and
+        how far after its deadline it started (s)."""
         self.cycles += 1
         self.late += bool(late)
+        if behind > self.wakeup_max:
+            self.wakeup_max = behind
         if len(self.bodies) < self.keep:
             self.bodies.append(body)
         self._win[self._nwin] = body
@@ -130,7 +134,7 @@ class LoopStats:
                 "late": self.late, "dropped": self.dropped,
                 "p99_ms": 1e3 * (self.worst_p99 if self.worst_p99 else float(np.percentile(b, 99))),
                 "p99_all_ms": 1e3 * float(np.percentile(b, 99)), "median_ms": 1e3 * float(np.median(b)),
-                "realtime_factor": self.realtime_factor}
+                "realtime_factor": self.realtime_factor, "wakeup_max_ms": 1e3 * self.wakeup_max}
 
 
 class ControlLoop:
@@ -209,7 +213,7 @@ class ControlLoop:
                 continue
             state, command = self.cycle()
             if counting:
-                self.stats.record(behind >= T, clock() - woke, woke, state.t)
+                self.stats.record(behind >= T, clock() - woke, woke, state.t, behind)
             self.k += 1
             if self.after_write is not None:
                 self.after_write(state, command)

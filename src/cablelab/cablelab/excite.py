@@ -8,7 +8,9 @@ IEEE T-RA 1997): every joint follows a finite Fourier series
     q_j(t) = c_j + w(t) s_j sum_k [a_jk / (k w_f) sin(k w_f t) - b_jk / (k w_f) cos(k w_f t)]
 
 (base frequency w_f = 2 pi f_0, H harmonics; w(t) a smoothstep fade-in and fade-out so the
-machine starts and ends at rest at c), and the coefficients minimise the condition number of
+machine starts and ends at rest at c; a plant whose machine rests elsewhere when the reference
+starts, its ``Exciter.start``, gets a quintic lead-in from there to c, as fast as the speed and
+acceleration limits allow, within the requested duration), and the coefficients minimise the condition number of
 the named parameters' information (:func:`condition`: unit-norm columns of the regressor of the
 model that holds them, the plant's nominal model plus the effects they belong to, with the other
 parameters eliminated), computed with the plant's own effects on the dataset the
@@ -22,7 +24,7 @@ its limits from the description and a ``motion_dataset(t, q, qd, qdd, descriptio
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Callable, Sequence
 
 import numpy as np
@@ -82,6 +84,9 @@ class Exciter:
         trajectory: ``"joint"`` (trajectory_msgs/JointTrajectory of the limits' joints) or
             ``"pose"`` (trajectory_msgs/MultiDOFJointTrajectory of a level platform: the joints
             are its x, y, z).
+        start: ``fn(description) -> (n,)``: where the machine rests when the reference starts
+            (e.g. the simulator's start pose), or None: at the centre of the limits' box. The
+            designed reference then begins with a lead-in from there (:func:`lead_in`).
     """
 
     limits: Callable
@@ -92,6 +97,7 @@ class Exciter:
     rate_hz: float = 100.0
     grid: float = 10.0
     trajectory: str = "joint"
+    start: Callable | None = None
 
 
 _EXCITERS: dict[str, Exciter] = {}
@@ -113,18 +119,49 @@ def get_exciter(plant: str) -> Exciter:
     return ex
 
 
+def _smoothstep(x: np.ndarray, length: float):
+    """Quintic smoothstep from 0 (x <= 0) to 1 (x >= length), zero speed and acceleration at both
+    ends, with its first and second derivatives in x."""
+    s = np.clip(x / length, 0, 1)
+    inside = (x > 0) & (x < length)
+    w = s ** 3 * (10 - 15 * s + 6 * s * s)
+    wd = np.where(inside, 30 * s * s * (1 - s) ** 2 / length, 0.0)
+    wdd = np.where(inside, 60 * s * (1 - s) * (1 - 2 * s) / length ** 2, 0.0)
+    return w, wd, wdd
+
+
+#: peak speed and acceleration of the quintic smoothstep over a unit stroke in unit time
+_PEAK_SPEED, _PEAK_ACCEL = 15.0 / 8.0, 10.0 / np.sqrt(3.0)
+
+
+def lead_in(start, limits: Limits, rate_hz: float):
+    """The quintic move at rest from ``start`` (n,) to the centre of the limits' box, the fastest
+    the speed and acceleration limits allow on every joint (its length rounded up to the
+    ``rate_hz`` grid): ``(length s, fn(t) -> (q, qd, qdd))`` (N, n) each, 0 <= t <= length."""
+    q0 = np.asarray(start, float)
+    q1 = 0.5 * (limits.lower + limits.upper)
+    d = q1 - q0
+    a = np.abs(d)
+    length = float(np.max(np.maximum(_PEAK_SPEED * a / limits.speed, np.sqrt(_PEAK_ACCEL * a / limits.accel))))
+    length = np.ceil(length * rate_hz - 1e-9) / rate_hz
+
+    def fn(t):
+        t = np.asarray(t, float)
+        if length <= 0:                        # already at the centre
+            return np.tile(q0, (len(t), 1)), np.zeros((len(t), len(q0))), np.zeros((len(t), len(q0)))
+        w, wd, wdd = (v[:, None] for v in _smoothstep(t, length))
+        return q0 + w * d, wd * d, wdd * d
+
+    return length, fn
+
+
 def _window(t: np.ndarray, duration: float):
     """Smoothstep fade-in over the first and fade-out over the last FADE_S seconds, with its first
     and second derivatives."""
     fade = min(FADE_S, duration / 4)
 
     def ramp(x):
-        s = np.clip(x / fade, 0, 1)
-        inside = (x > 0) & (x < fade)
-        w = s ** 3 * (10 - 15 * s + 6 * s * s)
-        wd = np.where(inside, 30 * s * s * (1 - s) ** 2 / fade, 0.0)
-        wdd = np.where(inside, 60 * s * (1 - s) * (1 - 2 * s) / fade ** 2, 0.0)
-        return w, wd, wdd
+        return _smoothstep(x, fade)
 
     a, ad, add = ramp(t)
     b, bd, bdd = ramp(duration - t)
@@ -324,7 +361,8 @@ def model_for(plant, desc, params: Sequence[str], ds) -> tuple:
 @dataclass
 class Design:
     """Result of :func:`design`: the reference (t, q, qd, qdd), its limits, the condition numbers
-    before (in the given dataset, or None) and after, the model and the seconds spent."""
+    before (in the given dataset, or None) and after, the model, the seconds spent and the
+    length of its lead-in from the machine's start (s, 0 without one)."""
 
     t: np.ndarray
     q: np.ndarray
@@ -336,12 +374,13 @@ class Design:
     condition_after: float
     model: object
     seconds: float
+    lead_in: float = 0.0
 
     def to_json(self) -> dict:
         return {"params": list(self.params), "condition_before": self.condition_before,
                 "condition_after": self.condition_after, "duration": float(self.t[-1] - self.t[0]),
                 "model": list(self.model.effects), "joints": list(self.limits.joints),
-                "seconds": self.seconds}
+                "seconds": self.seconds, "lead_in": self.lead_in}
 
 
 def _stacked_motion(xs, basis, t, limits: Limits, shape):
@@ -429,6 +468,12 @@ def design(plant_name: str, desc, params: Sequence[str], *, duration: float = 60
     plant = get_plant(plant_name)
     ex = get_exciter(plant_name)
     lim = ex.limits(desc)
+    total = duration
+    lead_s, lead = lead_in(ex.start(desc), lim, ex.rate_hz) if ex.start is not None else (0.0, None)
+    duration = total - lead_s               # the Fourier part, after the lead-in
+    if duration < 4 * FADE_S:
+        raise CablelabError(f"--duration {total!r}: expected at least {lead_s + 4 * FADE_S:g} s (the "
+                            f"move from the machine's start to the design's centre takes {lead_s:g} s)")
     n_j, h = len(lim.joints), ex.harmonics
     shape = (n_j, 2, h)
     # design grid: ex.grid (10) samples per period of the highest harmonic
@@ -481,15 +526,21 @@ def design(plant_name: str, desc, params: Sequence[str], *, duration: float = 60
         if best is None or res.fun < best.fun:
             best = res
     coef = best.x.reshape(shape)
-    t_out = np.arange(0.0, duration + 0.5 / ex.rate_hz, 1.0 / ex.rate_hz)
-    q, qd, qdd = scaled_motion(coef, t_out, lim, ex.base_hz, duration)
-    bad = lim.check(q, qd, qdd)
+    t_out = np.arange(0.0, total + 0.5 / ex.rate_hz, 1.0 / ex.rate_hz)
+    k0 = int(round(lead_s * ex.rate_hz))      # the lead-in's samples, then the Fourier part from 0
+    motion = scaled_motion(coef, t_out[k0:] - t_out[k0], lim, ex.base_hz, duration)
+    if lead is not None:
+        motion = [np.concatenate([a[:-1], b]) for a, b in zip(lead(t_out[:k0 + 1]), motion)]
+    q, qd, qdd = motion
+    # a start outside the box: the lead-in's positions are checked by the constraint alone
+    check = replace(lim, lower=np.minimum(lim.lower, q[0]), upper=np.maximum(lim.upper, q[0]))
+    bad = check.check(q, qd, qdd)
     if bad:   # a plant whose box does not guarantee its constraint: refuse, never write it
         raise CablelabError(f"designed reference breaks the machine's limits: {bad[0]}")
     after = condition(model, ex.motion_dataset(t_out, q, qd, qdd, desc), params)
     before = condition(model, before_ds, params) if before_ds is not None else None
     return Design(t_out, q, qd, qdd, lim, tuple(params), before, after, model,
-                  time.monotonic() - t0)
+                  time.monotonic() - t0, lead_s)
 
 
 def write_reference(path, d: Design, exciter: Exciter, description_yaml: str | None = None,
@@ -539,6 +590,6 @@ def read_reference(path, topic: str, joints: Sequence[str]):
     return fn
 
 
-__all__ = ["Design", "Exciter", "LINEARISED", "Limits", "Linearised", "block_conditions", "condition", "design", "fourier_basis",
-           "fourier_motion", "get_exciter",
-           "linear_values", "model_for", "read_reference", "register_exciter", "scaled_motion", "write_reference"]
+__all__ = ["Design", "Exciter", "LINEARISED", "Limits", "Linearised", "block_conditions", "condition", "design",
+           "fourier_basis", "fourier_motion", "get_exciter", "lead_in", "linear_values",
+           "model_for", "read_reference", "register_exciter", "scaled_motion", "write_reference"]

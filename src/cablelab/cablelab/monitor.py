@@ -216,7 +216,7 @@ class ResidualMonitor:
         hold: seconds outside the band before an alarm. band_sigma: band = band_sigma x the
             residual RMS (calibration). calibrate: seconds of stream the calibration fits on.
         options: plant options by name (``tensions`` ...), as the command line's; those the plant
-            does not have are left out (the monitor node offers the CDPR's for every plant).
+            does not have are left out.
     """
 
     def __init__(self, plant_name: str, desc, model: MonitorModel, *, window: float = 3.0,

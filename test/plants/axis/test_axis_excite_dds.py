@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from cablelab.plants.axis.nodes.sim import DEFAULT_DESCRIPTION
+from cablelab.plants.axis.sim import DEFAULT_DESCRIPTION
 
 
 def test_axis_controller_plays_the_reference_bag(play_designed):

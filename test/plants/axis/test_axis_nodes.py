@@ -92,6 +92,19 @@ def test_rls_batch_equals_sequential_and_recovers_parameters():
     np.testing.assert_array_equal(rls.theta, before)
 
 
+def test_sine_trajectory_is_the_closed_form_sine_at_the_stamps_as_columns():
+    """The built-in reference the controller plays (``reference_source:=sine``): position, rate
+    and acceleration of ``offset + A sin(2 pi f t)`` at the state stamps themselves, one column."""
+    from cablelab.plants.axis.control import sine_trajectory
+
+    t = np.array([0.0, 0.3, 1.7, 12.25])
+    q, qd, qdd = sine_trajectory(0.2, 0.5, 0.1)(t, None)
+    assert q.shape == qd.shape == qdd.shape == (4, 1)
+    np.testing.assert_allclose(q[:, 0], 0.1 + 0.2 * np.sin(np.pi * t), atol=1e-12)
+    np.testing.assert_allclose(qd[:, 0], 0.2 * np.pi * np.cos(np.pi * t), atol=1e-12)
+    np.testing.assert_allclose(qdd[:, 0], -0.2 * np.pi ** 2 * np.sin(np.pi * t), atol=1e-12)
+
+
 # ----------------------------------------------------------------------------- input checks
 def test_input_monitor_rejects_nan_wrong_length_and_reports_stale():
     mon = InputMonitor()
@@ -233,7 +246,7 @@ def test_controller_and_estimator_ignore_bad_states(ros_context):
     try:
         ctl.on_state(convert.joint_state_msg(1.0, ["joint"], [0.0], [0.0], [0.0]))
         assert not sent  # no reference yet: no command
-        ctl.on_reference(convert.joint_trajectory_msg(1.0, ["joint"], [0.1], [0.0], [0.0]))
+        ctl.reference.on_message(convert.joint_trajectory_msg(1.0, ["joint"], [0.1], [0.0], [0.0]))
         ctl.on_state(convert.joint_state_msg(1.0, ["joint"], [0.0], [0.0], [0.0]))
         assert len(sent) == 1 and sent[0].data[0] == pytest.approx(ctl.kp * 0.1)
         ctl.on_state(convert.joint_state_msg(1.0, ["joint"], [float("nan")], [0.0], [0.0]))
@@ -241,7 +254,7 @@ def test_controller_and_estimator_ignore_bad_states(ros_context):
         assert len(sent) == 1 and ctl.inputs.inputs["joint_states"].rejected == 2
         for m in (JointState(), convert.joint_state_msg(1.0, ["joint"], [0.0], [0.0], None)):
             est.on_state(m)
-        assert est.inputs.inputs["joint_states"].rejected == 2 and est.rls.n == 0
+        assert est.inputs.inputs["joint_states"].rejected == 2 and est.est.rls.n == 0
     finally:
         ctl.destroy_node()
         est.destroy_node()

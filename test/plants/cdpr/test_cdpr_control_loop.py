@@ -3,6 +3,7 @@ loop's controller node on one recorded state stream, the hardware seam, the dead
 accounting, and the loop over DDS surviving the estimator's death."""
 from __future__ import annotations
 
+import json
 import time
 
 import numpy as np
@@ -13,9 +14,11 @@ from cablelab.errors import CablelabError
 
 @pytest.fixture
 def ros_context(domain_id):
+    """rclpy for nodes built in the test's process; a control loop publishes in its own thread
+    (``publisher:=loop``), so that the test sees every publish call."""
     import rclpy
 
-    rclpy.init(domain_id=domain_id)
+    rclpy.init(args=["test", "--ros-args", "-p", "publisher:=loop"], domain_id=domain_id)
     yield
     rclpy.try_shutdown()
 
@@ -40,13 +43,13 @@ def test_loop_commands_equal_the_controller_node_on_a_recorded_stream(ros_contex
     loop_node = CdprControlLoop()
     ctl = CdprController()
     from_loop, from_node = [], []
-    loop_node.out.pub_cmd.publish = _capture(from_loop, Float64MultiArray)
+    loop_node.cycle_pub.out.pub_cmd.publish = _capture(from_loop, Float64MultiArray)
     from sensor_msgs.msg import JointState
     from trajectory_msgs.msg import MultiDOFJointTrajectory
     js, tens, refs = [], [], []
-    loop_node.out.pub_js.publish = _capture(js, JointState)
-    loop_node.out.pub_ten.publish = _capture(tens, JointState)
-    loop_node.out.pub_ref.publish = _capture(refs, MultiDOFJointTrajectory)
+    loop_node.cycle_pub.out.pub_js.publish = _capture(js, JointState)
+    loop_node.cycle_pub.out.pub_ten.publish = _capture(tens, JointState)
+    loop_node.cycle_pub.out.pub_ref.publish = _capture(refs, MultiDOFJointTrajectory)
     ctl.pub_cmd.publish = _capture(from_node, Float64MultiArray)
     ctl.polled = []                 # callbacks alone, no DDS
     loop_node.take_every = 10 ** 9  # estimates are fed by hand below, at the same points for both
@@ -104,6 +107,40 @@ def test_loop_commands_equal_the_controller_node_on_a_recorded_stream(ros_contex
         loop_node.loop.stop()
         loop_node.destroy_node()
         ctl.destroy_node()
+
+
+def test_publisher_thread_publishes_every_sample_in_order(domain_id):
+    """``publisher:=thread``: the samples queued after each write are all published by the
+    thread, in the order of the periods, by the time the node shuts down."""
+    import rclpy
+    from sensor_msgs.msg import JointState
+    from std_msgs.msg import Float64MultiArray
+
+    from cablelab.plants.cdpr.nodes.control_loop import CdprControlLoop
+    from cablelab.ros import convert
+
+    rclpy.init(args=["test", "--ros-args", "-p", "publisher:=thread", "-p", "publish_batch:=0.002",
+                     "-p", "rate:=500.0"], domain_id=domain_id)
+    try:
+        node = CdprControlLoop()
+        js, cmds = [], []
+        node.cycle_pub.out.pub_js.publish = _capture(js, JointState)
+        node.cycle_pub.out.pub_cmd.publish = _capture(cmds, Float64MultiArray)
+        try:
+            node.loop.start()
+            states = []
+            for _ in range(300):
+                state, command = node.loop.cycle()
+                states.append(state)
+                node._after_write(state, command)
+            node.shutdown()
+            assert [convert.from_stamp(m.header.stamp) for m in js] == pytest.approx([s.t for s in states], abs=1e-9)
+            np.testing.assert_array_equal([m.position for m in js], [s.position for s in states])
+            assert [convert.command_stamp(m) for m in cmds] == pytest.approx([s.t for s in states], abs=1e-9)
+        finally:
+            node.destroy_node()
+    finally:
+        rclpy.try_shutdown()
 
 
 def test_hardware_seam():
@@ -172,10 +209,10 @@ def test_loop_survives_the_estimator_over_dds(launcher):
     """control_loop + payload_estimator as processes: the loop takes the live estimate; when the
     estimator is killed it keeps running (its state stream goes on) and reports the stale
     estimate on /diagnostics as WARN within a bounded time. (Publishing through the publisher
-    thread here; the equality test above covers publishing in the loop's thread.)"""
+    process, the default; the equality test above covers publishing in the loop's thread.)"""
     launcher.node("estimator", "payload_estimator", "cdpr", {"poll_period": 0.01})
     launcher.start("loop", [*_loop_argv(), "--ros-args", "-p", "rate:=250.0", "-p", "payload_mass:=249.0",
-                            "-p", "estimate_timeout:=1.0", "-p", "publish_thread:=true"])
+                            "-p", "estimate_timeout:=1.0"])
     probe, seen = _diag_listener(launcher)
 
     def loop_alive():
@@ -215,6 +252,68 @@ def test_loop_survives_the_estimator_over_dds(launcher):
     assert codes["loop"] == 0, launcher.procs["loop"].log()[-2000:]
     summary = [ln for ln in launcher.procs["loop"].log().splitlines() if ln.startswith('{"node": "control_loop"')]
     assert summary, launcher.procs["loop"].log()[-2000:]
+
+
+def test_recorder_gets_every_sample_through_the_publisher_process(launcher, tmp_path):
+    """The loop's samples go through the shared-memory ring to its publisher process (the
+    default ``publisher:=process``): a recorder started before the loop records every period's
+    joint state, tensions and command, once each and in the order of the periods, and the values
+    are the simulated robot's (the commands pull on every cable; the stamps are the loop's)."""
+    import sys
+
+    from cablelab.bags import open_bag
+
+    bag_dir = tmp_path / "run"
+    launcher.start("recorder", [sys.executable, "-m", "cablelab.cli", "record", "--plant", "cdpr",
+                                "-o", bag_dir, "--quiet"])
+    launcher.wait_for_subscribers(["/cdpr/joint_states", "/cdpr/effort_commands"], timeout=120,
+                                  node_name="cablelab_recorder")
+    rate, duration = 500.0, 3.0
+    loop = launcher.start("loop", [*_loop_argv(), "--ros-args", "-p", f"rate:={rate}", "-p", f"duration:={duration}",
+                                   "-p", "warmup:=0.0"])
+    assert loop.wait(600) == 0, loop.log()[-2000:]
+    summary = json.loads([ln for ln in loop.log().splitlines() if ln.startswith('{"node": "control_loop"')][-1])
+    n = summary["samples_written"]                  # stamps 0 .. duration (+ round-off), one per period
+    assert n in (duration * rate + 1, duration * rate + 2), n
+    assert summary["publisher"] == "process" and summary["commands"] == n
+    assert summary["samples_published"] == n and summary["samples_lost"] == 0
+    # every sample was published (above); what the recorder got: from its first sample (the
+    # publisher waits for the subscribers it has discovered; on a very busy machine discovery may
+    # take longer, which is DDS's matter, not the loop's) to the last, each period once, in order
+    last = (n - 1) / rate
+    deadline = time.monotonic() + 180
+    while True:
+        try:
+            bag = open_bag(bag_dir, recover=True)
+            done = all(bag.has(t) and bag.counts[t] and abs(_last_stamp(bag, t) - last) < 1e-9
+                       for t in ("/cdpr/joint_states", "/cdpr/cable_tensions", "/cdpr/effort_commands"))
+        except CablelabError:
+            done = False
+        if done or time.monotonic() > deadline:
+            break
+        time.sleep(0.5)
+    codes = launcher.stop_all()
+    assert codes["recorder"] == 0, codes
+    bag = open_bag(bag_dir)
+    stamps = {t: bag.joint_state(t).t for t in ("/cdpr/joint_states", "/cdpr/cable_tensions")}
+    from cablelab.ros.convert import label_stamp
+    stamps["/cdpr/effort_commands"] = np.array([label_stamp(m.layout.dim[0].label)
+                                                for m in bag.messages("/cdpr/effort_commands")])
+    for topic, t in stamps.items():
+        k0 = int(round(t[0] * rate))
+        assert k0 <= 0.5 * rate, (topic, t[0])                  # recorded from early on
+        np.testing.assert_allclose(t, np.arange(k0, n) / rate, atol=1e-9, err_msg=topic)  # none lost, in order
+    assert np.isfinite(bag.joint_state("/cdpr/cable_tensions").effort).all()
+    cmd = bag.float_array("/cdpr/effort_commands")
+    assert (cmd.data > 0).all()                                  # every command pulls on every cable
+
+
+def _last_stamp(bag, topic):
+    if topic == "/cdpr/effort_commands":
+        from cablelab.ros.convert import label_stamp
+
+        return label_stamp(bag.messages(topic)[-1].layout.dim[0].label)
+    return float(bag.joint_state(topic).t[-1])
 
 
 def _loop_argv():
@@ -317,7 +416,8 @@ def test_loop_survives_any_estimate(ros_context):
     from cablelab.ros import convert
 
     node = CdprControlLoop()
-    node.out.pub_cmd.publish = node.out.pub_js.publish = node.out.pub_ten.publish = node.out.pub_ref.publish = lambda m: None
+    out = node.cycle_pub.out
+    out.pub_cmd.publish = out.pub_js.publish = out.pub_ten.publish = out.pub_ref.publish = lambda m: None
     node.loop.start()
     anchors = node.description.cdpr.anchor_points[:, :2]
     num = st.one_of(st.floats(allow_nan=True, allow_infinity=True), st.sampled_from([0.0, -615.0, 615.0, 1e300]))

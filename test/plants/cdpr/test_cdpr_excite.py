@@ -15,7 +15,8 @@ from cablelab.diagnose.identifiability import correlations
 from cablelab.excite import get_exciter, read_reference
 from cablelab.fit import identify
 from cablelab.plants.cdpr.control import PdffConfig
-from cablelab.plants.cdpr.sim import CdprTruth, default_description, simulate, write_run_bag
+from cablelab.plants.cdpr.sim import (CdprTruth, default_description, default_description_path, simulate,
+                                      write_run_bag)
 from cablelab.plants.cdpr.topics import REFERENCE
 from cablelab.plants.cdpr.trajectory import Trajectory
 from cablelab.workbench import build_model, load
@@ -90,3 +91,41 @@ def _max_corr(r) -> float:
     """Largest |correlation| between the mass and a dynamometer offset in a fit."""
     names, corr = correlations(r)
     return max(abs(corr[names.index("m"), names.index(f"b[winch_{i}]")]) for i in range(1, 9))
+
+
+def test_designed_reference_starts_where_the_simulator_starts():
+    """The design begins at rest at point A of the pick-and-place (where ``cable_sim_node --plant
+    cdpr`` starts the platform) and reaches the box's centre by the lead-in, as fast as the limits
+    allow: positions, speeds and accelerations continuous (each the derivative of the one
+    before), within every limit, in the requested duration."""
+    from cablelab.excite import FADE_S, design
+    from cablelab.plants.cdpr.trajectory import CAROCA_WAYPOINTS
+
+    desc = default_description()
+    d = design("cdpr", desc, ["b[winch_1]", "m"], duration=20.0, max_iter=2)
+    lim = d.limits
+    assert d.t[-1] == pytest.approx(20.0) and 0 < d.lead_in < 20.0 - 8.0
+    np.testing.assert_allclose(d.q[0], CAROCA_WAYPOINTS[0], atol=1e-12)
+    assert np.abs(d.qd[0]).max() < 1e-12 and np.abs(d.qdd[0]).max() < 1e-12
+    k = int(round(d.lead_in * 100))
+    np.testing.assert_allclose(d.q[k], 0.5 * (lim.lower + lim.upper), atol=1e-9)   # at rest at the centre
+    assert np.abs(d.qd[k]).max() < 1e-9 and np.abs(d.qdd[k]).max() < 1e-9
+    assert lim.check(d.q, d.qd, d.qdd) == []
+    # the fastest move: one axis reaches its speed or acceleration limit (within a sample)
+    peak = np.max(np.maximum(np.abs(d.qd[:k]) / lim.speed, np.abs(d.qdd[:k]) / lim.accel))
+    assert 0.98 < peak <= 1.0 + 1e-9
+    # smooth through the junction: central differences of q and qd give qd and qdd (away from
+    # the Fourier window's corners FADE_S after the lead-in and before the end, where the jerk
+    # jumps and the central difference of qd is off by O(dt))
+    dt = d.t[1] - d.t[0]
+    np.testing.assert_allclose(np.gradient(d.q, dt, axis=0)[1:-1], d.qd[1:-1], atol=2e-4)
+    smooth = (np.abs(d.t - d.lead_in - FADE_S) > 0.015) & (np.abs(d.t - d.t[-1] + FADE_S) > 0.015)
+    smooth[[0, -1]] = False
+    np.testing.assert_allclose(np.gradient(d.qd, dt, axis=0)[smooth], d.qdd[smooth], atol=2e-3)
+
+
+def test_too_short_for_the_lead_in_is_a_one_line_error(tmp_path, capsys):
+    assert main(["excite", "--description", default_description_path(), "--params", "b[winch_1],m",
+                 "--duration", "10", "-o", str(tmp_path / "ref")]) != 0
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--duration 10" in err[0] and "from the machine's start" in err[0], err

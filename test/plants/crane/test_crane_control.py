@@ -6,7 +6,7 @@ import mujoco
 from cablelab.plants.crane.control import LIVE_GAINS, Gains, control_law, hold_command, joint_command, sim_drive
 from cablelab.plants.crane.model import CraneParams
 from cablelab.plants.crane.mjcf import build_mjcf
-from cablelab.plants.crane.sim import CraneTruth, contract_to_qpos, simulate
+from cablelab.plants.crane.sim import CraneSim, CraneTruth, contract_to_qpos, simulate
 
 P = CraneParams()
 
@@ -68,6 +68,21 @@ def test_sim_drive_applies_answers_and_fresh_commands_else_holds_against_mujoco_
     qd = np.array([0.5, -0.3, 0.2, 0.0, 0.0])
     got, held = sim_drive(None, q, qd, P, answered=False, fresh=False, lockstep=False)
     np.testing.assert_allclose(got - gravity, -np.asarray(LIVE_GAINS.kd) * qd[:3], rtol=1e-6, atol=1e-6)
+
+
+def test_simulator_period_holds_the_crane_until_an_answer_and_counts_the_holds():
+    """``CraneSim.drive`` (one period of the simulator node): with no command the drives keep
+    the crane where it is (luff within 1 mrad after 0.5 s: MuJoCo's gravity is held) and each
+    period is counted as held; an answer is applied as given (the MuJoCo controls)."""
+    sim = CraneSim(CraneTruth(params=P), (0.0, 0.5, 0.6))
+    for _ in range(50):
+        assert sim.drive(None, 0.01, answered=False, fresh=False, lockstep=True)
+    _, q, _ = sim.state()
+    assert abs(q[1] - 0.5) < 1e-3 and sim.held == 50
+    u = np.array([0.5, -1.0, 2.0])
+    assert not sim.drive(u, 0.01, answered=True, fresh=False, lockstep=True)
+    np.testing.assert_array_equal(sim.data.ctrl, u)
+    assert sim.held == 50
 
 
 def test_joint_command_at_its_reference_or_stale_is_mujocos_gravity_load():

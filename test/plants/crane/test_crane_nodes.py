@@ -40,7 +40,7 @@ def test_adapters_survive_nan_wrong_length_stale(ros_context):
         for _ in range(50):
             sim.tick()
         _, q, _ = sim.sim.state()
-        assert abs(q[1] - 0.5) < 1e-3 and sim.fallbacks == 50
+        assert abs(q[1] - 0.5) < 1e-3 and sim.sim.held == 50
         # estimator: NaN pose = dropout, reported; good pair -> exact swing
         m = sim.sim.measurement()
         t = sim.sim.time
@@ -67,7 +67,7 @@ def test_adapters_survive_nan_wrong_length_stale(ros_context):
         ctl.on_state(convert.joint_state_msg(t, ["slew", "luff", "hoist"], [np.nan, 0, 0]))
         ctl.on_state(convert.joint_state_msg(t, ["slew", "luff"], [0, 0]))
         assert len(sent) == 1 and ctl.inputs.inputs["joint_states"].rejected == 2
-        ctl.on_reference(convert.joint_trajectory_msg(t, ["slew", "luff", "hoist"], m["joints"] + [0.1, 0, 0],
+        ctl.reference.on_message(convert.joint_trajectory_msg(t, ["slew", "luff", "hoist"], m["joints"] + [0.1, 0, 0],
                                                       [0, 0, 0], [0, 0, 0]))
         ctl.on_state(js)
         assert sent[-1].data[0] == pytest.approx(ctl.gains.kp[0] * 0.1, rel=1e-6)

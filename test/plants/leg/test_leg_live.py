@@ -101,3 +101,20 @@ def test_controller_holds_on_nan_apex():
 def test_grf_zero_at_rest_equilibrium():
     z_eq = P.spring_rest - P.m * P.g / P.k
     assert grf(z_eq, 0.0, 0.0, P) == pytest.approx(P.m * P.g)
+
+
+def test_controller_step_takes_each_apex_of_the_estimate_stream_once():
+    """The controller node's per-estimate step: the hop estimate repeats the last apex until the
+    next one; T is updated once per apex (oracle: on_apex called once per apex), not at NaN
+    apex times, and the torque is the law's for the phase."""
+    h_des = P.z_td + 0.016
+    ctl, ref = ApexController(P, h_des, T=1.2), ApexController(P, h_des, T=1.2)
+    for k in range(5):                                   # five estimates, one apex at t = 0.5
+        assert ctl.step(0.5 + 0.001 * k, 0, P.z_td + 0.010, 0.5) == 0.0
+    assert ctl.T == ref.on_apex(P.z_td + 0.010) != 1.2
+    ctl.step(0.9, 0, P.z_td + 0.020, math.nan)          # no apex yet
+    assert ctl.T == ref.T
+    ctl.step(1.0, 0, P.z_td + 0.020, 1.0)               # the next apex
+    assert ctl.T == ref.on_apex(P.z_td + 0.020)
+    assert ctl.step(1.1, STANCE, P.z_td + 0.020, 1.0) == ref.torque(1.1, STANCE)
+    assert ctl.step(1.1 + ctl.P / 4, STANCE, P.z_td + 0.020, 1.0) == pytest.approx(ctl.T)

@@ -31,7 +31,8 @@ def add_arguments(p) -> None:
                    help="parameters to separate, as the fit names them (e.g. 'OF[hoist],m'; 'tau,I_tot' "
                         "for a delay, linearised)")
     p.add_argument("--duration", type=number(ge=5, le=3600, unit="s"), default=60.0, metavar="S",
-                   help="length of the designed reference, s (default 60)")
+                   help="length of the designed reference, s (default 60; for a plant whose machine "
+                        "starts away from the design's centre, the CDPR, it includes the move from there)")
     p.add_argument("--seed", type=number(ge=0, le=2**32 - 1, integer=True), default=0, help="seed of the optimiser's random start")
     p.add_argument("-o", "--out", required=True, metavar="REF", help="reference bag to write")
     add_overwrite(p)

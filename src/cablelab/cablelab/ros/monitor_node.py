@@ -9,11 +9,14 @@ stamped like the inputs) is published, the same topics as the overlay bag of ``c
 ``error_factor`` bands) with the channel, the residual's size and the stamps when one stays
 outside longer than ``hold`` s; published at once when the level changes.
 
-ROS parameters: :data:`PARAMETERS` (``model_monitor --plant P --help``). The monitor is off every
-critical path: run it with a positive niceness beside a 1 kHz loop.
+ROS parameters: :data:`PARAMETERS`, and the plant's own options its dataset takes
+(:func:`plant_parameters`, e.g. the CDPR's ``tensions``), together :func:`parameters_for`
+(``model_monitor --plant P --help``). The monitor is off every critical path: run it with a
+positive niceness beside a 1 kHz loop.
 """
 from __future__ import annotations
 
+import dataclasses
 import importlib
 import time
 from pathlib import Path
@@ -22,6 +25,7 @@ import numpy as np
 from sensor_msgs.msg import JointState
 
 from ..errors import CablelabError
+from ..plant_interface import cli_options
 from . import convert
 from .params import DESCRIPTION, Param, executor_params, help_text, merge
 from .plant_node import PlantNode
@@ -40,9 +44,29 @@ PARAMETERS = merge((
     Param("calibrate", 10.0, "stream used to fit the nominal model when no identify_json is given", "s",
           gt=0.0, le=1e6),
     Param("error_factor", 3.0, "ERROR instead of WARN beyond this many bands", gt=0.0, le=1e6),
-    Param("tensions", "dynamometer", "CDPR: which tension measurement the model uses",
-          choices=("dynamometer", "motor")),
 ), executor_params(False))
+
+#: the verb whose options the monitor takes: it compares the model with the stream as it does
+MONITOR_VERB = "compare"
+
+
+def plant_parameters(plant) -> tuple:
+    """The plant's own options its dataset takes (the fields of its ``options_type`` that
+    ``cablelab compare`` offers on the command line, :func:`cablelab.plant_interface.option`) as
+    ROS parameters of the same name, default, choices and help (CDPR: ``tensions``)."""
+    if plant.options_type is None:
+        return ()
+    defaults = {f.name: f.default for f in dataclasses.fields(plant.options_type)}
+    return tuple(Param(name, defaults[name], f"{plant.name}: {opt.help}", choices=tuple(opt.choices or ()))
+                 for name, opt in cli_options(plant.options_type) if MONITOR_VERB in opt.verbs)
+
+
+def parameters_for(plant_name: str) -> tuple:
+    """Every ROS parameter of ``model_monitor --plant plant_name``: :data:`PARAMETERS` and the
+    plant's own (:func:`plant_parameters`)."""
+    from ..registry import get_plant
+
+    return merge(PARAMETERS, plant_parameters(get_plant(plant_name)))
 
 
 def _msg_class(msgtype: str):
@@ -58,10 +82,10 @@ class ModelMonitorNode(PlantNode):
 
         self.plant_name = plant
         self.plant = get_plant(plant)
-        v = self.declare_params(PARAMETERS)
+        v = self.declare_params(parameters_for(plant))
+        self.options = {p.name: getattr(v, p.name) for p in plant_parameters(self.plant)}
         self.band_sigma, self.hold, self.window = v.band_sigma, v.hold, v.window
         self.period, self.calibrate, self.error_factor = v.period, v.calibrate, v.error_factor
-        self.tensions = v.tensions
         path = v.identify_json
         if path:
             try:
@@ -99,7 +123,7 @@ class ModelMonitorNode(PlantNode):
         self.keep_first_description = True
         self.monitor = ResidualMonitor(self.plant_name, desc, self.spec, window=self.window, hold=self.hold,
                                        band_sigma=self.band_sigma, calibrate=self.calibrate,
-                                       error_factor=self.error_factor, options={"tensions": self.tensions})
+                                       error_factor=self.error_factor, options=self.options)
 
     def on_message(self, topic: str, data: bytes) -> None:
         now = time.monotonic()
@@ -153,13 +177,17 @@ def main(argv=None) -> int:
 
     argv = list(sys.argv[1:] if argv is None else argv)
     user, ros_args = split_ros_args(argv)
+    pre = argparse.ArgumentParser(add_help=False)
+    pre.add_argument("--plant", choices=available_plants())
+    known, _ = pre.parse_known_args(user)
+    specs = parameters_for(known.plant) if known.plant else PARAMETERS   # with P: P's own options too
     parser = argparse.ArgumentParser(
         prog="model_monitor", description="Live model monitor: the plant's identified model on the live "
         "topics; publishes /<plant>/model/{measured,prediction,residual} and raises WARN/ERROR on "
         "/diagnostics when a channel's residual leaves its band for longer than a set time.",
         formatter_class=argparse.RawDescriptionHelpFormatter,
         epilog="ROS parameters (--ros-args -p name:=value, or --params-file FILE.yaml):\n"
-               f"{help_text(PARAMETERS)}\n\nStops cleanly on SIGINT/SIGTERM.")
+               f"{help_text(specs)}\n\nStops cleanly on SIGINT/SIGTERM.")
     parser.add_argument("--plant", choices=available_plants(), required=True, help="which plant")
     args = parser.parse_args(user)
     return run_node(lambda: make_node(args.plant), ros_args, "model_monitor")

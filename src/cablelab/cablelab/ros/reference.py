@@ -11,6 +11,7 @@ JointTrajectory``, stamped like the state it goes with) so recordings hold what 
 """
 from __future__ import annotations
 
+import time
 from typing import Callable, Sequence
 
 import numpy as np
@@ -18,9 +19,9 @@ from trajectory_msgs.msg import JointTrajectory, MultiDOFJointTrajectory
 
 from . import convert
 from .params import Param
-from .qos import publisher_qos
+from .qos import publisher_qos, stream_qos
 
-__all__ = ["ReferencePlayer", "reference_bag_param"]
+__all__ = ["ReferencePlayer", "reference_bag_param", "FollowedReference"]
 
 
 def reference_bag_param(topic: str, overrides: str = "reference_source") -> Param:
@@ -39,11 +40,15 @@ class ReferencePlayer:
         joints: the joint names of the published trajectory point.
         platform: the reference is the platform's position x, y, z, published as a
             ``MultiDOFJointTrajectory`` (orientation identity; the CDPR) instead.
+        absolute: ``trajectory`` is given the state stamps themselves, not the time since the
+            first state.
     """
 
     def __init__(self, node, topic: str, joints: Sequence[str],
-                 trajectory: Callable[[np.ndarray, np.ndarray], tuple], platform: bool = False):
+                 trajectory: Callable[[np.ndarray, np.ndarray], tuple], platform: bool = False,
+                 absolute: bool = False):
         self.joints, self.trajectory, self.platform = list(joints), trajectory, platform
+        self.absolute = absolute
         self.pub = node.create_publisher(MultiDOFJointTrajectory if platform else JointTrajectory, topic,
                                          publisher_qos())
         self.t0 = None
@@ -63,10 +68,60 @@ class ReferencePlayer:
         published stamped ``t``."""
         if self.t0 is None:
             self.t0, self.q0 = t, np.array(q, dtype=float)
-        ref = tuple(x[0] for x in self.trajectory(np.array([t - self.t0]), self.q0))
+        ref = tuple(x[0] for x in self.trajectory(np.array([t if self.absolute else t - self.t0]), self.q0))
         if self.platform:
             p, v, a = ref
             self.pub.publish(convert.multidof_msg(t, p, [0.0, 0.0, 0.0, 1.0], v, None, a, None))
         else:
             self.pub.publish(convert.joint_trajectory_msg(t, self.joints, *ref))
         return ref
+
+
+class FollowedReference:
+    """The reference a controller follows: played by the controller itself (the bag of a
+    ``reference_bag`` parameter, else a built-in ``trajectory``; :class:`ReferencePlayer`,
+    published on ``topic``) or the latest point received on ``topic`` (input ``reference`` of
+    the node: wrong names, length, NaN rejected and counted; stale after ``timeout`` s wall).
+
+    Args:
+        node: the controller (:class:`~cablelab.ros.plant_node.PlantNode`).
+        topic: the plant's reference topic; joints: its joint names.
+        bag: a reference bag path (empty: none); trajectory: the built-in reference
+            (:class:`ReferencePlayer`; None: none), ``absolute`` as there.
+        timeout: a point from the topic older than this (s wall) is stale.
+        any_names: a point from the topic may name other joints (only its length is checked).
+
+    Attributes:
+        source: ``"bag"``, ``"builtin"`` or ``"topic"``.
+    """
+
+    def __init__(self, node, topic: str, joints: Sequence[str], bag: str = "",
+                 trajectory: Callable | None = None, timeout: float = 0.5, absolute: bool = False,
+                 any_names: bool = False):
+        self.node, self.joints, self.any_names = node, list(joints), any_names
+        self.source = "bag" if bag else "topic" if trajectory is None else "builtin"
+        self.player = None
+        if bag:
+            self.player = ReferencePlayer.from_bag(node, bag, topic, joints)
+        elif trajectory is not None:
+            self.player = ReferencePlayer(node, topic, joints, trajectory, absolute=absolute)
+        self.point = None
+        node.inputs.add("reference", timeout=timeout, length=len(self.joints), required=self.player is None)
+        if self.player is None:
+            node.create_subscription(JointTrajectory, topic, self.on_message, stream_qos())
+
+    def on_message(self, msg: JointTrajectory) -> None:
+        """A point from the topic: kept when usable (else counted as rejected)."""
+        ref = convert.reference_point(msg, None if self.any_names else self.joints)
+        if self.node.accept("reference", None if ref is None else ref[0]):
+            self.point = ref
+
+    def __call__(self, t: float, q):
+        """The reference ``(q, qd, qdd)`` ((n,) each) for the state of stamp ``t`` at ``q``: the
+        played sample (published), else the topic's latest point; None when it is stale or none
+        came yet."""
+        if self.player is not None:
+            return self.player(t, q)
+        if self.point is None or not self.node.inputs.fresh("reference", time.monotonic()):
+            return None
+        return self.point

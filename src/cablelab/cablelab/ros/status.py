@@ -9,7 +9,7 @@ import numpy as np
 
 from .inputs import WARN
 
-__all__ = ["add_problem", "SkipLog", "Latency"]
+__all__ = ["add_problem", "SkipLog", "Latency", "sim_values"]
 
 
 def add_problem(level: int, msg: str, new_level: int, text: str) -> tuple[int, str]:
@@ -65,3 +65,13 @@ class Latency:
         if self.samples:
             values["latency p99 ms"] = f"{1000 * np.percentile(np.asarray(self.samples[-1000:]), 99):.3f}"
         return values
+
+
+def sim_values(values: dict, t: float | None = None, lock=None) -> dict:
+    """A simulator's own /diagnostics values: ``sim time s`` (when ``t`` is given) and, with a
+    :class:`~cablelab.ros.lockstep.LockStep`, the answers to earlier states it ignored."""
+    if t is not None:
+        values["sim time s"] = f"{t:.3f}"
+    if lock is not None:
+        values["stale answers ignored (lock-step)"] = str(lock.stale_answers)
+    return values

@@ -24,6 +24,13 @@ def sine_reference(t, amplitude: float, frequency: float, offset: float = 0.0):
             -amplitude * w * w * np.sin(w * t))
 
 
+def sine_trajectory(amplitude: float, frequency: float, offset: float = 0.0):
+    """:func:`sine_reference` as a trajectory the controller plays
+    (:class:`cablelab.ros.reference.ReferencePlayer`, ``absolute``): ``(t, q0) -> (q, qd, qdd)``,
+    (N, 1) each, at the state stamps ``t`` (s); the first state ``q0`` is not used."""
+    return lambda t, _q0: tuple(np.reshape(x, (-1, 1)) for x in sine_reference(t, amplitude, frequency, offset))
+
+
 def pd_feedforward(q, qd, q_ref, qd_ref, qdd_ref, kp: float, kd: float, inertia: float = 0.0):
     """Motor force/torque of PD + inertia feedforward (N or N m)."""
     return (inertia * np.asarray(qdd_ref) + kp * (np.asarray(q_ref) - np.asarray(q))

@@ -36,6 +36,20 @@ class AxisTruth:
     timestep: float = 0.001
 
 
+#: the simulator node's description without a ``description`` parameter
+DEFAULT_DESCRIPTION = ("plant: axis\nname: simulated linear axis\ngravity: 9.81\n"
+                       "axis:\n  joint_type: prismatic\n  inertia: 2.0\n")
+
+
+def truth_from_parameters(description, v) -> AxisTruth:
+    """The true axis of the simulator node's parameters ``v`` (:data:`.nodes.parameters.SIM`):
+    an ``inertia`` of NaN is the description's ``axis.inertia``, else 2."""
+    nominal = description.axis.inertia if description.axis else None
+    inertia = v.inertia if v.inertia == v.inertia else float(nominal or 2.0)
+    return AxisTruth(inertia=inertia, viscous=v.viscous, coulomb=v.coulomb, offset=v.offset,
+                     timestep=v.timestep)
+
+
 def pendulum_arm(inertia: float, gravity_moment: float) -> tuple[float, float]:
     """(c m, m kg) of the revolute axis's point mass: m c = ``gravity_moment`` with c at most 1 m
     and half of ``inertia`` at most in m c^2 (so the armature stays positive); (0, 1e-6) without

@@ -10,7 +10,9 @@ between :data:`MIN_TENSION` and the drives' maximum (``max_torque`` R/r) on a gr
 for the empty platform and for it with :data:`PAYLOAD_FACTOR` times its mass, at every
 acceleration up to the box's limit along each axis (corners of the acceleration box). The
 designed reference is checked against the same tensions sample by sample (the
-:class:`~cablelab.excite.Limits` constraint).
+:class:`~cablelab.excite.Limits` constraint). It starts where ``cable_sim_node --plant cdpr``
+starts, at point A of the pick-and-place (:func:`start_position`), and moves from there to the
+box's centre before the Fourier series (:func:`cablelab.excite.lead_in`).
 """
 from __future__ import annotations
 
@@ -23,6 +25,7 @@ from .control import PdffConfig, feedforward_tensions, motor_rates
 from .dataset import CdprArrays, dataset_from_arrays
 from .geometry import cable_geometry
 from .topics import REFERENCE
+from .trajectory import pick_and_place
 
 JOINTS = ("x", "y", "z")
 #: lowest tension a designed motion may ask of a cable, N (the controller floors at
@@ -119,6 +122,12 @@ def motion_dataset(t, q, qd, qdd, description):
     return dataset_from_arrays(arr, description, "designed motion")
 
 
+def start_position(description=None) -> np.ndarray:
+    """Where the platform rests when a designed reference starts: the simulator's start, point A
+    of the pick-and-place test trajectory (001 sec. II-C), m."""
+    return pick_and_place(np.array([0.0])).position[0]
+
+
 #: the CDPR's experiment design (``cablelab excite``), registered by the package
 EXCITER = Exciter(limits=excite_limits, motion_dataset=motion_dataset, reference_topic=REFERENCE,
-                  base_hz=0.05, harmonics=5, trajectory="pose")
+                  base_hz=0.05, harmonics=5, trajectory="pose", start=start_position)

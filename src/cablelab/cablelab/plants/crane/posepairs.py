@@ -5,6 +5,7 @@ joint states on separate topics, which DDS does not order between them. :class:`
 each payload pose with the tip pose of its stamp, keeps the pairs until the slew angle of their
 stamp is known (interpolated over the unwrapped angles received), and hands them out in stamp
 order; a pair that waited more than ``max_wait`` s of stamps takes the latest angle (counted).
+:class:`PairedSwing` runs the pairs through the swing tracker: the live estimator's core.
 """
 from __future__ import annotations
 
@@ -12,7 +13,9 @@ from collections import deque
 
 import numpy as np
 
-__all__ = ["PosePairs"]
+from .swing import SwingTracker
+
+__all__ = ["PosePairs", "PairedSwing"]
 
 
 class PosePairs:
@@ -66,3 +69,40 @@ class PosePairs:
                 self.unsynced += 1
             self.pending.popleft()
             yield t, tip, pay, slew
+
+
+class PairedSwing:
+    """The live swing estimate (what ``payload_estimator --plant crane`` runs): each pose pair of
+    :attr:`pairs` with the slew angle of its stamp goes through :attr:`tracker`
+    (:class:`.swing.SwingTracker`).
+
+    Args:
+        max_wait: s (of stamps) a pair waits for the slew angle of its stamp.
+        velocity_tau: time constant smoothing the swing rates, s.
+    """
+
+    def __init__(self, max_wait: float, velocity_tau: float):
+        self.pairs = PosePairs(max_wait)
+        self.tracker = SwingTracker(tau=velocity_tau)
+
+    def estimates(self):
+        """Yield ``(t, [theta1, theta2, rope length], their rates)`` of every pair whose slew
+        angle is known, in stamp order (dropouts and frozen stamps are counted instead)."""
+        for t, tip, pay, slew in self.pairs.ready():
+            _status, x, v = self.tracker.update(t, tip, pay, slew)
+            if x is not None:
+                yield t, x, v
+
+    def report(self) -> tuple[str, dict]:
+        """``(problem, values)`` for /diagnostics: the counts by sample status and of unpaired
+        and unsynchronised poses; the problem names the dropouts, frozen stamps and irregular
+        periods (empty without any)."""
+        c = self.tracker.counts
+        values = {f"samples {k}": str(v) for k, v in c.items()}
+        values["unpaired poses"] = str(self.pairs.unpaired)
+        values["poses without a synchronous slew angle"] = str(self.pairs.unsynced)
+        problem = ""
+        if c["dropout"] or c["frozen"] or c["irregular"]:
+            problem = (f"{c['dropout']} motion-capture dropouts, {c['frozen']} frozen stamps, "
+                       f"{c['irregular']} irregular periods")
+        return problem, values

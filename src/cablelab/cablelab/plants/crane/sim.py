@@ -18,18 +18,24 @@ and dropouts. Actuators are torque/force motors (``ctrl`` = slew N m, luff N m, 
 """
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass, field
 
 import mujoco
 import numpy as np
 
 from . import topics
+from .control import sim_drive
 from .kinematics import gimbal_rates_to_swing, gimbal_to_swing, swing_to_gimbal
 from .mjcf import build_mjcf, gravity_in_base
 from .model import CraneParams, gravity_vector, mass_matrix
 from .reference import reference_trajectory
+from ...description import load_description
 from ...errors import CablelabError
 from ...rotations import wxyz_to_xyzw
+
+#: the simulator node's description without a ``description`` parameter
+DEFAULT_DESCRIPTION = os.path.join(os.path.dirname(__file__), "data", "crane.yaml")
 
 __all__ = ["CraneTruth", "set_state", "gravity_in_base", "simulate", "SimResult",
            "reference_trajectory", "QPOS", "contract_acceleration", "truth_accelerations",
@@ -245,10 +251,13 @@ class CraneSim:
         set_state(self.model, self.data, [q0[0], q0[1], q0[2], 0.0, 0.0])
         self.u = np.zeros(3)
         self.resets = 0  # divergences recovered (see advance)
+        self.held = 0    # periods the drives held the crane (see drive)
 
     @property
     def time(self) -> float:
         return float(self.data.time)
+
+    t = time    #: the sim time, s (as the other plants' simulators name it)
 
     def advance(self, u, duration: float) -> None:
         u = np.asarray(u, dtype=float).reshape(3)
@@ -267,6 +276,18 @@ class CraneSim:
             self.data.qpos[:], self.data.qvel[:] = qpos0, 0.0
             self.data.time = t0 + steps * self.model.opt.timestep
         mujoco.mj_forward(self.model, self.data)
+
+    def drive(self, u, duration: float, *, answered: bool, fresh: bool, lockstep: bool) -> bool:
+        """Advance ``duration`` s with the drives of :func:`.control.sim_drive` (``u``: the last
+        good command, None before the first; ``answered``, ``fresh``, ``lockstep`` as there): ``u``,
+        or the drives holding the crane when it is missing, stale or, in lock-step, not the
+        answer to the last state. True for the hold (counted in :attr:`held`)."""
+        _, q, qd = self.state()
+        effort, held = sim_drive(u, q, qd, self.truth.params, answered=answered, fresh=fresh,
+                                 lockstep=lockstep)
+        self.held += held
+        self.advance(effort, duration)
+        return held
 
     def state(self) -> tuple[float, np.ndarray, np.ndarray]:
         """(t s, contract q (5,), qd (5,)) - simulation truth."""
@@ -293,7 +314,7 @@ class CraneSim:
 
 def truth_from_parameters(node: str, params: CraneParams, v) -> tuple[CraneTruth, tuple]:
     """The simulated crane's truth and initial ``(slew, luff, rope length)`` from the validated
-    simulator node parameters ``v`` (:data:`cablelab.plants.crane.nodes.sim.PARAMETERS`); a
+    simulator node parameters ``v`` (:data:`cablelab.plants.crane.nodes.parameters.SIM`); a
     one-line error naming ``node`` for a rope length that is not positive."""
     q0 = tuple(v.initial)
     if q0[2] <= 0:
@@ -303,6 +324,18 @@ def truth_from_parameters(node: str, params: CraneParams, v) -> tuple[CraneTruth
                       coulomb=tuple(v.coulomb), torque_offset=tuple(v.offset),
                       mocap_noise=v.mocap_noise, mocap_dropout=v.mocap_dropout,
                       timestep=v.timestep), q0
+
+
+def live_sim(node: str, v):
+    """``(description, CraneSim)`` of the simulator node's validated parameters ``v``
+    (:data:`.nodes.parameters.SIM`: its ``description`` or :data:`DEFAULT_DESCRIPTION`, the
+    inertias it does not hold, the truth of :func:`truth_from_parameters`); a one-line error
+    naming ``node`` for a description without a crane section."""
+    desc = load_description(v.description or DEFAULT_DESCRIPTION)
+    if desc.crane is None:
+        raise CablelabError(f"{node} --plant crane: the description has no crane section")
+    params = CraneParams.from_description(desc, slew_inertia=v.slew_inertia, luff_inertia=v.luff_inertia)
+    return desc, CraneSim(*truth_from_parameters(node, params, v))
 
 
 def write_bag(path, res: SimResult, description_yaml: str, *, overwrite: bool = False) -> None:

@@ -58,6 +58,7 @@ class ApexController:
         self._t_d = 0.0
         self._phase = FLIGHT
         self.last_sensitivity = math.nan
+        self._apex_time = math.nan      # time of the last apex taken (see step)
 
     def sensitivity(self, h: float) -> float:
         """dh_{n+1}/dT at the apex height h, m/(N m) (central difference of two model strides)."""
@@ -86,3 +87,12 @@ class ApexController:
         if phase != STANCE:
             return 0.0
         return self.T * math.sin(2.0 * math.pi * (t - self._t_d) / self.P)
+
+    def step(self, t: float, phase: int, apex_height: float, apex_time: float) -> float:
+        """One hop estimate (``/leg/hop_estimate``: the last apex's height and time repeat until the
+        next apex): a new apex updates T (:meth:`on_apex`, once per apex time), then the
+        :meth:`torque` at ``t`` for ``phase``."""
+        if math.isfinite(apex_time) and apex_time != self._apex_time:
+            self._apex_time = apex_time
+            self.on_apex(apex_height)
+        return self.torque(t, phase)

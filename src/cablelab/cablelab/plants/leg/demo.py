@@ -2,11 +2,17 @@
 a 2.7 N spring preload hidden; ``diagnose --greedy`` on 003's model without impact adds
 ``impact_restitution`` then ``spring_preload`` (error waterfall); the 003 Fig. 11 comparison of
 apex height and time errors with and without the impact map; plots of the apex-to-apex return
-map and of the residual around touch-down / lift-off. Then the experiment-design loop with the
-mass free: low hops under the apex controller confound the preload F0 with the mass m,
-``cablelab excite`` designs an apex-height schedule, the controller plays it on the hybrid leg
-(offline, :func:`.excite.closed_loop`) and the fit on that run finds both (condition numbers
-before and after in the table).
+map and of the residual around touch-down / lift-off.
+
+Then the experiment-design loop, closed over DDS: low hops (4 mm, the apex controller on the
+hybrid leg, offline) confound the preload F0 with the mass m when m is free; ``cablelab excite``
+designs an apex-height schedule for (F0, m) from that recording; ``cable_sim_node --plant leg``
+(2.7 N preload hidden) + ``payload_estimator`` + ``pd_feedforward -p reference_bag:=REF`` + the
+recorder play it as separate processes (bags ``<out>/leg/low_hops``, ``<out>/leg/designed``,
+reference ``<out>/leg/designed_ref``). On the recorded run ``diagnose`` with the mass fixed at
+its weighed value (the description's, ``--fix m=``) ranks ``spring_preload`` first and brings F0
+back; the table shows the condition numbers before and after (F0, m with m free; F0 against the
+stance mass ``dm_f`` with m weighed) and the fits of F0 and m.
 """
 from __future__ import annotations
 
@@ -113,36 +119,135 @@ def run(out_dir: Path, quick: bool = False) -> dict:
     out = {"waterfall": rows, "identified": ident, "truth": {"beta_td": truth.beta_td, "beta_lo": truth.beta_lo,
                                                             "F0": truth.F0, "m": truth.m},
            "fig11": fig11, "plot": str(out_dir / "leg_demo.png")}
-    out["excite"] = _excite_loop(desc, plant, truth, quick)
     (out_dir / "leg_demo.json").write_text(json.dumps(out, indent=2))
     out["bag"] = str(bag)
     return out
 
 
-def _excite_loop(desc, plant, truth, quick: bool) -> dict:
-    """Low hops (4 mm) confound F0 with m (m free); the designed apex-height schedule, played by
-    the apex controller on the hybrid leg, separates them: condition numbers and both fits."""
-    from ...excite import design
-    from ...fit import identify
-    from ...workbench import build_model
+#: the loop's hidden preload (N) and the apex height of its low hops above z_td (m)
+LOOP_F0, LOW_HOPS = 2.7, 0.004
+#: the pair the design separates (m free), and the preload against the stance mass (m weighed)
+LOOP_PARAMS, WEIGHED_PAIR = ("F0", "m"), ("F0", "dm_f")
+
+
+def run_over_dds(bag: Path, logs: Path, duration: float, domain: int, reference: Path) -> Path:
+    """``cable_sim_node --plant leg`` (preload :data:`LOOP_F0` hidden, lock-step: every 1 ms state
+    waits for the torque answering it) + ``payload_estimator`` + ``pd_feedforward`` playing
+    ``reference`` (``reference_bag``) + the recorder, over DDS into ``bag`` for ``duration``
+    simulated s. (In real time on a loaded machine the chain's delay outlasts a low hop's 40 ms
+    flight: the stance torque runs on into the flight and the next stance, and the recording is
+    no longer the apex controller's hopping.)"""
+    import sys
+    import time
+
+    from ...demo import log
+    from ...ros.launch import Launcher
+    from ...ros.sim_progress import SimProgress
+    from . import topics
+
+    t0 = time.monotonic()
+    with Launcher(domain_id=domain, log_dir=logs) as launch:
+        launch.start("recorder", [sys.executable, "-m", "cablelab.cli", "record", "--plant", "leg",
+                                  "-o", bag, "--overwrite", "--quiet"])
+        launch.node("estimator", "payload_estimator", "leg", {})
+        launch.node("controller", "pd_feedforward", "leg", {"reference_bag": str(reference)})
+        # every reader discovered before the simulator starts its clock
+        launch.wait_for_subscribers([topics.JOINT_STATES, topics.CONTACT, topics.HOP_ESTIMATE,
+                                     topics.REFERENCE, topics.EFFORT_COMMANDS],
+                                    timeout=90, node_name="cablelab_recorder")
+        launch.wait_for_subscribers([topics.JOINT_STATES, topics.CONTACT], timeout=90,
+                                    node_name="payload_estimator")
+        launch.wait_for_subscribers([topics.HOP_ESTIMATE], timeout=90, node_name="pd_feedforward")
+        launch.node("sim", "cable_sim_node", "leg", {"preload": LOOP_F0, "lockstep": True})
+        with SimProgress(launch.probe(), duration, "leg designed") as bar:
+            bar.wait_for(launch, duration, "leg", logs)
+        time.sleep(1.0)                     # let the recorder take the last messages
+        codes = launch.stop_all()
+    bad = {k: v for k, v in codes.items() if v != 0}
+    if bad:
+        raise RuntimeError(f"leg: processes exited with {bad}; logs in {logs}")
+    log(f"leg: recorded {bag} in {time.monotonic() - t0:.0f} s")
+    return bag
+
+
+def close_loop(out_dir: Path, *, low_s: float, designed_s: float, domain: int, max_iter: int) -> dict:
+    """The loop up to the recordings: the low hops (offline, hybrid leg under the apex controller,
+    preload hidden), ``cablelab excite`` for :data:`LOOP_PARAMS` on them, the designed schedule
+    played over DDS (:func:`run_over_dds`). Returns the paths and the design's numbers."""
+    from ...demo import log
+    from ...description import load_description
+    from ...excite import design, get_exciter, write_reference
     from .dataset import dataset_from_arrays
     from .excite import closed_loop
     from .hybrid import LegParams
+    from .sim import write_bag
 
+    desc_text = (Path(__file__).parent / "data" / "leg.yaml").read_text()
+    desc = load_description(desc_text)
     nominal = LegParams()
-    dur = 30.0 if quick else 60.0
+    low, ref = out_dir / "low_hops", out_dir / "designed_ref"
+    log(f"leg: low hops ({1e3 * LOW_HOPS:g} mm, {low_s:g} s, offline) with a hidden {LOOP_F0} N preload ...")
+    tr = closed_loop(nominal.replace(F0=LOOP_F0), nominal.z_td + LOW_HOPS, low_s, controller_params=nominal)
+    write_bag(low, tr, desc_text, overwrite=True)
+    ds0 = dataset_from_arrays(tr.t, tr.z_meas, tr.contact, tr.tau, desc)
+    log(f"leg: cablelab excite --params {','.join(LOOP_PARAMS)} --duration {designed_s:g} ...")
+    d = design("leg", desc, LOOP_PARAMS, duration=designed_s, before_ds=ds0, max_iter=max_iter)
+    write_reference(ref, d, get_exciter("leg"), desc_text, overwrite=True)
+    log(f"leg: excite's condition number {d.condition_before:.3g} -> {d.condition_after:.3g} "
+        f"({d.seconds:.1f} s); pd_feedforward -p reference_bag:={ref} over DDS ...")
+    designed = run_over_dds(out_dir / "designed", out_dir / "logs_designed", designed_s, domain, ref)
+    return {"low_hops": str(low), "designed": str(designed), "reference": str(ref),
+            "condition_before": d.condition_before, "condition_after": d.condition_after,
+            "design_s": d.seconds, "duration_s": designed_s}
 
-    def ds_of(tr):
-        return dataset_from_arrays(tr.t, tr.z_meas, tr.contact, tr.tau, desc)
 
-    low = ds_of(closed_loop(truth, nominal.z_td + 0.004, dur, controller_params=nominal))
-    d = design("leg", desc, ["F0", "m"], duration=dur, before_ds=low, max_iter=10 if quick else 30)
-    run = ds_of(closed_loop(truth, lambda t: np.interp(t, d.t, d.q[:, 0]), dur, controller_params=nominal))
-    model = build_model(plant, desc, ["impact_restitution", "spring_preload"])
-    fits = {k: identify(model, ds).params for k, ds in (("low_hops", low), ("designed", run))}
-    return {"condition_before": d.condition_before, "condition_after": d.condition_after,
-            "design_s": d.seconds, "duration_s": dur,
-            **{f"{k}_{p}": float(v[p]) for k, v in fits.items() for p in ("F0", "m")}}
+def loop_fit(bag_dir) -> dict:
+    """On one bag: the fit with m free (003's model + impacts + preload: F0, m, the condition
+    number of (F0, m)) and ``diagnose`` with m fixed at the weighed (description) mass (the first
+    effect, its significance, rivals, F0; the condition number of (F0, dm_f))."""
+    from ...excite import condition
+    from ...fit import identify
+    from ...workbench import build_model, diagnose, load
+    from .description import leg_of
+
+    plant, desc, ds = load(bag_dir)
+    free = build_model(plant, desc, ["impact_restitution", "spring_preload"])
+    fit = identify(free, ds)
+    weighed = {"m": leg_of(desc).mass}
+    both = build_model(plant, desc, ["impact_restitution", "spring_preload", "phase_effective_mass"],
+                       fixed=weighed)
+    d = diagnose(ds, build_model(plant, desc, ["impact_restitution"], fixed=weighed),
+                 plant.candidates(desc)).to_json()
+    first = d["ranking"][0]
+    pre = next((r for r in d["ranking"] if r["effect"] == "spring_preload"), {"params": {}})
+    return {"F0_free": float(fit.params["F0"]), "m_free": float(fit.params["m"]),
+            "cond_free": condition(free, ds, LOOP_PARAMS), "cond_weighed": condition(both, ds, WEIGHED_PAIR),
+            "first": first["effect"], "significant": bool(first["significant"]),
+            "ambiguous_with": first.get("ambiguous_with") or [], "F0": pre["params"].get("F0", float("nan")),
+            "error": (d["baseline"]["error"], first["error_after"]), "weighed_m": weighed["m"], "n": ds.n}
+
+
+def loop_rows(loop: dict) -> list:
+    """The loop's table rows: condition numbers, fits and the diagnosis, low hops -> designed."""
+    a, b = loop_fit(loop["low_hops"]), loop_fit(loop["designed"])
+    loop["fits"] = {"low_hops": a, "designed": b}
+    amb = f", ambiguous with {', '.join(b['ambiguous_with'])}" if b["ambiguous_with"] else ""
+    return [
+        ["loop: excite's condition number of (F0, m), low hops -> designed schedule",
+         f"{loop['condition_before']:.3g} -> {loop['condition_after']:.3g} (designed in {loop['design_s']:.1f} s)",
+         "-"],
+        ["loop: condition number of (F0, m) in the fitted model, m free, low hops -> DDS run",
+         f"{a['cond_free']:.3g} -> {b['cond_free']:.3g}", "-"],
+        ["loop: condition number of (F0, dm_f), m weighed, low hops -> DDS run",
+         f"{a['cond_weighed']:.3g} -> {b['cond_weighed']:.3g}", "-"],
+        [f"loop: F0 (N) / m (kg) with m free, low hops -> DDS run (truth {LOOP_F0} / {b['weighed_m']:g})",
+         f"{a['F0_free']:.2f} / {a['m_free']:.3f} -> {b['F0_free']:.2f} / {b['m_free']:.3f}", "hidden"],
+        [f"loop: diagnose on the DDS run, m weighed ({b['weighed_m']:g} kg): first effect",
+         f"{b['first']} ({'significant' if b['significant'] else 'not significant'}{amb})", "spring_preload"],
+        [f"loop: held-out error -> + first; F0 (N, truth {LOOP_F0})",
+         f"{100 * b['error'][0]:.1f} % -> {100 * b['error'][1]:.1f} %; {b['F0']:.2f} "
+         f"({100 * (b['F0'] / LOOP_F0 - 1):+.1f} %)", "hidden"],
+    ]
 
 
 def _page(out_dir: Path, rows: list) -> str:
@@ -175,19 +280,40 @@ def _analyse(out_dir: Path, args, res: dict) -> PartResult:
             ["apex time MAE with / without impact (ms)",
              f"{f11['apex_time_mae_ms']['with_impact']:.1f} / {f11['apex_time_mae_ms']['without_impact']:.1f}",
              "Fig. 11: with < without"]]
-    ex = res.get("excite")
-    if ex:
-        rows += [["excite F0,m (m free): condition number low hops -> designed apex schedule",
-                  f"{ex['condition_before']:.3g} -> {ex['condition_after']:.3g} "
-                  f"(designed in {ex['design_s']:.1f} s)", "-"],
-                 ["F0 (N) / m (kg) from low hops -> designed schedule (truth 2.7 / 1.55)",
-                  f"{ex['low_hops_F0']:.2f} / {ex['low_hops_m']:.3f} -> "
-                  f"{ex['designed_F0']:.2f} / {ex['designed_m']:.3f}", "hidden"]]
-    return PartResult(rows=rows, bags=[res["bag"]], page=_page(Path(out_dir), rows),
+    bags = [res["bag"]]
+    loop = res.get("loop")
+    if loop:
+        rows += loop_rows(loop)
+        bags += [loop["low_hops"], loop["designed"]]
+        (Path(out_dir) / "leg_loop.json").write_text(json.dumps(loop, indent=2))
+    return PartResult(rows=rows, bags=bags, page=_page(Path(out_dir), rows),
                       first=w[1]["step"] if len(w) > 1 else "")
 
 
+def add_arguments(group) -> None:
+    group.add_argument("--leg-loop", type=float, nargs=2, default=(30.0, 20.0), metavar=("S1", "S2"),
+                       help="leg: simulated s of the low hops (offline) and of the designed schedule "
+                            "played over DDS in lock-step at 1 kHz (preload vs mass); 0 0 skips that step")
+
+
+def quick(a) -> None:
+    """--quick: 10 s of low hops and the shortest designed schedule (8 s: two 2 s fades and 4 s
+    between), fewer design iterations."""
+    a.leg_loop = (min(a.leg_loop[0], 10.0), min(a.leg_loop[1], 8.0))
+
+
+def _record(out: Path, a) -> dict:
+    from ...ros.launch import unique_domain_id
+
+    res = run(out, quick=a.quick)
+    s1, s2 = a.leg_loop
+    if s1 > 0 and s2 > 0:
+        res["loop"] = close_loop(Path(out), low_s=s1, designed_s=s2, domain=unique_domain_id(4),
+                                 max_iter=3 if a.quick else 20)
+    return res
+
+
 DEMO = DemoPart(plant="leg", title="Hopping leg (003), impact map and preload hidden", order=40,
-                add_arguments=lambda group: None,
-                record=lambda out, args: run(out, quick=args.quick), analyse=_analyse,
-                subdir="leg", how="MuJoCo hybrid-plant data (offline), then the workbench")
+                add_arguments=add_arguments, record=_record, analyse=_analyse, quick=quick,
+                subdir="leg", how="MuJoCo hybrid-plant data (offline); the designed schedule over DDS "
+                                  "(sim + estimator + controller + recorder); then the workbench")

@@ -21,7 +21,7 @@ import mujoco.rollout
 import numpy as np
 
 from .mjcf import VJ, arm_joint_names, build_truth, build_virtual, levelling_ctrl
-from .params import VirtualParams
+from .params import VirtualParams, parameter_set
 from .swing import CHANNELS, swing_from_pose
 
 __all__ = ["initial_state", "simulate", "simulate_paper_levelling", "Run", "outputs",
@@ -238,6 +238,13 @@ class LiveSim:
         self.steps = max(1, int(round(1.0 / (rate * self.model.opt.timestep))))
         self.noise = pose_noise
         self.rng = np.random.default_rng(seed)
+
+    @classmethod
+    def of_parameters(cls, v) -> "LiveSim":
+        """The simulator node's plant from its validated parameters ``v``
+        (:data:`.nodes.parameters.SIM`)."""
+        return cls(parameter_set(v.variant), v.model, arm_motors=v.arm_input == "effort", rate=v.rate,
+                   start=(v.start_swing_x, v.start_swing_y, v.start_yaw), pose_noise=v.pose_noise)
 
     @property
     def t(self) -> float:

@@ -115,6 +115,17 @@ class SwingEstimator:
         self._yaw_unwrapped = 0.0
         self.imu_max_lag = float(imu_max_lag)
         self._imu = None                   # (t, raw yaw, yaw rate) of the last good IMU sample
+        self.held = 0                      # samples held (not estimated) ...
+        self.last_problem = ""             # ... and why, the last time
+        self.from_imu = 0                  # estimates whose yaw came from the IMU
+
+    @classmethod
+    def of_parameters(cls, v) -> "SwingEstimator":
+        """The estimator node's estimator from its validated parameters ``v``
+        (:data:`.nodes.parameters.ESTIMATOR`; a NaN rest position or yaw: from the rest window)."""
+        rest = v.rest_position if all(np.isfinite(v.rest_position)) else None
+        return cls(v.suspension_point, rest_window=v.rest_window, imu_max_lag=v.imu_max_lag, rest_pos=rest,
+                   rest_yaw=v.rest_yaw if np.isfinite(v.rest_yaw) else None, velocity_tau=v.velocity_tau)
 
     def imu(self, t: float, quat_wxyz, gyro) -> bool:
         """Take one IMU sample: orientation (4,) w x y z (IMU = platform frame to world) and
@@ -173,8 +184,11 @@ class SwingEstimator:
         if imu is not None:
             self._vel[2] = imu[2]          # gyro: no finite difference, no low-pass lag
         self._prev_t, self._prev_x = t, xk
+        self.from_imu += imu is not None
         return SwingSample(xk, self._vel.copy(), True, source="pose" if imu is None else "imu")
 
     def _hold(self, msg: str) -> SwingSample:
+        self.held += 1
+        self.last_problem = msg
         x = self._prev_x if self._prev_x is not None else np.full(5, np.nan)
         return SwingSample(np.array(x), self._vel.copy(), False, msg)

@@ -7,97 +7,51 @@ sensor offset; the command held over the period that ends at that state),
 ``/plant_description`` (transient-local). ``lockstep``: the simulation advances one period only
 after the command answering the last published state arrived, so a loaded machine slows the run
 down instead of delaying the control loop (:class:`cablelab.ros.lockstep.LockStep`, ``wait_first``:
-answers to earlier states are counted on /diagnostics and ignored).
-Parameters: ``cable_sim_node --plant axis --help``.
+answers to earlier states are counted on /diagnostics and ignored). Parameters: :data:`.parameters.SIM`.
 """
 from __future__ import annotations
-
-import time
 
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 
 from .. import topics
+from ..markers import axis_markers
+from ..sim import DEFAULT_DESCRIPTION, AxisSim, truth_from_parameters
 from ....description import load_description
-from ..sim import AxisSim, AxisTruth
 from ....ros import convert
-from ....ros.clock import ClockPublisher
-from ....ros.lockstep import FREE, LockStep
-from ....ros.markers import start_markers
-from ....ros.params import DESCRIPTION, START_GATE, Param, markers_rate, merge
-from ....ros.plant_node import PlantNode
-from ....ros.qos import publisher_qos, stream_qos
-
-DEFAULT_DESCRIPTION = ("plant: axis\nname: simulated linear axis\ngravity: 9.81\n"
-                       "axis:\n  joint_type: prismatic\n  inertia: 2.0\n")
+from ....ros.lockstep import LockStep
+from ....ros.qos import stream_qos
+from ....ros.simulator import FREE, SimulatorNode
+from .parameters import SIM as PARAMETERS
 
 
-PARAMETERS = merge((
-    DESCRIPTION,
-    Param("inertia", float("nan"), "true inertia M (NaN = the description's axis.inertia, else 2)",
-          "kg or kg m^2", gt=0.0, le=1e6, nan=True),
-    Param("viscous", 5.0, "true viscous friction Fv", "N s/m or N m s/rad", ge=0.0, le=1e6),
-    Param("coulomb", 1.0, "true Coulomb friction Fc", "N or N m", ge=0.0, le=1e6),
-    Param("offset", 0.0, "bias added to the reported effort", "N or N m", ge=-1e6, le=1e6),
-    Param("timestep", 0.001, "physics step", "s", ge=1e-5, le=0.01),
-    Param("rate", 200.0, "publishing rate = command sampling", "Hz", ge=1.0, le=10000.0),
-    Param("command_timeout", 0.5, "a command older than this falls back to 0 (WARN)", "s wall", gt=0.0),
-    Param("lockstep", False, "advance one period only once the command answering the last state "
-          "arrived"),
-    Param("lockstep_resend", 0.25, "lock-step: the state is republished this often while waiting",
-          "s wall", gt=0.0, le=60.0),
-    markers_rate("/axis/markers: carriage on its rail or link and load"),
-), START_GATE)
+class AxisSimNode(SimulatorNode):
+    command = "effort_command"
 
-
-class AxisSimNode(PlantNode):
     def __init__(self):
-        super().__init__("cable_sim_node")
+        super().__init__()
         v = self.declare_params(PARAMETERS)
-        self.description = load_description(v.description or DEFAULT_DESCRIPTION)
-        nominal = self.description.axis.inertia if self.description.axis else None
-        inertia = v.inertia if v.inertia == v.inertia else float(nominal or 2.0)
-        truth = AxisTruth(inertia=inertia, viscous=v.viscous, coulomb=v.coulomb, offset=v.offset,
-                          timestep=v.timestep)
-        self.rate = v.rate
-        self.resend = v.lockstep_resend
-        self.lock = LockStep(v.lockstep, wait_first=True, resend=self.resend)
+        desc = load_description(v.description or DEFAULT_DESCRIPTION)
+        self.sim = AxisSim(desc, truth_from_parameters(desc, v))
+        self.rate, self.republish_every, self.u = v.rate, v.lockstep_resend, 0.0
+        self.lock = LockStep(v.lockstep, wait_first=True, resend=v.lockstep_resend)
         self.start_gate()
-        self.sim = AxisSim(self.description, truth)
-        self.u = 0.0
         self.inputs.add("effort_command", timeout=v.command_timeout, length=1)
-
-        self.pub_js = self.create_publisher(JointState, topics.JOINT_STATES, publisher_qos())
-        self.pub_truth = self.create_publisher(JointState, topics.GROUND_TRUTH, publisher_qos())
-        self.clock = ClockPublisher(self)
-        self.publish_description(self.description)
+        self.pub_js, self.pub_truth = self.state_publishers((JointState, topics.JOINT_STATES),
+                                                            (JointState, topics.GROUND_TRUTH))
         self.create_subscription(Float64MultiArray, topics.EFFORT_COMMAND, self.on_command, stream_qos())
-        self.start_diagnostics()
-        self.timer = self.create_timer(1.0 / self.rate, self.tick)
-        from ..markers import axis_markers
-
-        start_markers(self, "/axis/markers", lambda: axis_markers(self.description, self.sim.state()[1], truth.inertia),
-                      lambda: self.sim.t, v.markers_rate)
-        self.publish_state()
-
-    def extend_status(self, level, msg, values):
-        values["sim time s"] = f"{self.sim.t:.3f}"
-        values["stale answers ignored (lock-step)"] = str(self.lock.stale_answers)
-        return level, msg, values
+        self.start_simulation(desc, 1.0 / self.rate, topics.MARKERS, lambda: axis_markers(
+            desc, self.sim.state()[1], self.sim.truth.inertia), v.markers_rate)
 
     def on_command(self, msg: Float64MultiArray) -> None:
         values = self.take_command("effort_command", msg, self.lock)
         if values is not None:
             self.u = float(values[0])
 
-    def tick(self) -> None:
-        step = self.may_step(self.lock, self.pub_js, self.publish_state, self.resend)
-        if step is None:
-            return
-        if step == FREE and not self.inputs.fresh("effort_command", time.monotonic()):
+    def step(self, kind: str, fresh: bool) -> None:
+        if kind == FREE and not fresh:
             self.u = 0.0  # no (fresh) command: the drive is switched off
         self.sim.advance(self.u, 1.0 / self.rate)
-        self.publish_state()
 
     def publish_state(self) -> None:
         t, q, qd = self.sim.state()
@@ -107,5 +61,5 @@ class AxisSimNode(PlantNode):
         self.pub_truth.publish(convert.joint_state_msg(t, ["joint"], [q], [qd], [self.u]))
 
 
-def make_node() -> PlantNode:
+def make_node() -> SimulatorNode:
     return AxisSimNode()

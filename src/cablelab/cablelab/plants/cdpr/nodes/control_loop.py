@@ -25,6 +25,7 @@ from geometry_msgs.msg import InertiaStamped
 from ....description import load_description
 from ....errors import CablelabError
 from ....hardware import DriverStub, load_hardware_class
+from ....sample_ring import StateLayout
 from ....ros import convert
 from ....ros.control_loop import LOOP_PARAMETERS, ControlLoopNode
 from ....ros.fastspin import take_newest
@@ -56,6 +57,46 @@ PARAMETERS = merge(
     executor_params(True))
 
 
+class CdprCyclePublisher:
+    """The loop's topics of one period: reference, joint states, tensions, effort command, and
+    every ``extras_every`` periods /clock, the measured pose and the ground truth (the
+    simulator's). Built in the loop's process or in its publisher process
+    (:mod:`cablelab.ros.loop_publisher`) from a JSON ``config``: ``n`` winches, ``rate``,
+    ``settle`` and ``trajectory_speed`` (the reference, recomputed from the state's stamp),
+    ``extras_every``, ``payload`` ([true moving mass, CoM] of a simulated robot, else None)."""
+
+    def __init__(self, node, config: dict):
+        self.n, self.extras_every = int(config["n"]), int(config["extras_every"])
+        self.reference = ReferenceTable(config["rate"], config["settle"], config["trajectory_speed"])
+        self.simulated = config.get("payload") is not None
+        self.out = CdprOutputs(node, self.n, truth=self.simulated, commands=True)
+        if self.simulated:                  # the true moving mass and CoM do not change
+            self.out.payload(*config["payload"])
+
+    @classmethod
+    def layout(cls, config: dict) -> StateLayout:
+        """The records of the publisher process: the state, the command and the extras published."""
+        n = int(config["n"])
+        extras = [("tension", n), ("cable_length", n), ("position", 3), ("quat", 4)]
+        if config.get("payload") is not None:
+            extras += [("true_position", 3), ("true_quat", 4)]
+        return StateLayout(n, tuple(extras), n)
+
+    def publish(self, state, command, cycle: int) -> None:
+        t, extra, out = state.t, state.extra, self.out
+        out.reference(t, *self.reference.at(t))       # the reference of the state's stamp, before it
+        out.joints(t, state.position, state.velocity, state.effort)
+        if "tension" in extra:
+            out.tensions(t, extra["tension"], extra.get("cable_length"))
+        if command is not None:
+            out.command(t, command)
+        if cycle % self.extras_every == 0:
+            pose = (extra["position"], extra["quat"]) if "position" in extra and "quat" in extra else None
+            # the truth read with the state (not now: another thread or process publishes)
+            truth = (extra["true_position"], extra["true_quat"]) if self.simulated else None
+            out.extras(t, pose, truth)
+
+
 class CdprControlLoop(ControlLoopNode):
     def __init__(self):
         super().__init__("control_loop")
@@ -73,9 +114,6 @@ class CdprControlLoop(ControlLoopNode):
         self.simulated = isinstance(hardware, SimulatedCdpr)
         self.estimates_rejected = 0
 
-        self.out = CdprOutputs(self, self.n, truth=self.simulated, commands=True)
-        if self.simulated:                  # the true moving mass and CoM do not change
-            self.out.payload(hardware.sim.truth.total_mass, hardware.sim.truth.total_com)
         self.publish_description(desc)
         # the estimate waits in a keep-last-1 queue that no executor watches; the loop takes it
         # after a write (take_inputs), never waiting for it
@@ -93,19 +131,12 @@ class CdprControlLoop(ControlLoopNode):
         return cls(names, desc)
 
     # ------------------------------------------------------------------ the loop's hooks
-    def publish_cycle(self, state, command) -> None:
-        t, extra, out = state.t, state.extra, self.out
-        out.reference(t, *self.reference.at(t))       # the reference of the state's stamp, before it
-        out.joints(t, state.position, state.velocity, state.effort)
-        if "tension" in extra:
-            out.tensions(t, extra["tension"], extra.get("cable_length"))
-        if command is not None:
-            out.command(t, command)
-        if self._cycle % self.extras_every == 0:
-            pose = (extra["position"], extra["quat"]) if "position" in extra and "quat" in extra else None
-            # the truth read with the state (not now: another thread may publish)
-            truth = (extra["true_position"], extra["true_quat"]) if self.simulated else None
-            out.extras(t, pose, truth)
+    def cycle_publisher(self):
+        truth = self.hardware.sim.truth if self.simulated else None
+        return CdprCyclePublisher, {
+            "n": self.n, "rate": self.rate, "settle": self.v.settle, "trajectory_speed": self.v.trajectory_speed,
+            "extras_every": self.extras_every,
+            "payload": None if truth is None else [float(truth.total_mass), [float(x) for x in truth.total_com]]}
 
     def take_inputs(self) -> None:
         take_newest(self.est_sub)

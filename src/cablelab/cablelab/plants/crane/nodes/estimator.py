@@ -1,13 +1,11 @@
 """Crane swing estimator node: theta1, theta2 and rope length from motion capture, live.
 
 Inputs: ``/crane/boom_tip_pose`` and ``/crane/payload_pose`` (PoseStamped, same stamps) and the
-slew angle from ``/crane/joint_states``. For each pose pair it runs
-:class:`cablelab.plants.crane.swing.SwingTracker` (the exact inverse of CONTRACT sec. 2 in the
-slewing frame, 002 sec. 6.3; velocities by smoothed differences) and publishes
-``/crane/swing_estimate`` (names theta1, theta2, rope_length; position and velocity) stamped like
-the poses. Dropouts (NaN poses), frozen stamps and gaps are counted and reported on /diagnostics.
-
-ROS parameters: :data:`PARAMETERS` (``payload_estimator --plant crane --help``).
+slew angle from ``/crane/joint_states``, paired by stamp (:class:`..posepairs.PairedSwing`). Each
+pair goes through :class:`..swing.SwingTracker` (the exact inverse of CONTRACT sec. 2 in the slewing
+frame, 002 sec. 6.3; velocities by smoothed differences) to ``/crane/swing_estimate`` (names
+theta1, theta2, rope_length; position and velocity) stamped like the poses. Dropouts (NaN poses),
+frozen stamps and gaps are counted and reported on /diagnostics. Parameters: :data:`.parameters.ESTIMATOR`.
 """
 from __future__ import annotations
 
@@ -15,33 +13,22 @@ from geometry_msgs.msg import PoseStamped
 from sensor_msgs.msg import JointState
 
 from .. import topics
-from ..posepairs import PosePairs
-from ..swing import SwingTracker
+from ..posepairs import PairedSwing
 from ....ros import convert
 from ....ros.inputs import WARN
-from ....ros.status import add_problem
-from ....ros.params import Param
 from ....ros.plant_node import PlantNode
 from ....ros.qos import catch_up_qos, publisher_qos
+from ....ros.status import add_problem
+from .parameters import ESTIMATOR as PARAMETERS
 
 NAMES = ["theta1", "theta2", "rope_length"]
-
-
-PARAMETERS = (
-    Param("velocity_tau", 0.02, "time constant smoothing the swing rates", "s", gt=0.0, le=10.0),
-    Param("max_wait", 0.2, "a pose pair waits this long (in stamps) for the slew angle of its "
-          "stamp before the latest one is used", "s", ge=0.0, le=10.0),
-    Param("pose_timeout", 0.5, "a pose older than this is stale", "s wall", gt=0.0),
-    Param("slew_timeout", 0.5, "a slew angle older than this is stale", "s wall", gt=0.0),
-)
 
 
 class CraneSwingEstimator(PlantNode):
     def __init__(self):
         super().__init__("payload_estimator")
         v = self.declare_params(PARAMETERS)
-        self.tracker = SwingTracker(tau=v.velocity_tau)
-        self.pairs = PosePairs(v.max_wait)
+        self.swing = PairedSwing(v.max_wait, v.velocity_tau)
         self.inputs.add("boom_tip_pose", timeout=v.pose_timeout, length=3)
         self.inputs.add("payload_pose", timeout=v.pose_timeout, length=3)
         self.inputs.add("slew", timeout=v.slew_timeout, length=1)
@@ -52,43 +39,35 @@ class CraneSwingEstimator(PlantNode):
         self.start_diagnostics()
 
     def extend_status(self, level, msg, values):
-        c = self.tracker.counts
-        values.update({f"samples {k}": str(v) for k, v in c.items()})
-        values["unpaired poses"] = str(self.pairs.unpaired)
-        values["poses without a synchronous slew angle"] = str(self.pairs.unsynced)
-        if c["dropout"] or c["frozen"] or c["irregular"]:
-            level, msg = add_problem(level, msg, WARN, f"{c['dropout']} motion-capture dropouts, "
-                                     f"{c['frozen']} frozen stamps, {c['irregular']} irregular periods")
+        problem, own = self.swing.report()
+        values.update(own)
+        if problem:
+            level, msg = add_problem(level, msg, WARN, problem)
         return level, msg, values
 
     def on_joints(self, msg: JointState) -> None:
         t, names, q, _qd, _eff = convert.joint_state_arrays(msg)
-        if q is None or "slew" not in names or len(names) != q.size:
-            self.accept("slew", None)
-            return
-        val = q[names.index("slew")]
-        if self.accept("slew", [val]):
-            self.pairs.slew(t, val)
+        ok = q is not None and "slew" in names and len(names) == q.size
+        if self.accept("slew", [q[names.index("slew")]] if ok else None):
+            self.swing.pairs.slew(t, q[names.index("slew")])
             self.process()
 
     def on_tip(self, msg: PoseStamped) -> None:
         t, pos, _ = convert.pose_arrays(msg)
         self.accept("boom_tip_pose", pos)   # NaN is counted as rejected
-        self.pairs.tip_pose(t, pos)
+        self.swing.pairs.tip_pose(t, pos)
 
     def on_payload(self, msg: PoseStamped) -> None:
         t, pos, _ = convert.pose_arrays(msg)
         self.accept("payload_pose", pos)
-        self.pairs.payload_pose(t, pos)
+        self.swing.pairs.payload_pose(t, pos)
         self.process()
 
     def process(self) -> None:
-        """Estimate every pose pair whose slew angle is known (:meth:`PosePairs.ready
-        <cablelab.plants.crane.posepairs.PosePairs.ready>`) and publish the estimates."""
-        for t, tip, pay, slew in self.pairs.ready():
-            status, x, v = self.tracker.update(t, tip, pay, slew)
-            if x is not None:
-                self.pub.publish(convert.joint_state_msg(t, NAMES, x, v))
+        """Publish the estimate of every pose pair whose slew angle is known
+        (:meth:`PairedSwing.estimates <cablelab.plants.crane.posepairs.PairedSwing.estimates>`)."""
+        for t, x, v in self.swing.estimates():
+            self.pub.publish(convert.joint_state_msg(t, NAMES, x, v))
 
 
 def make_node() -> PlantNode:

@@ -6,128 +6,63 @@ Publishes (CONTRACT sec. 2) ``/crane/joint_states`` (slew, luff, hoist: position
 ``/crane/payload_pose`` (noise, NaN dropouts), ``/crane/ground_truth/swing`` (theta1, theta2,
 rope_length), ``/clock`` and ``/plant_description`` (transient-local).
 
-``lockstep`` (default true): once commands flow, a state is followed by the command answering it
-before the simulation advances (:class:`cablelab.ros.lockstep.LockStep` matches answers by stamp;
-an answer is applied however late), so a slow controller slows the simulation down instead of
-destabilising it; without an answer for ``lockstep_timeout`` s it runs in real time again until
-commands flow. Without a fresh command the drives hold the crane (gravity compensation + damping,
-like a brake: :func:`cablelab.plants.crane.control.sim_drive`), reported as WARN on /diagnostics.
-Parameters: ``cable_sim_node --plant crane --help``.
+``lockstep`` (default true, :class:`cablelab.ros.lockstep.LockStep`): once commands flow, a state
+is answered before the simulation advances, so a slow controller slows it down instead of
+destabilising it (``lockstep_timeout`` s unanswered: real time until commands flow). Without a
+fresh command the drives hold the crane like a brake (:meth:`..sim.CraneSim.drive`), reported on
+/diagnostics. Parameters: :data:`.parameters.SIM`.
 """
 from __future__ import annotations
-
-import os
-import time
 
 from geometry_msgs.msg import PoseStamped
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 
-from ....description import load_description
-from ....errors import CablelabError
 from .. import topics
-from ..control import sim_drive
 from ..markers import state_markers
-from ..model import JOINTS, CraneParams
-from ....ros.clock import ClockPublisher
-from ....ros.markers import start_markers
+from ..model import JOINTS
+from ..sim import live_sim
 from ....ros import convert
-from ....ros.lockstep import ADVANCE, LockStep
-from ....ros.params import DESCRIPTION, START_GATE, Param, markers_rate, merge
-from ....ros.plant_node import PlantNode
 from ....ros.inputs import ERROR
-from ....ros.qos import publisher_qos, stream_qos
+from ....ros.lockstep import LockStep
+from ....ros.qos import stream_qos
+from ....ros.simulator import ADVANCE, SimulatorNode
 from ....ros.status import add_problem
-from ..sim import CraneSim, truth_from_parameters
-
-DEFAULT_DESCRIPTION = os.path.join(os.path.dirname(os.path.dirname(__file__)), "data", "crane.yaml")
-SWING = ["theta1", "theta2", "rope_length"]
+from .parameters import SIM as PARAMETERS
 
 
-PARAMETERS = merge((
-    DESCRIPTION,
-    Param("slew_inertia", 0.05, "slew inertia the description does not hold", "kg m^2", gt=0.0, le=1e6),
-    Param("luff_inertia", 0.02, "luff inertia the description does not hold", "kg m^2", gt=0.0, le=1e6),
-    Param("base_tilt", [0.0, 0.0], "true tilt of the base [about x, about y]", "rad", length=(2,),
-          ge=-0.5, le=0.5),
-    Param("viscous", [0.0, 0.0, 0.0], "true viscous friction [slew, luff, hoist]",
-          "N m s/rad, N m s/rad, N s/m", length=(3,), ge=0.0, le=1e6),
-    Param("coulomb", [0.0, 0.0, 0.0], "true Coulomb friction [slew, luff, hoist]", "N m, N m, N",
-          length=(3,), ge=0.0, le=1e6),
-    Param("offset", [0.0, 0.0, 0.0], "true effort sensor offset [slew, luff, hoist]", "N m, N m, N",
-          length=(3,), ge=-1e6, le=1e6),
-    Param("mocap_noise", 0.0, "standard deviation of the motion-capture positions", "m", ge=0.0, le=10.0),
-    Param("mocap_dropout", 0.0, "probability of a motion-capture dropout (NaN pose)", ge=0.0, le=1.0),
-    Param("timestep", 0.001, "physics step", "s", ge=1e-5, le=0.01),
-    Param("initial", [0.0, 0.5, 0.6], "initial [slew rad, luff rad, hoist rope length m]", length=(3,),
-          ge=-10.0, le=100.0),
-    Param("rate", 100.0, "publishing rate = command sampling", "Hz", ge=1.0, le=10000.0),
-    Param("command_timeout", 0.5, "a command older than this is stale: the drives hold (real time)",
-          "s wall", gt=0.0),
-    Param("lockstep", True, "once commands flow, advance only when the command answering the last "
-          "state arrived"),
-    Param("lockstep_timeout", 10.0, "lock-step: without an answer for this long, back to real time "
-          "holding the crane", "s wall", gt=0.0),
-    markers_rate("/crane/markers: mast, boom, rope, payload"),
-), START_GATE)
-
-
-class CraneSimNode(PlantNode):
+class CraneSimNode(SimulatorNode):
     def __init__(self):
-        super().__init__("cable_sim_node")
+        super().__init__()
         v = self.declare_params(PARAMETERS)
-        self.description = load_description(v.description or DEFAULT_DESCRIPTION)
-        if self.description.crane is None:
-            raise CablelabError("cable_sim_node --plant crane: the description has no crane section")
-        params = CraneParams.from_description(self.description, slew_inertia=v.slew_inertia,
-                                              luff_inertia=v.luff_inertia)
-        truth, q0 = truth_from_parameters(self.get_name(), params, v)
-        self.rate = v.rate
+        desc, self.sim = live_sim(self.get_name(), v)
+        self.rate, self.u = v.rate, None
         self.lock = LockStep(v.lockstep, wait_first=False, timeout=v.lockstep_timeout)
         self.start_gate()
-        self.sim = CraneSim(truth, q0)
-        self.u = None
-        self.fallbacks = 0
         self.inputs.add("effort_commands", timeout=v.command_timeout, length=3)
-        pub = lambda kind, topic: self.create_publisher(kind, topic, publisher_qos())  # noqa: E731
-        self.pub_js = pub(JointState, topics.JOINT_STATES)
-        self.pub_tip = pub(PoseStamped, topics.TIP_POSE)
-        self.pub_pay = pub(PoseStamped, topics.PAYLOAD_POSE)
-        self.pub_truth = pub(JointState, topics.SWING_TRUTH)
-        self.clock = ClockPublisher(self)
-        self.publish_description(self.description)
+        self.pub_js, self.pub_tip, self.pub_pay, self.pub_truth = self.state_publishers(
+            (JointState, topics.JOINT_STATES), (PoseStamped, topics.TIP_POSE),
+            (PoseStamped, topics.PAYLOAD_POSE), (JointState, topics.SWING_TRUTH))
         self.create_subscription(Float64MultiArray, topics.EFFORT_COMMANDS, self.on_command, stream_qos())
-        self.start_diagnostics()
-        self.timer = self.create_timer(1.0 / self.rate, self.tick)
-        start_markers(self, topics.MARKERS, lambda: state_markers(self.description, self.sim.state()[1]),
-                      lambda: self.sim.state()[0], v.markers_rate)
-        self.publish_state()
+        self.start_simulation(desc, 1.0 / self.rate, topics.MARKERS,
+                              lambda: state_markers(desc, self.sim.state()[1]), v.markers_rate)
 
     def extend_status(self, level, msg, values):
-        values["fallback (hold) steps"] = str(self.fallbacks)
-        values["stale answers ignored (lock-step)"] = str(self.lock.stale_answers)
-        values["simulation resets"] = str(self.sim.resets)
-        if self.sim.resets:
-            level, msg = add_problem(level, msg, ERROR, f"simulation diverged {self.sim.resets} times "
+        s = self.sim
+        values.update({"fallback (hold) steps": str(s.held), "simulation resets": str(s.resets)})
+        if s.resets:
+            level, msg = add_problem(level, msg, ERROR, f"simulation diverged {s.resets} times "
                                      "(restored at rest): commands too large?")
-        return level, msg, values
+        return super().extend_status(level, msg, values)
 
     def on_command(self, msg: Float64MultiArray) -> None:
         values = self.take_command("effort_commands", msg, self.lock)
         if values is not None:
             self.u = values.copy()       # (never applied late; lock-step starts with the next)
 
-    def tick(self) -> None:
-        step = self.may_step(self.lock, self.pub_js, self.publish_state)
-        if step is None:
-            return  # wait for the controller's answer to the last state
-        _, q, qd = self.sim.state()
-        u, held = sim_drive(self.u, q, qd, self.sim.truth.params, answered=step == ADVANCE,
-                            fresh=self.inputs.fresh("effort_commands", time.monotonic()),
-                            lockstep=self.lock.enabled)
-        self.fallbacks += held
-        self.sim.advance(u, 1.0 / self.rate)
-        self.publish_state()
+    def step(self, kind: str, fresh: bool) -> None:
+        self.sim.drive(self.u, 1.0 / self.rate, answered=kind == ADVANCE, fresh=fresh,
+                       lockstep=self.lock.enabled)
 
     def publish_state(self) -> None:
         t, q, qd = self.sim.state()
@@ -137,8 +72,9 @@ class CraneSimNode(PlantNode):
         self.pub_js.publish(convert.joint_state_msg(t, JOINTS, m["joints"], m["joint_rates"], m["effort"]))
         self.pub_tip.publish(convert.pose_msg(t, m["tip"], m["tip_quat"]))
         self.pub_pay.publish(convert.pose_msg(t, m["payload"], m["payload_quat"]))
-        self.pub_truth.publish(convert.joint_state_msg(t, SWING, [q[3], q[4], q[2]], [qd[3], qd[4], qd[2]]))
+        self.pub_truth.publish(convert.joint_state_msg(t, ("theta1", "theta2", "rope_length"),
+                                                       [q[3], q[4], q[2]], [qd[3], qd[4], qd[2]]))
 
 
-def make_node() -> PlantNode:
+def make_node() -> SimulatorNode:
     return CraneSimNode()

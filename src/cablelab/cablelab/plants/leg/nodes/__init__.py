@@ -1,13 +1,9 @@
 """The leg's ROS 2 nodes, one module per role (``sim``, ``estimator``, ``controller``), each with
-``PARAMETERS`` and ``make_node()``; run by the node executables (``cable_sim_node --plant leg``,
-...). Topics: :mod:`..topics`."""
+``PARAMETERS`` (from :mod:`.parameters`) and ``make_node()``; run by the node executables
+(``cable_sim_node --plant leg``, ...). Topics: :mod:`..topics`."""
 from __future__ import annotations
 
 from ....ros import convert
-from ....ros.params import Param
-
-DESCRIPTION = Param("description", "", "plant description: YAML file or text (empty = the "
-                    "package's data/leg.yaml)")
 
 HOP_NAMES = ["height", "phase", "apex_height", "grf"]
 

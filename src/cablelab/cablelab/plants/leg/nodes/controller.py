@@ -1,8 +1,8 @@
 """Leg controller node: ``/leg/hop_estimate`` (+ ``/leg/reference`` apex height, or a schedule
 written by ``cablelab excite``: ``reference_bag``, played from the first estimate on and published
-on ``/leg/reference``) -> :class:`~..controller.ApexController` -> ``/leg/effort_commands``.
+on ``/leg/reference``) -> :class:`~..control.ApexController` -> ``/leg/effort_commands``.
 
-ROS parameters: :data:`PARAMETERS` (``pd_feedforward --plant leg --help``).
+Parameters: :data:`.parameters.CONTROLLER`.
 """
 from __future__ import annotations
 
@@ -14,29 +14,14 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 from trajectory_msgs.msg import JointTrajectory
 
-from . import DESCRIPTION
 from .. import topics
 from ..control import ApexController
 from ..description import leg_of, load_leg_description
 from ....ros import convert
-from ....ros.params import Param
 from ....ros.plant_node import PlantNode
 from ....ros.qos import publisher_qos, stream_qos
-from ....ros.reference import ReferencePlayer, reference_bag_param
-
-PARAMETERS = (
-    DESCRIPTION,
-    Param("h_des", 0.016, "desired apex height above z_td until a /leg/reference arrives", "m",
-          ge=0.0, le=10.0),
-    Param("T", 1.0, "initial stance torque", "N m", ge=0.0, le=1e4),
-    Param("P", 0.30, "stance torque duration", "s", gt=0.0, le=10.0),
-    Param("k_i", 10.0, "integral gain on the apex-height error", "N m/m", ge=0.0, le=1e6),
-    Param("k_ff", 0.5, "feedforward fraction of the model-based Newton step", ge=0.0, le=10.0),
-    Param("T_max", 4.0, "largest stance torque", "N m", gt=0.0, le=1e4),
-    Param("mode", "apex", "apex-height control or a constant open-loop torque",
-          choices=("apex", "open_loop")),
-    reference_bag_param(topics.REFERENCE, "the topic"),
-)
+from ....ros.reference import ReferencePlayer
+from .parameters import CONTROLLER as PARAMETERS
 
 
 class LegControllerNode(PlantNode):
@@ -47,7 +32,6 @@ class LegControllerNode(PlantNode):
         params = leg_of(self.description).params(self.description.gravity)
         self.ctl = ApexController(params, params.z_td + v.h_des, T=v.T, P=v.P, k_i=v.k_i, k_ff=v.k_ff,
                                   T_max=v.T_max, mode=v.mode)
-        self.last_apex = math.nan
         self.player = ReferencePlayer.from_bag(self, v.reference_bag, topics.REFERENCE, ["apex_height"]) \
             if v.reference_bag else None
         self.inputs.add("hop_estimate", timeout=0.5)
@@ -75,11 +59,7 @@ class LegControllerNode(PlantNode):
         if self.player is not None:
             self.ctl.h_des = float(self.player(t, pos)[0][0])
         ia = names.index("apex_height")
-        h, ta = float(pos[ia]), float(vel[ia])
-        if math.isfinite(ta) and ta != self.last_apex:
-            self.last_apex = ta
-            self.ctl.on_apex(h)
-        tau = self.ctl.torque(t, int(round(pos[names.index("phase")])))
+        tau = self.ctl.step(t, int(round(pos[names.index("phase")])), float(pos[ia]), float(vel[ia]))
         self.pub.publish(convert.command_msg([tau], stamp=t))
 
 

@@ -2,7 +2,7 @@
 :class:`~..estimator.HopEstimator` -> ``/leg/hop_estimate``; /diagnostics reports the phase
 source, chattering flips, switch/height disagreements and dropouts.
 
-ROS parameters: :data:`PARAMETERS` (``payload_estimator --plant leg --help``).
+Parameters: :data:`.parameters.ESTIMATOR`.
 """
 from __future__ import annotations
 
@@ -10,21 +10,14 @@ import time
 
 from sensor_msgs.msg import JointState
 
-from . import DESCRIPTION, hop_msg
+from . import hop_msg
 from .. import topics
 from ..description import leg_of, load_leg_description
 from ..estimator import HopEstimator
 from ....ros import convert
-from ....ros.params import Param
 from ....ros.plant_node import PlantNode
 from ....ros.qos import publisher_qos, stream_qos
-
-PARAMETERS = (
-    DESCRIPTION,
-    Param("h", 0.5e-3, "height hysteresis of the phase detection", "m", ge=0.0, le=1.0),
-    Param("f_on", 1.0, "ground reaction force above which stance starts without a contact switch",
-          "N", ge=0.0, le=1e5),
-)
+from .parameters import ESTIMATOR as PARAMETERS
 
 
 class LegEstimatorNode(PlantNode):

@@ -1,15 +1,11 @@
-"""The suspended platform's ROS 2 nodes, one module per role (``sim``, ``estimator``,
-``controller``), each with ``PARAMETERS`` and ``make_node()``; run by the node executables
+"""The suspended platform's ROS 2 nodes, one module per role (``sim``, ``estimator``, ``controller``),
+each with ``PARAMETERS`` (from :mod:`.parameters`) and ``make_node()``; run by the node executables
 (``cable_sim_node --plant suspended``, ...). Topics: :mod:`..topics`."""
 from __future__ import annotations
 
 import numpy as np
 
-from ..params import VARIANTS
 from ....ros import convert
-from ....ros.params import Param
-
-VARIANT = Param("variant", "licas", "which platform: LiCAS or CRANEbot", choices=VARIANTS)
 
 
 def arm_reference(node, msg, names: list[str]):

@@ -4,59 +4,32 @@ stamped like the pose. ``/suspended/imu`` when present (spec 5.2): yaw from its 
 yaw rate from its gyro for poses within ``imu_max_lag`` s (stamps) of an IMU sample, else from
 the pose; a stale (``imu_timeout`` s wall) or NaN IMU is reported on /diagnostics once the IMU has
 been seen. NaN, wrong-length and frozen-stamp poses are held and counted on /diagnostics.
-
-ROS parameters: :data:`PARAMETERS` (``payload_estimator --plant suspended --help``).
+Parameters: :data:`.parameters.ESTIMATOR`.
 """
 from __future__ import annotations
-
-import math
 
 import numpy as np
 from geometry_msgs.msg import PoseStamped
 from sensor_msgs.msg import Imu, JointState
 
 from .. import topics
-from ..params import parameter_set
 from ..swing import CHANNELS, SwingEstimator
 from ....ros import convert
 from ....ros.inputs import WARN
-from ....ros.params import Param, executor_params, merge
 from ....ros.plant_node import PlantNode
 from ....ros.qos import catch_up_qos, publisher_qos
 from ....ros.status import add_problem
-
-PARAMETERS = merge((
-    Param("suspension_point", [float(x) for x in parameter_set("licas").S], "suspension point "
-          "S [x, y, z] (default: the LiCAS repo set)", "m", length=(3,), ge=-1e3, le=1e3),
-    Param("rest_position", [float("nan")] * 3, "rest position [x, y, z] (NaN: the mean over the "
-          "first rest_window s)", "m", length=(3,), ge=-1e3, le=1e3, nan=True),
-    Param("rest_yaw", float("nan"), "rest yaw (NaN: the mean over the first rest_window s)", "rad",
-          ge=-10.0, le=10.0, nan=True),
-    Param("rest_window", 2.0, "time the rest pose is averaged over", "s", gt=0.0, le=3600.0),
-    Param("imu_max_lag", 0.05, "yaw and yaw rate come from the IMU for poses within this of an "
-          "IMU sample (stamps)", "s", ge=0.0, le=10.0),
-    Param("velocity_tau", 0.05, "time constant smoothing the swing rates", "s", gt=0.0, le=10.0),
-    Param("pose_timeout", 0.5, "a pose older than this is stale", "s wall", gt=0.0),
-    Param("imu_timeout", 0.5, "an IMU sample older than this is stale (once the IMU was seen)",
-          "s wall", gt=0.0),
-), executor_params(True))
+from .parameters import ESTIMATOR as PARAMETERS
 
 
 class SuspendedSwingEstimator(PlantNode):
     def __init__(self):
         super().__init__("payload_estimator")
         v = self.declare_params(PARAMETERS)
-        rest, rest_yaw = v.rest_position, v.rest_yaw
-        self.est = SwingEstimator(v.suspension_point, rest_window=v.rest_window, imu_max_lag=v.imu_max_lag,
-                                  rest_pos=rest if all(map(math.isfinite, rest)) else None,
-                                  rest_yaw=rest_yaw if math.isfinite(rest_yaw) else None,
-                                  velocity_tau=v.velocity_tau)
+        self.est = SwingEstimator.of_parameters(v)
         self.use_fast_executor()
         self.inputs.add("platform_pose", timeout=v.pose_timeout, length=3)
         self.imu_timeout = v.imu_timeout
-        self.imu_used = 0            # estimates whose yaw came from the IMU
-        self.rejected = 0
-        self.last_problem = ""
         self.pub = self.create_publisher(JointState, topics.SWING_ESTIMATE, publisher_qos())
         self.create_subscription(Imu, topics.IMU, self.on_imu, catch_up_qos())
         self.create_subscription(PoseStamped, topics.PLATFORM_POSE, self.on_pose, catch_up_qos())
@@ -72,10 +45,10 @@ class SuspendedSwingEstimator(PlantNode):
             self.est.imu(t, qx[[3, 0, 1, 2]], gyro)
 
     def extend_status(self, level, msg, values):
-        values["yaw from IMU"] = str(self.imu_used)
-        values["held samples"] = str(self.rejected)
-        if self.rejected:
-            level, msg = add_problem(level, msg, WARN, f"{self.rejected} pose samples held ({self.last_problem})")
+        e = self.est
+        values.update({"yaw from IMU": str(e.from_imu), "held samples": str(e.held)})
+        if e.held:
+            level, msg = add_problem(level, msg, WARN, f"{e.held} pose samples held ({e.last_problem})")
         return level, msg, values
 
     def on_pose(self, msg: PoseStamped) -> None:
@@ -83,12 +56,8 @@ class SuspendedSwingEstimator(PlantNode):
         self.accept("platform_pose", pos)
         q = quat_xyzw[[3, 0, 1, 2]] if quat_xyzw is not None and len(quat_xyzw) == 4 else quat_xyzw
         s = self.est.step(t, pos, q)
-        self.imu_used += s.source == "imu"
-        if not s.ok:
-            self.rejected += 1
-            self.last_problem = s.message
-            return
-        self.pub.publish(convert.joint_state_msg(t, list(CHANNELS), s.position, s.velocity))
+        if s.ok:
+            self.pub.publish(convert.joint_state_msg(t, list(CHANNELS), s.position, s.velocity))
 
 
 def make_node() -> PlantNode:

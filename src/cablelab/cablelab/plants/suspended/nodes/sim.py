@@ -1,120 +1,63 @@
 """Suspended simulator node: the virtual-joint model (``model:=virtual``) or the truth plant
 (``model:=truth``) of ``variant`` (:class:`~..sim.LiveSim`) in real time.
 
-Arm position servos follow ``/suspended/reference`` (unknown joint names / wrong lengths are
-rejected and counted); ``arm_input:=effort``: torque motors driven by
-``/suspended/effort_commands`` (a command older than ``command_timeout`` s wall means zero torque
-and WARN). Publishes ``/suspended/imu``, ``/suspended/platform_pose``, ``/suspended/joint_states``
-(effort = actuator torque), ``/suspended/ground_truth/swing``,
-``/suspended/ground_truth/virtual_joints`` (virtual model), ``/clock``, ``/plant_description``.
-
+Arm position servos follow ``/suspended/reference`` (wrong names or lengths rejected and counted),
+or (``arm_input:=effort``) torque motors ``/suspended/effort_commands`` (older than
+``command_timeout`` s wall: zero torque, WARN). Publishes ``/suspended/{imu, platform_pose,
+joint_states, ground_truth/swing, ground_truth/virtual_joints}``, ``/clock``, ``/plant_description``.
 ``lockstep`` (needs ``arm_input:=effort``, :class:`cablelab.ros.lockstep.LockStep`): a state is
-answered before the simulation advances one period, so DDS latency and CPU load slow the run
-instead of delaying the stiff arm loop (the state resent every ``lockstep_resend`` s while
-waiting; ``lockstep_timeout`` s unanswered: real time with zero torque until commands flow). Use
-``rate:=1000``: the LiCAS joint-3 loop (k_d / I ~ 1000 1/s) is unstable with a 10 ms hold.
-Parameters: ``cable_sim_node --plant suspended --help``.
+answered before the simulation advances, so DDS latency and CPU load slow the run instead of
+delaying the stiff arm loop. Use ``rate:=1000``: the LiCAS joint-3 loop (k_d / I ~ 1000 1/s) is
+unstable with a 10 ms hold. Parameters: :data:`.parameters.SIM`.
 """
 from __future__ import annotations
 
-import time
-
 from geometry_msgs.msg import PoseStamped
-from rclpy.duration import Duration
 from sensor_msgs.msg import Imu, JointState
 from std_msgs.msg import Float64MultiArray
 from trajectory_msgs.msg import JointTrajectory
 
-from . import VARIANT, arm_reference
+from . import arm_reference
 from .. import topics
 from ..bag import description_yaml
 from ..markers import state_markers
 from ..mjcf import VJ
-from ..params import parameter_set
 from ..sim import LiveSim
 from ..swing import CHANNELS
 from ....description import load_description
-from ....errors import CablelabError
 from ....ros import convert
-from ....ros.clock import ClockPublisher
-from ....ros.lockstep import FREE, LockStep
-from ....ros.markers import start_markers
-from ....ros.params import START_GATE, Param, executor_params, markers_rate, merge
-from ....ros.plant_node import PlantNode
-from ....ros.qos import publisher_qos, stream_qos
+from ....ros.lockstep import LockStep
+from ....ros.qos import stream_qos
+from ....ros.simulator import FREE, SimulatorNode
 from ....rotations import wxyz_to_xyzw
-
-PARAMETERS = merge((
-    VARIANT,
-    Param("model", "virtual", "the virtual-joint model or the four-tendon truth plant",
-          choices=("virtual", "truth")),
-    Param("start_swing_x", 0.0, "initial swing about x", "rad", ge=-1.5, le=1.5),
-    Param("start_swing_y", 0.0, "initial swing about y", "rad", ge=-1.5, le=1.5),
-    Param("start_yaw", 0.0, "initial yaw", "rad", ge=-3.2, le=3.2),
-    Param("arm_input", "reference", "arm drives: position servos following /suspended/reference "
-          "or torque motors driven by /suspended/effort_commands", choices=("reference", "effort")),
-    Param("pose_noise", 0.0, "standard deviation of the measured platform position", "m",
-          ge=0.0, le=10.0),
-    Param("rate", 100.0, "publishing rate = command sampling (use 1000 with arm_input effort)",
-          "Hz", ge=1.0, le=10000.0),
-    Param("duration", 0.0, "simulated time after which the node exits (0 = run for ever)", "s",
-          ge=0.0),
-    Param("lockstep", False, "after a state, wait for the command answering it (needs "
-          "arm_input effort)"),
-    Param("lockstep_timeout", 10.0, "lock-step: without an answer for this long, real time with "
-          "zero torque until commands flow again", "s wall", gt=0.0),
-    Param("lockstep_resend", 0.25, "lock-step: the state is resent this often while waiting",
-          "s wall", gt=0.0, le=60.0),
-    Param("command_timeout", 0.5, "an effort command older than this means zero torque (WARN)",
-          "s wall", gt=0.0),
-    Param("imu", True, "publish /suspended/imu (orientation, gyro, accelerometer in the "
-          "platform frame)"),
-    markers_rate(f"{topics.MARKERS}: cables coloured by tension, platform, arms"),
-), START_GATE, executor_params(True))
+from .parameters import SIM as PARAMETERS, check_sim
 
 
-class SuspendedSimNode(PlantNode):
+class SuspendedSimNode(SimulatorNode):
     def __init__(self):
-        super().__init__("cable_sim_node")
+        super().__init__()
         v = self.declare_params(PARAMETERS)
-        self.motors = v.arm_input == "effort"
-        if v.lockstep and not self.motors:
-            raise CablelabError("cable_sim_node suspended: parameter lockstep=true needs "
-                                "arm_input=effort (lock-step waits for effort commands)")
-        self.description = load_description(description_yaml(v.variant, name=f"simulated {v.variant}"))
-        self.sim = LiveSim(parameter_set(v.variant), v.model, arm_motors=self.motors, rate=v.rate,
-                           start=(v.start_swing_x, v.start_swing_y, v.start_yaw), pose_noise=v.pose_noise)
-        self.names = self.sim.names
-        self.duration = v.duration
-        self.done = False
+        check_sim(v)
+        desc = load_description(description_yaml(v.variant, name=f"simulated {v.variant}"))
+        self.motors, self.duration = v.arm_input == "effort", v.duration
+        self.sim = sim = LiveSim.of_parameters(v)
+        self.names = sim.names
         self.lock = LockStep(v.lockstep, wait_first=True, timeout=v.lockstep_timeout, resend=v.lockstep_resend)
+        self.republish_every = max(v.lockstep_resend, 0.5)
         self.start_gate()
         self.use_fast_executor()
         self.inputs.add("reference", timeout=1e9, length=len(self.names))
         self.inputs.add("effort_commands", timeout=v.command_timeout, length=len(self.names))
-        pub = lambda kind, topic: self.create_publisher(kind, topic, publisher_qos())  # noqa: E731
-        self.pub_js = pub(JointState, topics.JOINT_STATES)
-        self.pub_pose = pub(PoseStamped, topics.PLATFORM_POSE)
-        self.pub_sw = pub(JointState, topics.GROUND_TRUTH_SWING)
-        self.pub_vj = pub(JointState, topics.GROUND_TRUTH_VIRTUAL)
-        self.pub_imu = pub(Imu, topics.IMU) if v.imu else None
-        self.clock = ClockPublisher(self)
-        self.publish_description(self.description)
+        self.pub_js, self.pub_pose, self.pub_sw, self.pub_vj, self.pub_imu = self.state_publishers(
+            (JointState, topics.JOINT_STATES), (PoseStamped, topics.PLATFORM_POSE),
+            (JointState, topics.GROUND_TRUTH_SWING), (JointState, topics.GROUND_TRUTH_VIRTUAL),
+            (Imu, topics.IMU if v.imu else None))
         if self.motors:
             self.create_subscription(Float64MultiArray, topics.EFFORT_COMMANDS, self.on_effort, stream_qos())
         else:
             self.create_subscription(JointTrajectory, topics.REFERENCE, self.on_reference, stream_qos())
-        self.start_diagnostics()
-        self.timer = self.create_timer(1.0 / v.rate, self.tick)
-        sim = self.sim
-        start_markers(self, topics.MARKERS, lambda: state_markers(sim.p, sim.model, sim.data),
-                      lambda: float(sim.data.time), v.markers_rate)
-        self.publish_state()
-
-    def extend_status(self, level, msg, values):
-        values["sim time s"] = f"{self.sim.t:.3f}"
-        values["stale answers ignored (lock-step)"] = str(self.lock.stale_answers)
-        return level, msg, values
+        self.start_simulation(desc, 1.0 / v.rate, topics.MARKERS,
+                              lambda: state_markers(sim.p, sim.model, sim.data), v.markers_rate)
 
     def on_reference(self, msg: JointTrajectory) -> None:
         ref = arm_reference(self, msg, self.names)
@@ -128,34 +71,14 @@ class SuspendedSimNode(PlantNode):
             if self.lock.enabled:
                 self.advance()        # lock-step: the answer is here, step at once
 
-    def tick(self) -> None:
-        step = self.may_step(self.lock, self.pub_js, self.publish_state, max(self.lock.resend, 0.5))
-        if step is None:
-            return
-        if self.motors and step == FREE and not self.inputs.fresh("effort_commands", time.monotonic()):
+    def step(self, kind: str, fresh: bool) -> None:
+        if self.motors and kind == FREE and not fresh:
             self.sim.hold(0.0)        # stale command: no torque (reported)
-        self.advance()
-
-    def advance(self) -> None:
-        """One publishing period of physics, then the new state out."""
-        if self.done:
-            return
         self.sim.advance()
-        self.publish_state()
-        if self.duration and self.sim.t >= self.duration - 1e-9:
-            self.done = True          # the runner stops the node (exit 0)
-
-    def shutdown(self) -> None:
-        """Before the node goes (e.g. ``duration`` reached): wait (at most 5 s per topic) until
-        the subscribers acknowledged what was published, so a recorder that lags behind the
-        lock-step loop still gets the end of the run."""
-        for pub in (self.pub_pose, self.pub_imu, self.pub_js, self.pub_sw, self.pub_vj):
-            if pub is not None:
-                pub.wait_for_all_acked(Duration(seconds=5.0))
 
     def publish_state(self) -> None:
-        """Publish the current state: IMU, pose, then joint states (the estimator then has the
-        IMU sample of a pose's stamp, and a controller the attitude of the state it answers)."""
+        """IMU, pose, then joint states: the estimator then has the IMU sample of a pose's
+        stamp, and a controller the attitude of the state it answers."""
         r = self.sim.read(imu=self.pub_imu is not None)
         quat = wxyz_to_xyzw(r.quat[None])[0]
         if self.pub_imu is not None:
@@ -169,5 +92,5 @@ class SuspendedSimNode(PlantNode):
         self.lock.published(r.t)
 
 
-def make_node() -> PlantNode:
+def make_node() -> SimulatorNode:
     return SuspendedSimNode()
