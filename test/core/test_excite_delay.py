@@ -74,3 +74,12 @@ def test_design_raises_the_delay_information_over_a_slow_reference():
 def test_other_nonlinear_parameters_are_refused():
     with pytest.raises(CablelabError, match="l_c"):
         E.design("crane", DESC, ("l_c",), duration=20.0, max_iter=1)
+
+
+def test_cdpr_tau_design_is_refused():
+    """The CDPR re-forms its wrench from the measured tensions at the delayed pose (remeasure), so
+    a finite difference of its delayed output is not minus the model output's time derivative
+    (checked while writing this: errors of the order of the column itself); the design says so."""
+    cdpr_desc = load_description(str(Path(crane_pkg.__file__).parents[1] / "cdpr" / "data" / "caroca.yaml"))
+    with pytest.raises(CablelabError, match="remeasure"):
+        E.design("cdpr", cdpr_desc, ("tau",), duration=20.0, max_iter=1)

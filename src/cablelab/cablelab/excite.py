@@ -489,6 +489,12 @@ def design(plant_name: str, desc, params: Sequence[str], *, duration: float = 60
             if name in model.fixed:
                 raise CablelabError(f"--params {name!r} is also fixed; name free parameters")
     if any(p in LINEARISED for p in params):
+        if getattr(plant, "remeasure", None) is not None:
+            # its outputs are re-formed from the raw measurement at the delayed motion, so the
+            # output's sensitivity to tau is not the model output's time derivative alone
+            raise CablelabError(f"--params tau: plant {plant.name} re-forms its outputs under a delay "
+                                f"(remeasure hook); the linearised delay column is for plants whose "
+                                f"outputs the delay does not re-form (tested: the crane)")
         vals = dict(values or {})
         tau0 = float(vals.pop("tau", 0.0))
         model = Linearised(model, linear_values(model, before_ds, vals, probe), tau0)
