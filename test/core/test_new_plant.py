@@ -16,8 +16,8 @@ from cablelab.cli import main
 
 #: the template's files: each role in its place (docs/architecture.md)
 ROLES = ["__init__.py", "plant.py", "description.py", "dataset.py", "effects.py", "control.py",
-         "mjcf.py", "sim.py", "topics.py", "demo.py", "nodes/__init__.py", "nodes/sim.py",
-         "nodes/estimator.py", "nodes/controller.py", "README.md", "data/{name}.yaml"]
+         "mjcf.py", "sim.py", "topics.py", "demo.py", "nodes/__init__.py", "nodes/parameters.py",
+         "nodes/sim.py", "nodes/estimator.py", "nodes/controller.py", "README.md", "data/{name}.yaml"]
 
 
 def test_new_plant_writes_a_working_package(tmp_path, capsys):

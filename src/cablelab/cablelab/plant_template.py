@@ -310,10 +310,48 @@ DEMO = None
 
 FILES["PACKAGE/nodes/__init__.py"] = '''\
 """The plant's ROS 2 nodes, one module per role (``sim``, ``estimator``, ``controller``), each
-with ``PARAMETERS`` (its ROS parameter specs) and ``make_node()``; run by the node executables
+with ``PARAMETERS`` (its ROS parameter specs, declared in ``parameters.py``) and ``make_node()``;
+run by the node executables
 (``cable_sim_node --plant NAME``, ``payload_estimator --plant NAME``, ``pd_feedforward --plant
 NAME``). Nodes are adapters: messages to arrays, one call into the plant's ROS-free modules,
 arrays to messages."""
+'''
+
+FILES["PACKAGE/nodes/parameters.py"] = '''\
+"""The ROS parameters of the plant's nodes, declared once (as generate_parameter_library keeps a
+node's parameters in a YAML file beside it): :data:`SIM` (``cable_sim_node``), :data:`ESTIMATOR`
+(``payload_estimator``), :data:`CONTROLLER` (``pd_feedforward``). Each is a tuple of typed specs
+(:class:`cablelab.ros.params.Param`: name, default, description, unit, range or choices) the node
+declares with descriptors and validates; ``NODE --plant NAME --help`` lists them."""
+from __future__ import annotations
+
+from cablelab.ros.params import START_GATE, Param
+
+#: ``cable_sim_node --plant NAME``
+SIM = (
+    Param("description", "", "plant description: YAML file or text (empty = the package's data/NAME.yaml)"),
+    Param("damping", 0.05, "hinge damping (the effect the nominal model lacks)", "N m s/rad", ge=0.0, le=100.0),
+    Param("drive", "builtin", "the torque: the built-in chirp or /NAME/effort_commands",
+          choices=("builtin", "topic")),
+    Param("rate", 200.0, "publishing rate", "Hz", ge=1.0, le=1000.0),
+    Param("duration", 8.0, "simulated time after which the node exits", "s", gt=0.0, le=3600.0),
+    Param("realtime_factor", 4.0, "simulated seconds per wall second", gt=0.0, le=1000.0),
+    Param("torque_noise", 0.01, "standard deviation of the measured torque", "N m", ge=0.0, le=100.0),
+    Param("seed", 0, "seed of the noise generator", ge=0),
+    Param("command_timeout", 0.5, "a command older than this means zero torque", "s wall", gt=0.0),
+) + START_GATE
+
+#: ``payload_estimator --plant NAME``
+ESTIMATOR = (
+    Param("forgetting", 1.0, "forgetting factor of the recursive least squares (1 = none)", gt=0.0, le=1.0),
+    Param("publish_every", 20, "publish the estimate every this many samples", ge=1, le=10 ** 9),
+)
+
+#: ``pd_feedforward --plant NAME``
+CONTROLLER = (
+    Param("duration", 8.0, "length of the chirp", "s", gt=0.0, le=3600.0),
+    Param("amplitude", 0.3, "amplitude of the chirp", "N m", ge=0.0, le=1e3),
+)
 '''
 
 FILES["PACKAGE/nodes/sim.py"] = '''\
@@ -322,7 +360,7 @@ simulated time, as fast as ``realtime_factor`` allows, until ``duration`` s. The
 built-in chirp (:func:`~..control.chirp`, ``drive:=builtin``) or the latest
 ``/NAME/effort_commands`` (``drive:=topic``; a stale command means zero torque). Publishes
 ``/NAME/joint_states`` (angle, rate, applied torque plus ``torque_noise``), ``/clock`` and
-``/plant_description``. ROS parameters: :data:`PARAMETERS`.
+``/plant_description``. ROS parameters: :data:`.parameters.SIM`.
 """
 from __future__ import annotations
 
@@ -336,7 +374,6 @@ from std_msgs.msg import Float64MultiArray
 from cablelab.description import load_description
 from cablelab.ros import convert
 from cablelab.ros.clock import ClockPublisher
-from cablelab.ros.params import START_GATE, Param
 from cablelab.ros.plant_node import PlantNode
 from cablelab.ros.qos import publisher_qos, stream_qos
 
@@ -344,21 +381,9 @@ from .. import topics
 from ..control import chirp
 from ..mjcf import JOINT
 from ..sim import CLASSSim
+from .parameters import SIM as PARAMETERS
 
 DEFAULT_DESCRIPTION = Path(__file__).resolve().parent.parent / "data" / "NAME.yaml"
-
-PARAMETERS = (
-    Param("description", "", "plant description: YAML file or text (empty = the package's data/NAME.yaml)"),
-    Param("damping", 0.05, "hinge damping (the effect the nominal model lacks)", "N m s/rad", ge=0.0, le=100.0),
-    Param("drive", "builtin", "the torque: the built-in chirp or /NAME/effort_commands",
-          choices=("builtin", "topic")),
-    Param("rate", 200.0, "publishing rate", "Hz", ge=1.0, le=1000.0),
-    Param("duration", 8.0, "simulated time after which the node exits", "s", gt=0.0, le=3600.0),
-    Param("realtime_factor", 4.0, "simulated seconds per wall second", gt=0.0, le=1000.0),
-    Param("torque_noise", 0.01, "standard deviation of the measured torque", "N m", ge=0.0, le=100.0),
-    Param("seed", 0, "seed of the noise generator", ge=0),
-    Param("command_timeout", 0.5, "a command older than this means zero torque", "s wall", gt=0.0),
-) + START_GATE
 
 
 class CLASSSimNode(PlantNode):
@@ -418,7 +443,7 @@ FILES["PACKAGE/nodes/estimator.py"] = '''\
 """``payload_estimator --plant NAME``: recursive least squares of the nominal model
 ``tau = I qdd`` from ``/NAME/joint_states`` (qdd from consecutive velocities, the torque held over
 the period), published as ``/NAME/parameter_estimate`` ``[I]`` every ``publish_every`` samples.
-ROS parameters: :data:`PARAMETERS`.
+ROS parameters: :data:`.parameters.ESTIMATOR`.
 """
 from __future__ import annotations
 
@@ -429,16 +454,11 @@ from std_msgs.msg import Float64MultiArray
 
 from cablelab.rls import RecursiveLeastSquares
 from cablelab.ros import convert
-from cablelab.ros.params import Param
 from cablelab.ros.plant_node import PlantNode
 from cablelab.ros.qos import catch_up_qos, publisher_qos
 
 from .. import topics
-
-PARAMETERS = (
-    Param("forgetting", 1.0, "forgetting factor of the recursive least squares (1 = none)", gt=0.0, le=1.0),
-    Param("publish_every", 20, "publish the estimate every this many samples", ge=1, le=10 ** 9),
-)
+from .parameters import ESTIMATOR as PARAMETERS
 
 
 class CLASSEstimator(PlantNode):
@@ -477,7 +497,7 @@ def make_node() -> PlantNode:
 FILES["PACKAGE/nodes/controller.py"] = '''\
 """``pd_feedforward --plant NAME``: on every ``/NAME/joint_states`` publishes the chirp torque
 (:func:`~..control.chirp`) at the state's stamp on ``/NAME/effort_commands`` (run the simulator
-with ``drive:=topic``). ROS parameters: :data:`PARAMETERS`.
+with ``drive:=topic``). ROS parameters: :data:`.parameters.CONTROLLER`.
 """
 from __future__ import annotations
 
@@ -487,17 +507,12 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 
 from cablelab.ros import convert
-from cablelab.ros.params import Param
 from cablelab.ros.plant_node import PlantNode
 from cablelab.ros.qos import publisher_qos, stream_qos
 
 from .. import topics
 from ..control import chirp
-
-PARAMETERS = (
-    Param("duration", 8.0, "length of the chirp", "s", gt=0.0, le=3600.0),
-    Param("amplitude", 0.3, "amplitude of the chirp", "N m", ge=0.0, le=1e3),
-)
+from .parameters import CONTROLLER as PARAMETERS
 
 
 class CLASSController(PlantNode):
@@ -549,6 +564,7 @@ NAME`); docs/architecture.md of cablelab, "The plant template", lists what each 
 | `topics.py` | the topic names, defined once |
 | `demo.py` | the part of `./run demo` (none yet) |
 | `nodes/{sim,estimator,controller}.py` | the ROS 2 node adapters |
+| `nodes/parameters.py` | the nodes' ROS parameters (`SIM`, `ESTIMATOR`, `CONTROLLER`), declared once |
 | `data/NAME.yaml` | the default description |
 
 Install with `pip install -e .` next to `pyproject.toml`; then `cablelab diagnose BAG`,

@@ -113,3 +113,40 @@ def test_reference_stamps_lead_mass_change_and_duration():
     hw.sim.slack_now = True
     s.step(0.0, fresh=True)
     assert s.slack_steps == 1 and s.values()["slack cable steps"] == "1"
+
+
+def test_steps_due_and_report_name_the_slack_cables():
+    s, hw = stepper(False)
+    assert s.steps_due(123.0) == 1                # lock-step: one step per timer (it may wait)
+    hw.sim.truth_state = lambda: {"slack": np.array([False, True])}
+    level, msg, values = s.report(0, "ok", {})
+    assert (level, msg) == (1, "slack cable(s) 2") and values["mode"].startswith("as fast as possible")
+    hw.sim.truth_state = lambda: {"slack": np.array([False, False])}
+    assert s.report(2, "stale commands", {})[:2] == (2, "stale commands")   # nothing slack: kept
+    r, _ = stepper(True)
+    assert r.steps_due(100.0) == 0 and r.steps_due(100.025) == 2       # real time: the wall clock's
+
+
+def test_from_parameters_builds_the_caroca_at_rest_at_point_a():
+    """The simulator node's stepper from its parameter specs' defaults: the default description's
+    cables, the s-curve's start (oracle: trajectory.pick_and_place at 0) as the initial pose, the
+    reference published two periods ahead in real time, none with publish_reference false; a
+    description without a cdpr section is one line naming the node."""
+    from types import SimpleNamespace
+
+    from cablelab.errors import CablelabError
+    from cablelab.plants.cdpr.nodes.parameters import SIM
+    from cablelab.plants.cdpr.sim import default_description
+    from cablelab.plants.cdpr.trajectory import pick_and_place
+    from cablelab.ros.params import check_all
+
+    v = SimpleNamespace(**check_all(SIM, {"rate": 200.0}))
+    desc = default_description()
+    s = SimStepper.from_parameters(desc, v, "cable_sim_node")
+    assert s.sim.n == len(desc.cdpr.cables) and s.rate == 200.0 and s.real_time
+    np.testing.assert_allclose(s.sim.truth_pose()[0], pick_and_place(np.array([0.0])).position[0], atol=2e-3)
+    assert s.reference_lead == pytest.approx(0.01) and s.publish_reference
+    quiet = SimpleNamespace(**{**vars(v), "publish_reference": False})
+    assert not SimStepper.from_parameters(desc, quiet).publish_reference
+    with pytest.raises(CablelabError, match=r"^cable_sim_node --plant cdpr: the description has no cdpr section$"):
+        SimStepper.from_parameters(SimpleNamespace(cdpr=None), v)

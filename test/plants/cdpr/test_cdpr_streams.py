@@ -125,3 +125,32 @@ def test_an_awaited_estimate_holds_the_state_until_it_comes_or_times_out(desc):
     s.state((1.001, [], np.zeros(8), np.zeros(8), None), now=1.0)
     assert s.ready(now=1.049) is None and s.ready(now=1.051) is not None
     assert not CommandStream(False, 0.005, 0.05).awaits_estimate      # PD: no estimate to wait for
+
+
+def test_command_checks_law_state_and_reference_in_that_order(desc):
+    """A state is commanded only with a law, a good motor state and a fresh reference, checked in
+    that order (a state before the description is not shown to the input monitor); the torques
+    are the law's (oracle: LiveController.update)."""
+    from cablelab.ros.inputs import InputMonitor
+
+    inputs = InputMonitor()
+    inputs.add("joint_states", timeout=0.5, length=8)
+    inputs.add("reference", timeout=0.5)
+    s = CommandStream(True, sync_wait=0.005, estimate_wait=0.0)
+    q, qd = np.full(8, -4000.0), np.zeros(8)
+    assert s.command((1.0, [], q, qd, None), inputs, 0.0) is None
+    assert s.skips.last_problem == "waiting for /plant_description" and inputs.inputs["joint_states"].received == 0
+    cfg = controller_config(PARAMS, desc.cdpr.platform_mass)
+    s.describe(desc.cdpr, desc.gravity, cfg)
+    for bad_q, bad_qd in ((np.full(8, np.nan), qd), (q[:7], qd[:7]), (q, None), (q, qd[:7])):
+        assert s.command((1.0, [], bad_q, bad_qd, None), inputs, 0.0) is None
+        assert s.skips.last_problem.startswith("bad motor state")
+    assert inputs.inputs["joint_states"].rejected == 2          # (the monitor checks positions)
+    assert s.command((1.0, [], q, qd, None), inputs, 0.0) is None and "no fresh reference" in s.skips.last_problem
+    tr = pick_and_place(np.array([1.0]))
+    s.reference(1.0, tr.position[0], ONE, tr.velocity[0], tr.acceleration[0])
+    inputs.accept("reference", tr.position[0], 0.0)
+    assert s.command((1.0, [], q, qd, None), inputs, 0.6) is None       # the reference went stale
+    want = LiveController(desc.cdpr, desc.gravity, cfg).update(1.0, q, qd, tr.position[0], ONE,
+                                                               tr.velocity[0], tr.acceleration[0])
+    np.testing.assert_allclose(s.command((1.0, [], q, qd, None), inputs, 0.1), want, rtol=1e-12)

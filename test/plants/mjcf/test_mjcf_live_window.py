@@ -94,3 +94,25 @@ def test_tension_values_pick_the_measured_tendons_by_name(cam):
     assert w.tension_values(CABLES[:3], [1.0, 2.0, 3.0]) is None          # a tendon missing
     assert w.tension_values(CABLES, [1.0, 2.0, 3.0]) is None              # names and values differ
     assert w.tension_values(CABLES, None) is None
+
+
+def test_state_values_zero_the_undriven_joints_effort_and_report_the_window(cam):
+    """A joint state's values for the input check: positions then efforts in the model's joint
+    order, an undriven joint's effort (not measured: NaN allowed) read as zero; the report gives
+    the window's samples and the last fitted mass, and a recent skip as a WARN."""
+    desc, t, q, eff, ten = cam
+    w = PayloadWindow(desc, window=3.0, every=10 ** 9)
+    assert len(w.joints) == 3 and not w.driven.any()     # the carriage moves on its cables alone
+    raw = np.full(3, np.nan)                              # (what a driver reports for no motor)
+    np.testing.assert_array_equal(w.state_values(w.joints, q[0], raw), np.concatenate([q[0], np.zeros(3)]))
+    assert w.state_values(w.joints[::-1], q[0], raw) is None                   # another order
+    assert w.state_values(w.joints, q[0], raw[:-1]) is None                    # a short array
+    level, msg, values = w.report(0, "ok", {})
+    assert (level, msg) == (0, "ok") and values == {"samples in window": "0"}
+    for j in range(len(t)):
+        w.tension(t[j], ten[j])
+        w.state(t[j], q[j], eff[j])
+    w.fit()
+    w.state(t[-1], q[-1], eff[-1])                                # a repeated stamp: skipped
+    level, msg, values = w.report(0, "ok", {})
+    assert level == 1 and "not after" in msg and values["payload mass kg"] == f"{w.last.m:.6g}"

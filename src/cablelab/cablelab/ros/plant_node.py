@@ -13,15 +13,20 @@ from types import SimpleNamespace
 
 from rclpy.duration import Duration
 from rclpy.node import Node
-from std_msgs.msg import String
+from std_msgs.msg import Float64MultiArray, String
 
 from ..description import load_description
 from ..errors import CablelabError
 from . import convert
 from .diagnostics import Diagnostics
+from .fastspin import drain, poll, take_newest
 from .inputs import InputMonitor
 from .lockstep import ADVANCE, FREE, RESEND
-from .qos import DESCRIPTION_QOS
+from .markers import start_markers
+from .qos import DESCRIPTION_QOS, stream_qos
+from .rawmsg import RawReader, joint_state_arrays, multidof_arrays
+from .reference import ReferencePlayer
+from .status import Latency
 
 PROBE_REPEAT = 5.0  # s wall: the start gate's probe state is published again (see waiting_for_subscribers)
 FINISH_ACK_TIMEOUT = 120.0  # s wall: a node that finished waits this long for acknowledgements (drain)
@@ -46,6 +51,9 @@ class PlantNode(Node):
         self.fast = False
         self.keep_first_description = False  # True: later /plant_description messages are ignored
         self._desc_pub = None
+        self.polled = []     # subscriptions left out of the executor's wait set (subscribe(polled=True))
+        self._raw_readers = {}
+        self.latency = Latency()  # per-sample processing time a node measures (latency.since(t0))
 
     # ------------------------------------------------------------------ parameters
     def declare_params(self, specs) -> SimpleNamespace:
@@ -152,10 +160,51 @@ class PlantNode(Node):
             return None
         return values
 
+    def subscribe(self, kind, topic: str, callback, qos, raw: bool = False, polled: bool = False):
+        """``create_subscription``; ``polled``: left out of the fast executor's wait set
+        (:func:`~cablelab.ros.fastspin.poll`), its samples wait queued until :meth:`take_polled`
+        (it joins :attr:`polled`, in subscription order)."""
+        sub = self.create_subscription(kind, topic, callback, qos, raw=raw)
+        if polled:
+            poll(self, sub)
+            self.polled.append(sub)
+        return sub
+
+    def take_polled(self, newest: bool = False) -> int:
+        """Run the callbacks of every sample queued on the :attr:`polled` subscriptions, in order
+        (:func:`~cablelab.ros.fastspin.drain`), or with ``newest`` one take from each (keep-last-1
+        queues hold only the newest: :func:`~cablelab.ros.fastspin.take_newest`); returns how many."""
+        if newest:
+            return sum(take_newest(sub) for sub in self.polled)
+        return drain(*self.polled)
+
+    def decode_raw(self, name: str, kind, msg):
+        """The arrays of a ``kind`` message (``JointState``:
+        :func:`~cablelab.ros.rawmsg.joint_state_arrays`, ``MultiDOFJointTrajectory``:
+        :func:`~cablelab.ros.rawmsg.multidof_arrays`) given as an object or as its serialised
+        bytes (a subscription with ``raw=True``), read with one reader per type; None, counted as
+        rejected on input ``name``, when the bytes are not one."""
+        reader = self._raw_readers.get(kind)
+        if reader is None:
+            reader = self._raw_readers[kind] = RawReader(kind)
+        arrays = multidof_arrays if kind.__name__ == "MultiDOFJointTrajectory" else joint_state_arrays
+        return self.decode(name, lambda m: arrays(m, reader), msg)
+
+    def play_reference(self, bag: str, topic: str, joints, builtin=None, platform: bool = False):
+        """The reference a controller plays itself and publishes on ``topic``
+        (:class:`~cablelab.ros.reference.ReferencePlayer`): the one in ``bag`` (a
+        ``reference_bag`` parameter) when given, else the ``builtin`` trajectory when given; None
+        when the controller follows the reference topic instead."""
+        if bag:
+            return ReferencePlayer.from_bag(self, bag, topic, joints, platform)
+        return None if builtin is None else ReferencePlayer(self, topic, joints, builtin, platform)
+
     # ------------------------------------------------------------------ description
-    def listen_for_description(self, text: str = "") -> None:
+    def listen_for_description(self, text: str = "", keep_first: bool = False) -> None:
         """Subscribe to ``/plant_description`` (transient local); ``text`` (a ``description``
-        parameter) is used at once when given."""
+        parameter) is used at once when given. ``keep_first``: the first valid description
+        configures the node for good (:attr:`keep_first_description`)."""
+        self.keep_first_description = self.keep_first_description or keep_first
         self.create_subscription(String, "/plant_description", self.on_description, DESCRIPTION_QOS)
         if text:
             self.set_description(load_description(text))
@@ -234,6 +283,25 @@ class PlantNode(Node):
             return False
         return True
 
+    def command_input(self, topic: str, length: int, timeout: float, qos=None, raw: bool = False,
+                      polled: bool = False):
+        """A simulator's commands: input ``effort_commands`` (``length`` values, stale after
+        ``timeout`` s wall) and its std_msgs/Float64MultiArray subscription on ``topic`` calling
+        ``self.on_command`` (:meth:`subscribe`; ``qos`` default: a stream's)."""
+        self.inputs.add("effort_commands", timeout=timeout, length=length)
+        return self.subscribe(Float64MultiArray, topic, self.on_command, qos or stream_qos(), raw, polled)
+
+    def start_stepping(self, period: float, markers_topic: str, frame, stamp, markers_rate: float) -> None:
+        """A simulator's last call in ``__init__``: /diagnostics (:meth:`start_diagnostics`), the
+        timer calling ``self.tick`` every ``period`` s wall (:attr:`timer`), the 3D view ``frame()``
+        on ``markers_topic`` stamped ``stamp()`` at ``markers_rate`` Hz wall
+        (:func:`~cablelab.ros.markers.start_markers`), and the initial state
+        (``self.publish_state()``)."""
+        self.start_diagnostics()
+        self.timer = self.create_timer(period, self.tick)
+        start_markers(self, markers_topic, frame, stamp, markers_rate)
+        self.publish_state()
+
     def may_step(self, lock, publisher, republish, every: float = 0.5) -> str | None:
         """A simulator's timer: the start gate (:meth:`waiting_for_subscribers` on ``publisher``),
         then the lock-step ``lock``: its ADVANCE (the answer to the last state is here) or FREE
@@ -277,12 +345,14 @@ class PlantNode(Node):
         self.diag = Diagnostics(self, update=self.status)
 
     def status(self):
-        """``(level, message, values)``: the inputs' status, extended by the node."""
+        """``(level, message, values)``: the inputs' status, extended by the node, and the p99
+        of the per-sample processing time when the node measures it (:attr:`latency`)."""
         level, msg, values = self.inputs.status(time.monotonic())
         if self.description_problem:
             level = max(level, 1)
             msg = self.description_problem if msg == "ok" else f"{msg}; {self.description_problem}"
-        return self.extend_status(level, msg, values)
+        level, msg, values = self.extend_status(level, msg, values)
+        return level, msg, self.latency.report(values)     # (nothing before the first sample)
 
     def extend_status(self, level: int, msg: str, values: dict):
         """Add the node's own values / raise the level (override)."""

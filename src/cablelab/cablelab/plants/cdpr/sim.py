@@ -408,7 +408,7 @@ def write_run_bag(run: CdprRun, path, *, overwrite: bool = True, pose: bool = Tr
 
 def truth_from_parameters(node: str, v, n: int, rate: float) -> CdprTruth:
     """The simulated CDPR's truth from the validated simulator node parameters ``v`` (the specs
-    of :data:`cablelab.plants.cdpr.nodes.sim.PARAMETERS`) for ``n`` cables at ``rate`` Hz;
+    of :data:`cablelab.plants.cdpr.nodes.parameters.SIM`) for ``n`` cables at ``rate`` Hz;
     one-line errors naming ``node`` for what the specs alone cannot check (the bias length
     against the cable count, the smallest step)."""
     bias = v.tension_bias

@@ -11,8 +11,15 @@ from __future__ import annotations
 
 from typing import Callable
 
+import numpy as np
+
+from ...errors import CablelabError
+from ...ros.inputs import WARN
+from ...ros.status import add_problem
+from .geometry import check_pulley_radius
 from .hardware import SimulatedCdpr
-from .trajectory import ReferenceTable
+from .sim import truth_from_parameters
+from .trajectory import ReferenceTable, pick_and_place
 
 __all__ = ["SimStepper", "MAX_CATCH_UP"]
 
@@ -74,6 +81,31 @@ class SimStepper:
         self._wall0 = None          # wall time of sim time 0 (real time)
         hardware.start()
 
+    @classmethod
+    def from_parameters(cls, description, v, who: str = "cable_sim_node",
+                        on_mass_change: Callable[[float], None] | None = None) -> "SimStepper":
+        """The simulator node's stepper: the MuJoCo CAROCA of ``description`` with the truth of
+        the validated node parameters ``v`` (:data:`~.nodes.parameters.SIM`), at rest at the
+        start of the pick-and-place (point A) at ``v.rate`` Hz, publishing that s-curve unless
+        ``v.publish_reference`` is false.
+
+        Raises:
+            CablelabError: one line naming ``who``: no cdpr section, a parameter the specs alone
+                cannot check (:func:`~.sim.truth_from_parameters`), or a pulley radius that does
+                not fit the geometry at A (:func:`~.geometry.check_pulley_radius`).
+        """
+        c = description.cdpr
+        if c is None:
+            raise CablelabError(f"{who} --plant cdpr: the description has no cdpr section")
+        truth = truth_from_parameters(who, v, len(c.cables), v.rate)
+        start = pick_and_place(np.array([0.0])).position[0]
+        check_pulley_radius(c.exit_points, c.anchor_points, start[None], None, c.pulley_radius,
+                            c.swivel_axes, f"{who}: description cdpr.pulley_radius")
+        return cls(SimulatedCdpr(description, truth, v.rate, start), v.rate, v.real_time, v.lockstep_timeout,
+                   ReferenceTable(v.rate, v.settle, v.trajectory_speed),
+                   v.reference_lead if v.publish_reference else None, v.duration, v.mass_change,
+                   v.mass_change_time, on_mass_change)
+
     def command(self, values, stamp: float | None) -> None:
         """A good command (n,) N m, naming the stamp of the state it answers (or None)."""
         self.u = values.copy()
@@ -94,6 +126,11 @@ class SimStepper:
             self._wall0 = now - self.k / self.rate
             due = MAX_CATCH_UP
         return max(0, due)
+
+    def steps_due(self, now: float) -> int:
+        """The steps the node's timer runs at wall time ``now``: :meth:`due` in real time, one in
+        lock-step (:meth:`step` says whether it went)."""
+        return self.due(now) if self.real_time else 1
 
     def step(self, now: float, fresh: bool = False, late: bool = False) -> bool:
         """One step at wall time ``now``; False when lock-step still waits for the answer.
@@ -166,3 +203,12 @@ class SimStepper:
                 "stale command steps": str(self.stale_command_steps),
                 "missed steps": str(self.missed_steps),
                 "command age 1/2/3+ periods": "/".join(str(a) for a in self.command_age)}
+
+    def report(self, level: int, msg: str, values: dict) -> tuple[int, str, dict]:
+        """The simulator's part of /diagnostics: ``values`` gains the counts (:meth:`values`);
+        ``(level, msg)`` a WARN naming the cables slack now (1-based)."""
+        values.update(self.values())
+        slack = [str(i + 1) for i in np.flatnonzero(self.sim.truth_state()["slack"])]
+        if slack:
+            level, msg = add_problem(level, msg, WARN, "slack cable(s) " + ", ".join(slack))
+        return level, msg, values

@@ -221,6 +221,20 @@ class CommandStream:
                        "feedforward mass kg": "-" if ctl is None or ctl.mass is None else f"{ctl.mass:.1f}"})
         return level, msg, values
 
+    def command(self, state, inputs, now: float):
+        """Torques for ``state`` = (t, names, position, velocity, effort) when it can be commanded
+        (checked in this order): a law configured by a description, a good motor state (the
+        node's input monitor ``inputs`` accepts the positions at wall ``now``; velocities of the
+        same length) and a fresh reference; else None (:attr:`skips` says why)."""
+        t, _names, q, qd, _eff = state
+        if self.controller is None:
+            return self.skips.skip("waiting for /plant_description")
+        if not inputs.accept("joint_states", q, now) or qd is None or qd.size != q.size:
+            return self.skips.skip("bad motor state (NaN, empty or wrong length)")
+        if not self.refs or not inputs.fresh("reference", now):
+            return self.skips.skip("no fresh reference: not commanding (brakes hold)")
+        return self.torques(t, q, qd)
+
     def torques(self, t: float, q, qd):
         """Torques for the motor state of stamp ``t`` at the reference of that stamp (prepared
         ahead when it was), or None (:attr:`skips` says why)."""

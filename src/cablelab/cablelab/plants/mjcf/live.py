@@ -71,6 +71,23 @@ class PayloadWindow:
         self.count += 1
         return self.fit() if self.count % self.every == 0 else None
 
+    def state_values(self, names, q, effort) -> np.ndarray | None:
+        """A joint-state message's positions and efforts (dof order) concatenated, the effort of an
+        undriven joint (not measured) taken as zero, when its ``names`` are the model's joints
+        with one value each (:func:`joint_values`), else None."""
+        if effort is not None and np.size(effort) == self.driven.size:
+            effort = np.where(self.driven, effort, 0.0)
+        return joint_values(names, self.joints, q, effort)
+
+    def report(self, level: int, msg: str, values: dict) -> tuple[int, str, dict]:
+        """The estimator's part of /diagnostics: ``values`` gains the samples in the window and
+        the last fitted mass; ``(level, msg)`` a WARN for a recently skipped sample or fit."""
+        values["samples in window"] = str(len(self.states))
+        if self.last is not None:
+            values["payload mass kg"] = f"{self.last.m:.6g}"
+        level, msg = self.skips.warn(level, msg)
+        return level, msg, values
+
     def tension_values(self, names, values) -> np.ndarray | None:
         """The tensions of the section's ``tendons`` in a message naming them (any order, others
         ignored; names and values of equal number), else None."""

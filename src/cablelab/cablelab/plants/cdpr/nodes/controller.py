@@ -9,13 +9,12 @@ or none (PD), friction compensation (eq. 15) and a minimum-tension floor. A stal
 estimate falls back to the nominal mass (WARN on /diagnostics). Without a reference (or with a
 bad motor state) nothing is published (the simulator's brakes hold) and /diagnostics says why.
 Matching samples by stamp: :class:`cablelab.plants.cdpr.streams.CommandStream`.
-Parameters: ``pd_feedforward --plant cdpr --help``.
+Parameters: :data:`.parameters.CONTROLLER` (``pd_feedforward --plant cdpr --help``).
 """
 from __future__ import annotations
 
 import math
 import time
-from functools import partial
 
 from geometry_msgs.msg import InertiaStamped
 from sensor_msgs.msg import JointState
@@ -23,85 +22,38 @@ from std_msgs.msg import Float64MultiArray
 from trajectory_msgs.msg import MultiDOFJointTrajectory
 
 from .. import topics
-from ..control import PdffConfig
 from ..streams import CommandStream, controller_config
-from ....ros import convert, rawmsg
-from ....ros.fastspin import drain, poll
-from ....ros.params import Param, executor_params, merge
+from ....ros import convert
 from ....ros.plant_node import PlantNode
 from ....ros.qos import publisher_qos, stream_qos
-from ....ros.rawmsg import CommandTemplate, RawReader
-from ....ros.reference import ReferencePlayer
-from ....ros.status import Latency
+from ....ros.rawmsg import CommandTemplate
 from ....rotations import xyzw_to_wxyz
-
-
-_D = PdffConfig()
-PARAMETERS = merge((
-    Param("description", "", "plant description: YAML file or text (empty = the first valid "
-          "/plant_description)"),
-    Param("feedforward", True, "mass feedforward of 001 eq. 14 with the live payload estimate "
-          "(PDFF; false: PD)"),
-    Param("nominal_mass", 0.0, "mass used without a valid estimate (0 = the description's "
-          "platform_mass)", "kg", ge=0.0, le=1e5),
-    Param("kp", _D.kp, "proportional gain on the motor angles", "N m/rad", ge=0.0, le=1e4),
-    Param("kd", _D.kd, "derivative gain on the motor rates", "N m s/rad", ge=0.0, le=1e3),
-    Param("coulomb", 0.3, "Coulomb friction compensation F_c (001 eq. 15)", "N m", ge=0.0, le=1e3),
-    Param("viscous", 0.002, "viscous friction compensation F_v (001 eq. 15)", "N m s/rad", ge=0.0, le=1e3),
-    Param("min_tension", _D.min_tension, "floor on the commanded tensions (cables stay taut)", "N",
-          ge=0.0, le=1e6),
-    Param("preload", _D.preload, "uniform tension the feedforward distribution stays nearest to", "N",
-          ge=0.0, le=1e6),
-    Param("max_torque", _D.max_torque, "saturation of the motor torques", "N m", gt=0.0, le=1e5),
-    Param("model", "II", "dynamic model of the feedforward: II (with the platform's inertia) or I",
-          choices=("II", "I")),
-    Param("estimate_timeout", 2.0, "a payload estimate older than this (in stamps) falls back to the "
-          "nominal mass", "s", gt=0.0),
-    Param("reference_timeout", 0.5, "a reference older than this is stale (nothing published)",
-          "s wall", gt=0.0),
-    Param("state_timeout", 0.5, "a joint state older than this is stale", "s wall", gt=0.0),
-    Param("sync_wait", 0.005, "a state waits this long for the reference of its stamp before the "
-          "latest one is used", "s wall", ge=0.0, le=1.0),
-    Param("reference_bag", "", "a reference bag written by `cablelab excite`: played from the first "
-          "joint state on and published on /cdpr/reference (run the simulator with "
-          "publish_reference:=false)"),
-    Param("estimate_wait", 0.0, "a state waits this long for the estimate of its stamp (0 = never: "
-          "use the latest; with a lock-step simulator: one deterministic chain)", "s wall",
-          ge=0.0, le=10.0),
-), executor_params(True))
+from .parameters import CONTROLLER as PARAMETERS
 
 
 class CdprController(PlantNode):
     def __init__(self):
         super().__init__("pd_feedforward", start_parameter_services=False)  # smaller wait set
         v = self.v = self.declare_params(PARAMETERS)
-        self.feedforward = v.feedforward
         self.stream = CommandStream(v.feedforward, v.sync_wait, v.estimate_wait)
         self.sent = 0
-        self.latency = Latency()
+        self._cmd = CommandTemplate("winch")     # pre-serialised commands naming their state's stamp
         self.inputs.add("joint_states", timeout=v.state_timeout)
         self.inputs.add("reference", timeout=v.reference_timeout)
         self.inputs.add("payload_estimate", timeout=v.estimate_timeout, length=1, required=False)
-        q = stream_qos(1000)     # deep queue: a busy moment delays samples instead of dropping them
         self.pub_cmd = self.create_publisher(Float64MultiArray, topics.EFFORT_COMMANDS, publisher_qos())
-        self.keep_first_description = True   # the first valid description configures the law
-        self.listen_for_description(v.description)
-        # the 1 kHz inputs arrive as bytes, decoded without rclpy message objects (RawReader)
-        self.readers = {"state": RawReader(JointState), "reference": RawReader(MultiDOFJointTrajectory)}
-        ref_sub = self.create_subscription(MultiDOFJointTrajectory, topics.REFERENCE, self.on_reference, q, raw=True)
-        est_sub = self.create_subscription(InertiaStamped, topics.PAYLOAD_ESTIMATE, self.on_estimate, q)
+        self.listen_for_description(v.description, keep_first=True)     # it configures the law
+        # 1 kHz inputs as bytes in deep queues (a busy moment delays samples, drops none). Only a
+        # state wakes the node: the reference (published before its state) and the estimate wait
+        # queued until a state or the timer takes them; an awaited estimate still wakes it
+        q = stream_qos(1000)
+        self.subscribe(MultiDOFJointTrajectory, topics.REFERENCE, self.on_reference, q, raw=True, polled=True)
+        self.subscribe(InertiaStamped, topics.PAYLOAD_ESTIMATE, self.on_estimate, q,
+                       polled=not self.stream.awaits_estimate)
         self.create_subscription(JointState, topics.JOINT_STATES, self.on_state, q, raw=True)
-        self.player = ReferencePlayer.from_bag(self, v.reference_bag, topics.REFERENCE, ("x", "y", "z"),
-                                               platform=True) if v.reference_bag else None
-        # only a state wakes the node: the reference (published before the state of its stamp)
-        # and the estimate wait queued until a state or the timer takes them (one wake-up per
-        # cycle at 1 kHz instead of three); an awaited estimate (estimate_wait) still wakes it
-        self.polled = [ref_sub] if self.stream.awaits_estimate else [ref_sub, est_sub]
-        for sub in self.polled:
-            poll(self, sub)
+        self.player = self.play_reference(v.reference_bag, topics.REFERENCE, ("x", "y", "z"), platform=True)
         self.create_timer(0.002, self.on_timer)
         self.use_fast_executor()
-        self._cmd = CommandTemplate("winch")     # pre-serialised commands naming their state's stamp
         self.start_diagnostics()
 
     @property
@@ -117,7 +69,7 @@ class CdprController(PlantNode):
 
     def on_reference(self, msg: MultiDOFJointTrajectory) -> None:
         """A reference sample (MultiDOFJointTrajectory or its serialised bytes)."""
-        r = self.decode("reference", partial(rawmsg.multidof_arrays, reader=self.readers["reference"]), msg)
+        r = self.decode_raw("reference", MultiDOFJointTrajectory, msg)
         if r is not None and self.accept("reference", r["position"]):     # (position None when empty)
             self.stream.reference(r["t"], r["position"], xyzw_to_wxyz(r["quaternion"]),
                                   r["linear_velocity"], r["linear_acceleration"])
@@ -129,30 +81,25 @@ class CdprController(PlantNode):
         self.command(self.stream.ready())     # a state may have been waiting for this estimate
 
     def on_state(self, msg: JointState) -> None:
-        """Keep the state (JointState or its serialised bytes); command now if the reference of
-        its stamp is here (else a little later, see :meth:`on_timer`: DDS does not order samples
-        across topics).
-
-        The state -> command path is kept short: when the reference terms of this stamp were
-        prepared after the previous command (:meth:`CommandStream.prepare_next
-        <cablelab.plants.cdpr.streams.CommandStream.prepare_next>`), the command is the
-        motor-state part of the law only, and the queued reference and estimate are taken
-        afterwards."""
-        try:
-            state = rawmsg.joint_state_arrays(msg, self.readers["state"])
-        except ValueError:
-            state = (float("nan"), [], None, None, None)      # rejected by command()
+        """A motor state (JointState or its bytes): commanded now if the reference of its stamp is
+        here, else a little later (:meth:`on_timer`: DDS does not order samples across topics).
+        The queued reference and estimate are taken after the command when the reference terms
+        were prepared ahead (:meth:`CommandStream.prepare_next <cablelab.plants.cdpr.streams.
+        CommandStream.prepare_next>`): the state -> command path stays short."""
+        state = self.decode_raw("joint_states", JointState, msg)
+        if state is None:
+            return
         if self.player is not None and math.isfinite(state[0]):
             self.player(state[0], ())        # the designed reference of this stamp, published first
         if self.stream.needs_inputs_first(state[0]):
-            drain(*self.polled)         # the reference and estimate that came before it
+            self.take_polled()          # the reference and estimate that came before it
         self.stream.state(state, time.monotonic())
         self.command(self.stream.ready())
-        drain(*self.polled)             # then prepare the next stamp's terms, off this path
+        self.take_polled()              # then prepare the next stamp's terms, off this path
         self.stream.prepare_next(state[0])
 
     def on_timer(self) -> None:
-        drain(*self.polled)
+        self.take_polled()
         self.command(self.stream.ready(time.monotonic()))
 
     def command(self, state) -> None:
@@ -160,25 +107,14 @@ class CdprController(PlantNode):
         if state is None:
             return
         t0 = time.perf_counter()
-        t, _names, q, qd, _eff = state
-        skips = self.stream.skips
-        if self.controller is None:
-            return skips.skip("waiting for /plant_description")
-        if not self.accept("joint_states", q) or qd is None or qd.size != q.size:
-            return skips.skip("bad motor state (NaN, empty or wrong length)")
-        if not self.stream.refs or not self.inputs.fresh("reference", time.monotonic()):
-            return skips.skip("no fresh reference: not commanding (brakes hold)")
-        tau = self.stream.torques(t, q, qd)
-        if tau is not None:
-            # optional: the stamp of the state this command answers (a lock-step simulator matches it)
-            self.pub_cmd.publish(self._cmd.data(tau, t))
+        if (tau := self.stream.command(state, self.inputs, time.monotonic())) is not None:
+            self.pub_cmd.publish(self._cmd.data(tau, state[0]))   # naming the state it answers (lock-step)
             self.sent += 1
             self.latency.since(t0)
 
     def extend_status(self, level, msg, values):
-        level, msg, values = self.stream.report(level, msg, values, "PDFF" if self.feedforward else "PD",
-                                                self.sent)
-        return level, msg, self.latency.report(values)
+        return self.stream.report(level, msg, values, "PDFF" if self.v.feedforward else "PD", self.sent)
+
 
 def make_node() -> PlantNode:
     return CdprController()

@@ -1,5 +1,6 @@
 """The CDPR's state topics as pre-serialised messages (:class:`cablelab.ros.rawmsg.RawTemplate`),
-published by the simulator node and the control loop: each sample patches stamps and numbers."""
+published by the simulator node and the control loop, and the payload estimate of the estimator
+node: each sample patches stamps and numbers."""
 from __future__ import annotations
 
 import numpy as np
@@ -20,6 +21,19 @@ def fill_pose(tpl: RawTemplate, t: float, position, quat_wxyz) -> RawTemplate:
     tpl.stamp(t)
     tpl.vector("pose.position")[:] = position
     tpl.vector("pose.orientation", "xyzw")[:] = wxyz_to_xyzw(quat_wxyz)
+    return tpl
+
+
+def estimate_template() -> RawTemplate:
+    """The ``/cdpr/payload_estimate`` InertiaStamped (com z NaN: the estimator finds x_G, y_G)."""
+    return RawTemplate(convert.inertia_msg(0.0, 0.0, [0.0, 0.0, float("nan")]))
+
+
+def fill_estimate(tpl: RawTemplate, t: float, mass: float, com) -> RawTemplate:
+    """The estimate of stamp ``t``: ``mass`` kg and the centre of mass x, y (``com[:2]``), m."""
+    tpl.stamp(t)
+    tpl["inertia.m"][0] = mass
+    tpl.vector("inertia.com")[:2] = com[:2]
     return tpl
 
 
@@ -77,6 +91,23 @@ class CdprOutputs:
 
     def command(self, t: float, torques) -> None:
         self.pub_cmd.publish(self.t_cmd.data(torques, t))
+
+    def simulator_sample(self, stepper, pose: bool = True, extras: bool = True) -> None:
+        """One sample of the simulator node (a :class:`~cablelab.plants.cdpr.stepping.SimStepper`
+        at its present sim time): the reference samples due before the state, the joint states
+        and cable tensions, the reference samples due after it, then, with ``extras``, /clock, the
+        measured pose (``pose``) and the ground truth (off the controller's path)."""
+        sim, t = stepper.sim, stepper.sim.time
+        ms = sim.measure()
+        before, after = stepper.reference_stamps(t)
+        for tr in before:
+            self.reference(tr, *stepper.reference.at(tr))
+        self.joints(t, ms["motor_angle"], ms["motor_velocity"], ms["motor_torque"])
+        self.tensions(t, ms["tension"], ms["cable_length"])
+        for tr in after:
+            self.reference(tr, *stepper.reference.at(tr))
+        if extras:
+            self.extras(t, (ms["position"], ms["quat"]) if pose else None, sim.truth_pose())
 
     def extras(self, t: float, pose=None, truth=None) -> None:
         """/clock, the measured pose ``(position, quat wxyz)`` and the ground truth pose (and

@@ -1,14 +1,13 @@
 """PD + model feedforward controller of any MuJoCo model: ``pd_feedforward --plant mjcf``.
 
-On every ``joint_states`` message it computes the actuator controls of
-:class:`..control.Feedforward` (computed torque from the description's model, with the latest
-``payload_estimate``) for the reference and publishes them on ``effort_commands`` (model actuator
-order), naming the stamp of the state it answers. The reference is a bag written by ``cablelab
-excite --plant mjcf`` (``reference_bag``, played from the first state on and published on
-``reference``), the latest ``reference`` (``reference_source: topic``; a stale or missing one
-holds the first measured position) or a built-in sine around the first measured position
-(``sine``, also published). Bad messages (names, lengths, NaN) are rejected and counted on
-/diagnostics; nothing is commanded from them.
+On every ``joint_states`` message: the actuator controls of :class:`..control.Feedforward`
+(computed torque from the description's model, with the latest ``payload_estimate``) for the
+reference, on ``effort_commands`` (model actuator order) naming the state's stamp. The reference:
+a bag of ``cablelab excite --plant mjcf`` (``reference_bag``) or a built-in sine around the first
+measured position (``reference_source: sine``), played from the first state on and published on
+``reference``; else the latest ``reference`` (stale or missing: hold the first measured position).
+Bad messages (names, lengths, NaN) are rejected and counted on /diagnostics; nothing is commanded
+from them. Parameters: :data:`.parameters.CONTROLLER`.
 """
 from __future__ import annotations
 
@@ -21,25 +20,12 @@ from std_msgs.msg import Float64MultiArray
 from trajectory_msgs.msg import JointTrajectory
 
 from ....ros import convert
-from ....ros.params import DESCRIPTION, Param
 from ....ros.plant_node import PlantNode
 from ....ros.qos import publisher_qos, stream_qos
-from ....ros.reference import ReferencePlayer, reference_bag_param
 from ..control import Feedforward, payload_values, sine_trajectory
 from ..live import joint_values
-from ..topics import TOPICS, topic
-
-PARAMETERS = (
-    DESCRIPTION,
-    Param("kp", 100.0, "proportional gain of the commanded acceleration", "1/s^2", ge=0.0, le=1e9),
-    Param("kd", 20.0, "derivative gain of the commanded acceleration", "1/s", ge=0.0, le=1e9),
-    Param("reference_source", "topic", "the reference: the reference topic or a built-in sine "
-          "around the first measured position (sine)", choices=("topic", "sine")),
-    Param("amplitude", 0.2, "amplitude of the built-in sine", "rad or m", ge=0.0, le=1e3),
-    Param("frequency", 0.3, "frequency of the built-in sine", "Hz", gt=0.0, le=1e3),
-    Param("reference_timeout", 0.5, "a reference older than this is stale", "s wall", gt=0.0),
-    reference_bag_param(TOPICS["reference"][0]),
-)
+from ..topics import topic
+from .parameters import CONTROLLER as PARAMETERS
 
 
 class MjcfController(PlantNode):
@@ -57,11 +43,8 @@ class MjcfController(PlantNode):
         super().set_description(desc)
         self.law = Feedforward(sec, desc.gravity, v.kp, v.kd)
         self.joints, n, ref_topic = self.law.joints, len(self.law.joints), topic(sec, "reference")
-        if v.reference_bag:
-            self.player = ReferencePlayer.from_bag(self, v.reference_bag, ref_topic, self.joints)
-        elif v.reference_source == "sine":
-            self.player = ReferencePlayer(self, ref_topic, self.joints,
-                                          sine_trajectory(n, v.amplitude, v.frequency))
+        sine = sine_trajectory(n, v.amplitude, v.frequency) if v.reference_source == "sine" else None
+        self.player = self.play_reference(v.reference_bag, ref_topic, self.joints, sine)
         self.inputs.add("joint_states", timeout=0.5, length=2 * n)
         self.inputs.add("reference", timeout=v.reference_timeout, length=3 * n, required=self.player is None)
         self.inputs.add("payload_estimate", timeout=60.0, length=4, required=False)
@@ -86,12 +69,10 @@ class MjcfController(PlantNode):
         t, names, q, qd, _eff = convert.joint_state_arrays(msg)
         if not self.accept("joint_states", joint_values(names, self.joints, q, qd)):
             return
-        self.hold = (q.copy(), np.zeros(q.size), np.zeros(q.size)) if self.hold is None else self.hold
-        if self.player is not None:
-            ref = self.player(t, q)
-        else:                                   # no fresh reference: hold where it started
-            ref = self.ref if self.ref is not None and self.inputs.fresh("reference", time.monotonic()) \
-                else self.hold
+        if self.hold is None:                   # without a fresh reference: hold where it started
+            self.hold = (q.copy(), np.zeros(q.size), np.zeros(q.size))
+        fresh = self.ref is not None and self.inputs.fresh("reference", time.monotonic())
+        ref = self.player(t, q) if self.player is not None else self.ref if fresh else self.hold
         self.pub.publish(convert.command_msg(self.law.command(q, qd, *ref), stamp=t, label="joint"))
 
 

@@ -8,26 +8,19 @@ states it fits the payload on ``mjcf.payload_body`` over the last ``window`` sec
 dynamics and its payload columns) and publishes ``payload_estimate``
 (geometry_msgs/InertiaStamped: ``m``, ``com`` in the payload body's frame). A message whose
 names, lengths or values do not fit the model is rejected and counted on /diagnostics.
+Parameters: :data:`.parameters.ESTIMATOR`.
 """
 from __future__ import annotations
 
-import numpy as np
 from geometry_msgs.msg import InertiaStamped
 from sensor_msgs.msg import JointState
 
 from ....ros import convert
-from ....ros.params import DESCRIPTION, Param
 from ....ros.plant_node import PlantNode
 from ....ros.qos import catch_up_qos, publisher_qos
-from ..live import PayloadWindow, joint_values
+from ..live import PayloadWindow
 from ..topics import topic
-
-PARAMETERS = (
-    DESCRIPTION,
-    Param("window", 4.0, "length of the sliding window fitted", "s", gt=0.5, le=3600.0),
-    Param("publish_every", 200, "fit and publish every this many joint-state messages", ge=1,
-          le=10 ** 9),
-)
+from .parameters import ESTIMATOR as PARAMETERS
 
 
 class MjcfEstimator(PlantNode):
@@ -55,12 +48,7 @@ class MjcfEstimator(PlantNode):
             self.create_subscription(JointState, topic(sec, "cable_tensions"), self.on_tension, catch_up_qos())
 
     def extend_status(self, level, msg, values):
-        if self.win is not None:
-            values["samples in window"] = str(len(self.win.states))
-            if self.win.last is not None:
-                values["payload mass kg"] = f"{self.win.last.m:.6g}"
-            level, msg = self.win.skips.warn(level, msg)
-        return level, msg, values
+        return (level, msg, values) if self.win is None else self.win.report(level, msg, values)
 
     def on_tension(self, msg: JointState) -> None:
         if self.win is None or not self.win.tendons:        # not subscribed: nothing measured
@@ -71,15 +59,11 @@ class MjcfEstimator(PlantNode):
 
     def on_state(self, msg: JointState) -> None:
         t, names, q, _qd, eff = convert.joint_state_arrays(msg)
-        w = self.win
-        if eff is not None and eff.size == w.driven.size:
-            eff = np.where(w.driven, eff, 0.0)         # an undriven joint's effort is not measured
-        if not self.accept("joint_states", joint_values(names, w.joints, q, eff)):
+        if not self.accept("joint_states", values := self.win.state_values(names, q, eff)):
             return
-        est = w.state(t, q, eff)
-        if est is not None:
+        if (est := self.win.state(t, q, values[q.size:])) is not None:
             sec = self.description.mjcf
-            self.pub.publish(convert.inertia_msg(w.last_t, est.m, est.com, frame_id=sec.payload_body))
+            self.pub.publish(convert.inertia_msg(self.win.last_t, est.m, est.com, frame_id=sec.payload_body))
 
 
 def make_node() -> PlantNode:

@@ -1,13 +1,12 @@
 """Simulator node of any MuJoCo model: ``cable_sim_node --plant mjcf -p description:=FILE``.
 
-Steps the description's model at its own timestep (:class:`..sim.MjcfSim`) with the actuator
-controls of ``effort_commands`` (model actuator order; a stale or missing command: zero controls)
-and publishes, each period, ``joint_states`` (every hinge/slide joint: position, velocity,
-effort = the actuators' generalised force on it), ``cable_tensions`` (the description's
-``tendons``), ``ground_truth/joint_states``, ``/clock`` and ``/plant_description`` (the model
-inline), and the 3D view ``markers`` (the model's geoms and tendons, :mod:`..markers`) on a
-wall-clock timer. Topic names follow the description's ``mjcf.topics``. Without ``description``
-it runs the shipped three-joint arm (``plants/mjcf/examples/arm3.xml``).
+Steps the description's model (:class:`..sim.MjcfSim`; without ``description`` the shipped
+three-joint arm, ``plants/mjcf/examples/arm3.xml``) with the actuator controls of
+``effort_commands`` (model actuator order; a stale or missing command: zero controls) and
+publishes each period ``joint_states`` (every hinge/slide joint; effort = the actuators'
+generalised force on it), ``cable_tensions`` (the ``tendons``), ``ground_truth/joint_states``,
+``/clock``, ``/plant_description`` (the model inline) and, on a wall-clock timer, the 3D view
+``markers`` (:mod:`..markers`); topic names as ``mjcf.topics`` says. Parameters: :data:`.parameters.SIM`.
 """
 from __future__ import annotations
 
@@ -20,68 +19,42 @@ from std_msgs.msg import Float64MultiArray
 from ....description import load_description
 from ....errors import CablelabError
 from ....ros import convert
-from ....ros.clock import ClockPublisher
-from ....ros.markers import start_markers
-from ....ros.params import DESCRIPTION, START_GATE, Param, markers_rate, merge
-from ....ros.plant_node import PlantNode
-from ....ros.qos import publisher_qos, stream_qos
+from ....ros.simulator import SimulatorNode
 from ..description import section_of
 from ..markers import sim_markers
 from ..sim import MjcfSim, default_description, hidden_payload, publish_period
 from ..topics import topic
-
-PARAMETERS = merge((
-    DESCRIPTION,
-    Param("rate", float("nan"), "publishing rate = command sampling (NaN: every physics step of "
-          "the model)", "Hz", gt=0.0, le=10000.0, nan=True),
-    Param("command_timeout", 0.5, "a command older than this falls back to zero controls (WARN)",
-          "s wall", gt=0.0),
-    Param("payload_mass", 0.0, "mass the simulated truth carries on mjcf.payload_body, at its "
-          "centre of mass (not in the published description: what an estimator must find)", "kg",
-          ge=0.0, le=1e6),
-    markers_rate("/mjcf/markers: the model's geoms and tendons, tendons coloured by tension"),
-), START_GATE)
+from .parameters import SIM as PARAMETERS
 
 
-class MjcfSimNode(PlantNode):
+class MjcfSimNode(SimulatorNode):
     def __init__(self):
-        super().__init__("cable_sim_node")
+        super().__init__()
         v = self.declare_params(PARAMETERS)
         self.description = load_description(v.description or default_description())
         sec = section_of(self.description)
         self.sim = MjcfSim(sec, self.description.gravity, hidden_payload(sec, v.payload_mass))
-        self.period = publish_period(self.sim.model.opt.timestep, v.rate)
         self.ctrl = [0.0] * self.sim.model.nu
         self.start_gate()
-        self.inputs.add("effort_commands", timeout=v.command_timeout, length=self.sim.model.nu)
-        pub = lambda key: self.create_publisher(JointState, topic(sec, key), publisher_qos())  # noqa: E731
-        self.pub_js, self.pub_truth = pub("joint_states"), pub("ground_truth_joint_states")
-        self.pub_ten = pub("cable_tensions") if sec.tendons else None
-        self.clock = ClockPublisher(self)
-        self.publish_description(self.description)
-        self.create_subscription(Float64MultiArray, topic(sec, "effort_commands"), self.on_command,
-                                 stream_qos())
-        self.start_diagnostics()
-        self.timer = self.create_timer(self.period, self.tick)
-        start_markers(self, topic(sec, "markers"), lambda: sim_markers(self.sim), lambda: self.sim.t,
-                      v.markers_rate)
-        self.publish_state()
-
-    def extend_status(self, level, msg, values):
-        values["sim time s"] = f"{self.sim.t:.3f}"
-        return level, msg, values
+        self.pub_js, self.pub_truth, self.pub_ten = self.state_publishers(
+            (JointState, topic(sec, "joint_states")), (JointState, topic(sec, "ground_truth_joint_states")),
+            (JointState, topic(sec, "cable_tensions") if sec.tendons else None))
+        self.command_input(topic(sec, "effort_commands"), self.sim.model.nu, v.command_timeout)
+        self.start_simulation(self.description, publish_period(self.sim.model.opt.timestep, v.rate),
+                              topic(sec, "markers"), lambda: sim_markers(self.sim), v.markers_rate)
 
     def on_command(self, msg: Float64MultiArray) -> None:
         if (values := self.take_command("effort_commands", msg)) is not None:
             self.ctrl = [float(x) for x in values]
 
     def tick(self) -> None:
-        if self.waiting_for_subscribers(self.pub_js, self.last_publish, self.publish_state):
-            return
-        if not self.inputs.fresh("effort_commands", time.monotonic()):
+        if not self.waiting_for_subscribers(self.pub_js, self.last_publish, self.publish_state):
+            super().tick()
+
+    def step(self, kind: str, fresh: bool) -> None:
+        if not fresh:
             self.ctrl = [0.0] * self.sim.model.nu       # no (fresh) command: drives off
         self.sim.advance(self.ctrl, self.period)
-        self.publish_state()
 
     def publish_state(self) -> None:
         self.last_publish = time.monotonic()
@@ -95,5 +68,5 @@ class MjcfSimNode(PlantNode):
             self.pub_ten.publish(convert.joint_state_msg(t, self.sim.tendons, None, None, tension))
 
 
-def make_node() -> PlantNode:
+def make_node() -> SimulatorNode:
     return MjcfSimNode()
