@@ -24,7 +24,10 @@ hidden), ``cablelab excite``'s design for the confounded parameters (the generat
 the model the run is fitted with (the case's effects and known parameters), the designed
 reference simulated by the case's own simulator, then ``diagnose --greedy``; targets hidden set
 found >= 95 %, parameter p95 <= 3 %, 0 % false significant on controls. Every case's condition
-numbers before and after are printed in its own table.
+numbers before and after are printed in its own table. ``crane_delay=N``: a 20-45 ms measurement
+delay hidden in 60 s of slow sines (0.015-0.035 Hz; ``draw_delay_case``), diagnosed as it is (the
+delay should not be found), then ``excite``'s design for (tau, I_tot) with tau linearised, and the
+designed run diagnosed (time_delay first and significant, tau within 10 %).
 
     nice -n 10 ./run python bench/bench_diagnosis.py --designed crane=12,cdpr=4
 
@@ -146,16 +149,29 @@ def run_designed_case(case, gen, workdir: str) -> dict:
     Adds the condition numbers before/after and the error of every true parameter (the hidden
     effect's and the payload mass) to :func:`diagnose_case`'s result."""
     from cablelab import workbench
-    from cablelab.excite import condition, design, model_for
+    from cablelab.excite import LINEARISED, Linearised, condition, design, model_for
+    from cablelab.fit import identify
+
+    vis = []   # the delay's visibility (first recording, designed run) when the pair names tau
 
     def pair_condition(path):   # the pair in the model the case fits (known parameters fixed)
         plant, desc, ds = workbench.load(path, None, dict(case.options))
-        owners = model_for(plant, desc, gen.PAIR, ds)[1]      # the effects the pair belongs to
+        owners = model_for(plant, desc, pair, ds)[1]      # the effects the pair belongs to
         model = workbench.build_model(plant, desc, tuple(dict.fromkeys(tuple(case.effects) + owners)),
                                       fixed=case.fixed)
-        return ds, desc, condition(model, ds, gen.PAIR)
+        if any(p in LINEARISED for p in pair):   # a delay: its linearised column, at the fit on ds
+            fit = identify(model, ds, on_deficient="hold")
+            model = Linearised(model, fit.params)
+            # its visibility: what a 30 ms delay adds to the output, RMS over the fit's residual
+            # RMS (the largest over the channels; < ~0.1: below what a held-out gain can show)
+            col = model.tau_column(ds)
+            ok = np.isfinite(col).all(axis=1) & np.isfinite(fit.residual).all(axis=1)
+            vis.append(float(np.max(np.sqrt(np.mean((0.03 * col[ok]) ** 2, axis=0))
+                                    / np.sqrt(np.mean(fit.residual[ok] ** 2, axis=0)))))
+        return ds, desc, condition(model, ds, pair)
 
     tr = case.truth
+    pair = tuple(tr.get("pair", gen.PAIR))
     fields = {"case": case, "plant": case.plant, "hidden": tuple(case.hidden), "label": case.label(),
               "family": (case.family, int(case.fs), "velocity" if case.velocity_recorded else "encoder only"),
               "miss": f"seed {case.seed} {case.plant} {case.family}"}
@@ -166,9 +182,11 @@ def run_designed_case(case, gen, workdir: str) -> dict:
     except RuntimeError as exc:  # the generator could not make this case (e.g. a slack cable)
         return {**fields, "error": f"generator (first recording): {exc}", "seconds": 0.0}
     ds0, desc, fit0 = pair_condition(first)
+    # the first recording's own ranking (cases that hide what it cannot show, e.g. a delay)
+    first_r = diagnose_case(case, first, fields) if tr.get("diagnose_first") else None
     t0 = time.perf_counter()
     # designed for the model the run is fitted with (the case's effects, its known parameters)
-    d = design(case.plant, desc, gen.PAIR, duration=tr["designed_s"], before_ds=ds0, seed=case.seed,
+    d = design(case.plant, desc, pair, duration=tr["designed_s"], before_ds=ds0, seed=case.seed,
                effects=case.effects, fixed=case.fixed)
     design_s = time.perf_counter() - t0
     tr["duration"], tr["reference"] = tr["designed_s"], gen.tabulated(d.t, d.q, d.qd, d.qdd)
@@ -180,6 +198,10 @@ def run_designed_case(case, gen, workdir: str) -> dict:
     r = diagnose_case(case, path, fields)
     r.update(cond=(d.condition_before, d.condition_after), fit_cond=(fit0, pair_condition(path)[2]),
              design_s=design_s)
+    if first_r is not None:
+        r["first_top_sig"] = first_r.get("top_sig", "error")
+    if vis:
+        r["visibility"] = tuple(vis)
     if "error" not in r:
         r["perr"] = {h: rel_param_error(r["final"], v) for h, v in case.true_params.items()}
     return r
@@ -191,8 +213,8 @@ def summarise_designed(bench, results) -> None:
     significant on controls; condition numbers of the pair before (first recording) and after
     (designed run); then every case with its condition numbers and errors."""
     mean = lambda xs: float(np.mean(xs)) if len(xs) else np.nan  # noqa: E731
-    for plant in dict.fromkeys(r["plant"] for r in results):
-        rs = [r for r in results if r["plant"] == plant]
+    for plant in dict.fromkeys(r.get("group", r["plant"]) for r in results):
+        rs = [r for r in results if r.get("group", r["plant"]) == plant]
         ok = [r for r in rs if "error" not in r]
         hid = [r for r in ok if r["hidden"]]
         ctl = [r for r in ok if not r["hidden"]]
@@ -206,6 +228,13 @@ def summarise_designed(bench, results) -> None:
         bench.row(metric="hidden set found (greedy = hidden)",
                   value=f"{_pct(mean([set(r['added']) == set(r['hidden']) for r in hid]))} of {len(hid)}",
                   target=">= 95 %")
+        if any("first_top_sig" in r for r in ok):
+            bench.row(metric="first recording: hidden effect first and significant",
+                      value=f"{_pct(mean([r.get('first_top_sig') in r['hidden'] for r in hid]))} of {len(hid)}",
+                      target="(not found)")
+            bench.row(metric="first recording: anything significant on controls",
+                      value=f"{_pct(mean([r.get('first_top_sig') != 'none' for r in ctl]))} of {len(ctl)}",
+                      target="")
         bench.row(metric="right effect first", value=f"{_pct(mean([r['top'] in r['hidden'] for r in hid]))} of {len(hid)}",
                   target=">= 95 %")
         bench.row(metric="false significant on controls",
@@ -224,6 +253,10 @@ def summarise_designed(bench, results) -> None:
                   value=f"{np.median(f1):.4g} / {np.max(f1):.4g}" if f1.size else "nan", target="")
         bench.row(metric="excite's condition number (same model, the ideal designed motion) (median / max)",
                   value=f"{np.median(c1):.4g} / {np.max(c1):.4g}" if c1.size else "nan", target="")
+        v = np.array([r["visibility"] for r in ok if "visibility" in r])
+        if v.size:
+            bench.row(metric="delay visibility (30 ms x column RMS / residual RMS), first / designed (median)",
+                      value=f"{np.median(v[:, 0]):.3g} / {np.median(v[:, 1]):.3g}", target="")
         bench.row(metric="design seconds median / max",
                   value=f"{np.median([r['design_s'] for r in ok]):.1f} / {np.max([r['design_s'] for r in ok]):.1f}"
                   if ok else "nan", target="< 30 s")
@@ -234,8 +267,10 @@ def summarise_designed(bench, results) -> None:
                 bench.row(seed=r["case"].seed, case=r["case"].family, cond_first="-", cond_designed="-",
                           added="error", errors=r["error"][:60])
                 continue
+            more = ({"first_sig": r["first_top_sig"]} if "first_top_sig" in r else {}) | (
+                {"visibility": f"{r['visibility'][0]:.3g} -> {r['visibility'][1]:.3g}"} if "visibility" in r else {})
             bench.row(seed=r["case"].seed, case=r["case"].family, cond_first=f"{r['fit_cond'][0]:.3g}",
-                      cond_designed=f"{r['fit_cond'][1]:.3g}", added=",".join(r["added"]) or "none",
+                      cond_designed=f"{r['fit_cond'][1]:.3g}", **more, added=",".join(r["added"]) or "none",
                       errors="; ".join(f"{k} {100 * v:.2f} %" for k, v in r["perr"].items()))
 
 
@@ -278,7 +313,8 @@ def main() -> None:
                               ",".join(f"{p}={v[1]}" for p, v in PLANT_CASES.items()) + ")")
     bench.parser.add_argument("--designed", default="", metavar="P=N",
                               help="designed-experiment cases instead of the others (crane=N, cdpr=N, "
-                                   "leg=N: draw_designed_case of bench/cases_<plant>.py, seeds from "
+                                   "leg=N: draw_designed_case of bench/cases_<plant>.py; crane_delay=N: "
+                                   "draw_delay_case of bench/cases_crane.py; seeds from "
                                    + ", ".join(f"{v} ({k})" for k, v in DESIGNED_SEEDS.items()) + ")")
     bench.parser.add_argument("--workers", type=int, default=1,
                               help="processes for the --designed cases (default 1)")
@@ -316,7 +352,9 @@ def main() -> None:
 
 
 #: plant -> first seed of its designed-experiment cases
-DESIGNED_SEEDS = {"crane": 6000, "leg": 7000, "cdpr": 7000}
+DESIGNED_SEEDS = {"crane": 6000, "leg": 7000, "cdpr": 7000, "crane_delay": 8000}
+#: designed-case families beyond each plant's ``draw_designed_case``: name -> (plant, draw function)
+DESIGNED_DRAW = {"crane_delay": ("crane", "draw_delay_case")}
 
 
 def designed(bench, spec: str, workers: int = 1) -> None:
@@ -347,10 +385,12 @@ def _designed_job(job, workdir: str) -> dict:
     import importlib
 
     p, k = job
-    gen = importlib.import_module(PLANT_CASES[p][0])
-    case = gen.draw_designed_case(DESIGNED_SEEDS[p] + k)
+    plant, draw = DESIGNED_DRAW.get(p, (p, "draw_designed_case"))
+    gen = importlib.import_module(PLANT_CASES[plant][0])
+    case = getattr(gen, draw)(DESIGNED_SEEDS[p] + k)
     own = getattr(gen, "run_designed_case", None)    # a plant whose loop is its own (leg)
     r = own(case, workdir, diagnose_case) if own else run_designed_case(case, gen, workdir)
+    r["group"] = p
     if isinstance(getattr(r.get("case"), "truth", None), dict):
         r["case"].truth.pop("reference", None)
     return r

@@ -141,6 +141,54 @@ def draw_designed_case(seed: int, kind: str | None = None) -> PlantCase:
     return case
 
 
+#: the pair a slow recording leaves a hidden delay confounded in: the effort of a motion much slower
+#: than tau barely changes within tau, so the delay's column (minus the output's time derivative,
+#: linearised) is small and close to the inertia's (the acceleration's) columns
+DELAY_PAIR = ("tau", "I_tot")
+
+
+def draw_delay_case(seed: int, kind: str | None = None) -> PlantCase:
+    """A case whose first recording hides a measurement delay (20-45 ms, "delay") or nothing
+    ("control", every fourth seed): ``first_s`` s of slow sines of all three drives (0.02-0.05 Hz,
+    where tau shifts the effort by less than its noise), masses weighed as in :func:`draw_case`.
+    The benchmark diagnoses that recording, designs an excitation for :data:`DELAY_PAIR`
+    (``truth["pair"]``) on it and simulates it with :func:`simulate`."""
+    rng = np.random.default_rng(seed + 15485863)
+    if kind is None:
+        kind = "control" if seed % 4 == 3 else "delay"
+    case = draw_case(seed, kind="control")
+    tr = case.truth
+    if kind == "delay":
+        tr["tau"] = float(rng.uniform(20e-3, 45e-3))
+        case.hidden = ("time_delay",)
+        case.true_params = {"time_delay": {"tau": tr["tau"]}}
+    else:
+        tr["tau"] = 0.0
+        case.true_params = {}
+    case.family = f"designed {kind}"
+    hz = rng.uniform(0.015, 0.035, 3)
+    amp = rng.uniform(0.3, 0.6, 3) * 0.5 * np.array([hi - lo for lo, hi in LIMITS])
+    phase = rng.uniform(0, 2 * np.pi, 3)
+    tr.update(first_s=60.0, designed_s=60.0, pair=DELAY_PAIR, diagnose_first=True,
+              reference=slow_sines(amp, hz, phase))
+    return case
+
+
+def slow_sines(amp, hz, phase):
+    """Reference ``fn(t) -> (q, qd, qdd)``: a sine per drive about the centre of :data:`LIMITS`
+    (the simulator starts at the reference's first point, at rest; the speed there is a few
+    cm/s, which the PD loop takes up)."""
+    centre = np.array([0.5 * (lo + hi) for lo, hi in LIMITS])
+    w = 2 * np.pi * np.asarray(hz, float)
+    amp, phase = np.asarray(amp, float), np.asarray(phase, float)
+
+    def fn(t):
+        arg = w * np.asarray(t, float)[:, None] + phase
+        return centre + amp * np.sin(arg), amp * w * np.cos(arg), -amp * w * w * np.sin(arg)
+
+    return fn
+
+
 def tabulated(t_ref, q, qd, qdd):
     """Reference ``fn(t)`` interpolating a designed motion (held at its last point after the end)."""
     def fn(t):

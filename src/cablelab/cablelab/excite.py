@@ -247,6 +247,86 @@ def condition(model, ds, params: Sequence[str] | None = None) -> float:
     return float(1.0 / lam[0]) if lam[0] > 1e-15 else float("inf")
 
 
+#: nonlinear parameters a design can name, through their linearised column (:class:`Linearised`)
+LINEARISED = ("tau",)
+
+
+class Linearised:
+    """A model with its delay ``tau`` (:mod:`cablelab.effects.delay`) as one more regressor column,
+    linearised at ``tau0``: the delay evaluates the model on the motion at ``t - tau``, so its
+    output is ``y(t; tau) = y0(t - tau)`` and ``d y / d tau = -d y0 / dt`` (y0: the model's output
+    ``Phi theta + y_known`` at ``tau0``, with the linear parameters at ``theta``). That column's
+    information, jointly with the model's linear columns, is what :func:`condition` and
+    :func:`block_conditions` measure (they only call ``regressor``). The time derivative of the
+    stacked motions of :func:`_stacked_motion` is smooth across blocks (each starts and ends at
+    rest at the same point).
+
+    Args:
+        model: the model holding ``time_delay``.
+        theta: values of the model's free linear parameters by name (missing: 0).
+        tau0: the delay the column is evaluated at, s.
+    """
+
+    def __init__(self, model, theta: dict, tau0: float = 0.0):
+        self.model, self.theta, self.tau0 = model, dict(theta), float(tau0)
+
+    @property
+    def effects(self):
+        return self.model.effects
+
+    @property
+    def fixed(self):
+        return self.model.fixed
+
+    def _evaluated(self, ds):
+        """The model at ``tau0``: ``(y0, valid, phi, cols, y_known)``, y0 = ``Phi theta + y_known``."""
+        ds2 = self.model.apply_nonlinear(ds, {"tau": self.tau0})
+        phi, cols, y_known = self.model.regressor(ds2)
+        theta = np.array([self.theta.get(c.name, 0.0) for c in cols])
+        return phi @ theta + y_known, np.asarray(ds2.valid, bool), phi, cols, y_known
+
+    @staticmethod
+    def _column(y0, valid, t) -> np.ndarray:
+        col = -np.gradient(y0, np.asarray(t, float), axis=0)
+        col[~valid] = np.nan
+        return col
+
+    def tau_column(self, ds) -> np.ndarray:
+        """(N, C) ``d y / d tau`` at ``tau0`` (NaN where the delayed dataset is not valid)."""
+        y0, valid, *_ = self._evaluated(ds)
+        return self._column(y0, valid, ds.t)
+
+    def regressor(self, ds):
+        from .effects.base import Param
+
+        y0, valid, phi, cols, y_known = self._evaluated(ds)
+        col = self._column(y0, valid, ds.t)
+        return (np.concatenate([phi, col[:, :, None]], axis=2),
+                list(cols) + [Param("tau", "s", self.tau0, doc="delay, linearised")], y_known)
+
+
+def linear_values(model, ds, values: dict | None = None, columns_ds=None) -> dict:
+    """The linear parameters' values :class:`Linearised` evaluates the model output at: ``values``
+    where given, else a fit of ``model`` on ``ds`` (the recording that confounds them; parameters
+    it does not excite held at their description or neutral values), else each parameter's
+    description or neutral value (columns of ``columns_ds`` when there is no ``ds``)."""
+    from .fit.identification import held_value, identify
+
+    out = {}
+    if ds is not None:
+        try:
+            out = dict(identify(model, ds, on_deficient="hold").params)
+        except CablelabError:
+            out = {}
+    src = ds if ds is not None else columns_ds
+    if not out and src is not None:
+        for e in model.effect_objects:
+            for p in e.columns(src):
+                out[p.name] = held_value(model, src, p.name)
+    out.update(values or {})
+    return out
+
+
 def model_for(plant, desc, params: Sequence[str], ds) -> tuple:
     """The plant's nominal model plus the effects that own ``params`` (names as the fit reports
     them, ``OF[slew]``), and the parameters' effects.
@@ -269,10 +349,10 @@ def model_for(plant, desc, params: Sequence[str], ds) -> tuple:
         if name not in known:
             raise CablelabError(f"--params {name!r}: no parameter of that name for plant {plant.name} "
                                 f"(parameters: {', '.join(sorted(known))})")
-        if name in nonlinear:
+        if name in nonlinear and name not in LINEARISED:
             raise CablelabError(f"--params {name!r}: a nonlinear parameter of {known[name]} (no regressor "
                                 f"column whose information the design could condition); name linear "
-                                f"parameters")
+                                f"parameters or {', '.join(LINEARISED)}")
         if known[name] not in base and known[name] not in owners:
             owners.append(known[name])
     return Model(plant.name, tuple(base + owners)), tuple(known[n] for n in params)
@@ -351,7 +431,8 @@ def block_conditions(model, ds, blocks: int, params: Sequence[str]) -> np.ndarra
 
 def design(plant_name: str, desc, params: Sequence[str], *, duration: float = 60.0,
            before_ds=None, seed: int = 0, starts: int = 1, max_iter: int = 30,
-           effects: Sequence[str] = (), fixed: dict | None = None) -> Design:
+           effects: Sequence[str] = (), fixed: dict | None = None,
+           values: dict | None = None) -> Design:
     """Design an excitation of ``duration`` s for the named parameters (module doc).
 
     The cost (log condition number on a grid of 10 samples per period of the highest harmonic)
@@ -370,6 +451,10 @@ def design(plant_name: str, desc, params: Sequence[str], *, duration: float = 60
             CDPR's ``platform_inertia``, whose acceleration column a designed motion can confound
             with the named parameters) and known parameter values (``--fix``: no column, so the
             design spends no information on them). The condition numbers are those of this model.
+        values: for a design naming the delay ``tau`` (linearised, :class:`Linearised`): the
+            delay it is linearised at (``tau``, default 0) and values of the linear parameters
+            the model output is evaluated at (default: the fit on ``before_ds``,
+            :func:`linear_values`).
     """
     import scipy.optimize
 
@@ -403,6 +488,20 @@ def design(plant_name: str, desc, params: Sequence[str], *, duration: float = 60
         for name in params:
             if name in model.fixed:
                 raise CablelabError(f"--params {name!r} is also fixed; name free parameters")
+    if any(p in LINEARISED for p in params):
+        if getattr(plant, "remeasure", None) is not None:
+            # its outputs are re-formed from the raw measurement at the delayed motion, so the
+            # output's sensitivity to tau is not the model output's time derivative alone
+            raise CablelabError(f"--params tau: plant {plant.name} re-forms its outputs under a delay "
+                                f"(remeasure hook); the linearised delay column is for plants whose "
+                                f"outputs the delay does not re-form (tested: the crane)")
+        vals = dict(values or {})
+        tau0 = float(vals.pop("tau", 0.0))
+        model = Linearised(model, linear_values(model, before_ds, vals, probe), tau0)
+        if not np.any(np.abs(np.nan_to_num(model.tau_column(probe))) > 0):
+            raise CablelabError("--params tau: the model's output is zero on a designed motion, so a "
+                                "delay has nothing to shift; give the recording (BAG) whose fit "
+                                "gives the model's parameters")
     n = n_j * 2 * h
     basis = fourier_basis(t, ex.base_hz, h, duration)
 
@@ -497,6 +596,6 @@ def read_reference(path, topic: str, joints: Sequence[str]):
     return fn
 
 
-__all__ = ["Design", "Exciter", "Limits", "block_conditions", "condition", "design", "fourier_basis",
-           "fourier_motion", "get_exciter", "lead_in",
+__all__ = ["Design", "Exciter", "LINEARISED", "Limits", "Linearised", "block_conditions", "condition", "design",
+           "fourier_basis", "fourier_motion", "get_exciter", "lead_in", "linear_values",
            "model_for", "read_reference", "register_exciter", "scaled_motion", "write_reference"]

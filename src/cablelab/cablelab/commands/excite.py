@@ -12,7 +12,9 @@ HELP = "design a reference trajectory (within the machine's limits) that separat
 DESCRIPTION = (
     "Design an excitation: a finite Fourier series per joint (Swevers et al.) whose coefficients "
     "minimise the condition number of the regressor of the model holding the named parameters, "
-    "scaled into the machine's joint ranges, speeds and accelerations; written as a bag of the "
+    "scaled into the machine's joint ranges, speeds and accelerations (a delay tau of time_delay "
+    "is designable, not on the CDPR, through its linearised column, minus the time derivative of the model's output "
+    "with the parameters fitted on BAG); written as a bag of the "
     "plant's reference topic that the plant's controller node plays "
     "(pd_feedforward --plant P --ros-args -p reference_bag:=REF).")
 
@@ -26,7 +28,8 @@ def add_arguments(p) -> None:
     add_recover(p)
     add_plant_options(p, "excite")
     p.add_argument("--params", metavar="A,B", required=True,
-                   help="parameters to separate, as the fit names them (e.g. 'OF[hoist],m')")
+                   help="parameters to separate, as the fit names them (e.g. 'OF[hoist],m'; 'tau,I_tot' "
+                        "for a delay, linearised)")
     p.add_argument("--duration", type=number(ge=5, le=3600, unit="s"), default=60.0, metavar="S",
                    help="length of the designed reference, s (default 60; for a plant whose machine "
                         "starts away from the design's centre, the CDPR, it includes the move from there)")
