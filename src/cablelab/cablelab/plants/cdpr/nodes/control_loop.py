@@ -35,11 +35,10 @@ from .. import topics
 from ..hardware import SimulatedCdpr
 from ..live import LiveController
 from ..loop import ReferenceLaw
-from ..sim import default_description_path
+from ..sim import default_description_path, truth_from_parameters
 from ..streams import controller_config
 from ..trajectory import ReferenceTable
-from . import controller as _controller
-from . import sim as _sim
+from .parameters import CONTROLLER, SIM
 from .outputs import CdprOutputs
 
 __all__ = ["CdprControlLoop", "make_node", "PARAMETERS"]
@@ -49,9 +48,9 @@ PARAMETERS = merge(
     LOOP_PARAMETERS,
     (Param("hardware", "sim", "the winches: sim (the MuJoCo CAROCA), stub (a driver stub that says "
            "what a driver must implement) or package.module:Class (your driver)"),),
-    pick(_controller.PARAMETERS, "feedforward", "nominal_mass", "kp", "kd", "coulomb", "viscous",
+    pick(CONTROLLER, "feedforward", "nominal_mass", "kp", "kd", "coulomb", "viscous",
         "min_tension", "preload", "max_torque", "model", "estimate_timeout"),
-    pick(_sim.PARAMETERS, "trajectory_speed", "settle", "description", "payload_mass", "payload_com",
+    pick(SIM, "trajectory_speed", "settle", "description", "payload_mass", "payload_com",
         "pulleys", "winch_coulomb", "winch_viscous", "motor_inertia", "tension_noise", "tension_bias",
         "torque_noise", "pose_noise", "timestep", "seed", "extras_every"),
     executor_params(True))
@@ -125,7 +124,7 @@ class CdprControlLoop(ControlLoopNode):
     def _hardware(self, spec: str, desc):
         names = [f"winch_{i}" for i in range(1, self.n + 1)]
         if spec == "sim":
-            truth = _sim.truth_from_parameters(self.get_name(), self.v, self.n, self.rate)
+            truth = truth_from_parameters(self.get_name(), self.v, self.n, self.rate)
             return SimulatedCdpr(desc, truth, self.rate, self.reference.at(0.0)[0])
         cls = DriverStub if spec == "stub" else load_hardware_class(spec)
         return cls(names, desc)

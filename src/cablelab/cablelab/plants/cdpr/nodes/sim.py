@@ -20,7 +20,7 @@ from ....ros.plant_node import PlantNode
 from ....ros.qos import stream_qos
 from .. import topics
 from ..markers import sim_markers
-from ..sim import default_description_path, truth_from_parameters  # noqa: F401 (control_loop's)
+from ..sim import default_description_path
 from ..stepping import SimStepper
 from .outputs import CdprOutputs
 from .parameters import SIM as PARAMETERS
