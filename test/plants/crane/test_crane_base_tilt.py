@@ -62,6 +62,21 @@ def test_columns_are_the_gradient_of_the_horizontal_gravity_potential():
     np.testing.assert_allclose(_effect(q, tx, ty), grad, atol=1e-7 * np.abs(grad).max())
 
 
+def _held_at_rest(tilt, alpha, beta, d):
+    """The MuJoCo crane on a base rotated by ``tilt`` at slew ``alpha``, luff ``beta``, rope
+    ``d`` with the payload's swing angles at their equilibrium: (truth, swing angles, qfrc_bias)."""
+    truth = CraneTruth(params=P, base_tilt=tilt)
+    model = build_mjcf(truth)
+    data = mujoco.MjData(model)
+
+    def bias(sw):
+        set_state(model, data, [alpha, beta, d, sw[0], sw[1]])
+        return data.qfrc_bias.copy()
+
+    sw = root(lambda s: bias(s)[2:4], [0.0, 0.0], tol=1e-14).x
+    return truth, sw, bias(sw)
+
+
 @pytest.mark.parametrize("tilt,alpha,beta", [((-0.04, 0.03), 0.0, 0.5), ((0.02, -0.05), 1.1, 0.2),
                                              ((0.035, 0.0), -2.3, 0.9)])
 def test_mujoco_tilted_crane_at_rest_matches_the_angles(tilt, alpha, beta):
@@ -69,17 +84,9 @@ def test_mujoco_tilted_crane_at_rest_matches_the_angles(tilt, alpha, beta):
     payload in its equilibrium: slew torque = the effect at tilt_x = -g_y / g, tilt_y = g_x / g
     exactly (the vertical gravity gives no slew torque); luff torque = vertical-gravity model +
     effect up to the second-order change of the vertical gravity."""
-    truth = CraneTruth(params=P, base_tilt=tilt)
-    model = build_mjcf(truth)
-    data = mujoco.MjData(model)
     d = 0.6
-
-    def bias(sw):
-        set_state(model, data, [alpha, beta, d, sw[0], sw[1]])
-        return data.qfrc_bias.copy()
-
-    sw = root(lambda s: bias(s)[2:4], [0.0, 0.0], tol=1e-14).x
-    b = bias(sw)
+    truth, sw, b_all = _held_at_rest(tilt, alpha, beta, d)
+    b = b_all
     assert np.abs(b[2:4]).max() < 1e-10
     g = gravity_in_base(truth)
     tx, ty = -g[1] / P.gravity, g[0] / P.gravity
@@ -110,17 +117,9 @@ def test_tilt_also_shortens_the_vertical_gravity(tilt, alpha, beta):
     untilted model with the vertical gravity g_z = g cos|tilt| plus the effect, so the first-order
     model over-predicts the hoist force by m g (1 - cos|tilt|) ~ m g |tilt|^2 / 2 (0.1-0.3 % of the
     weight at 2-4 degrees): a constant a torque-sensor offset can take up."""
-    truth = CraneTruth(params=P, base_tilt=tilt)
-    model = build_mjcf(truth)
-    data = mujoco.MjData(model)
     d = 0.6
-
-    def bias(sw):
-        set_state(model, data, [alpha, beta, d, sw[0], sw[1]])
-        return data.qfrc_bias.copy()
-
-    sw = root(lambda s: bias(s)[2:4], [0.0, 0.0], tol=1e-14).x
-    b = bias(sw)[[0, 1, 4]]                        # slew, luff, hoist dofs
+    truth, sw, b_all = _held_at_rest(tilt, alpha, beta, d)
+    b = b_all[[0, 1, 4]]                        # slew, luff, hoist dofs
     g = gravity_in_base(truth)
     tx, ty = -g[1] / P.gravity, g[0] / P.gravity
     q = np.array([[alpha, beta, d, sw[0], sw[1]]])

@@ -159,16 +159,9 @@ def simulate(model, duration: float = 12.0, seed: int = 0, kp: float = 400.0, kd
     dt = model.opt.timestep
     t, qr, qdr, _ = excitation(duration, dt, model.nv, seed, amplitude)
     T = len(t)
-    q = np.empty((T, model.nv))
-    qd = np.empty((T, model.nv))
-    eff = np.empty((T, model.nv))
-    act = np.empty((T, model.nu))
-    ten_len = np.empty((T, model.ntendon))
+    q, qd, eff, act, ten_len = _buffers(model, T)
     mujoco.mj_forward(model, d)
-    mass = np.maximum(np.array(model.dof_M0), 0.05)
-    kp_v, kd_v = kp * mass, kd * mass
-    tendon = model.actuator_trntype == int(mujoco.mjtTrn.mjTRN_TENDON)
-    c0 = np.where(tendon, -pretension / np.maximum(np.abs(model.actuator_gear[:, 0]), 1e-12), 0.0)
+    kp_v, kd_v, c0 = _drive(model, kp, kd, pretension)
     for k in range(T):
         mujoco.mj_step1(model, d)
         tau = kp_v * (qr[k] - d.qpos[: model.nv]) + kd_v * (qdr[k] - d.qvel) + d.qfrc_bias
@@ -180,6 +173,24 @@ def simulate(model, duration: float = 12.0, seed: int = 0, kp: float = 400.0, kd
         eff[k] = d.qfrc_actuator
         act[k] = d.actuator_force
     return (t, q, qd, eff, act, ten_len) if lengths else (t, q, qd, eff, act)
+
+
+def _buffers(model, T: int) -> tuple:
+    """Empty (T, .) arrays of a record: q, qd, joint effort (nv each), actuator force (nu),
+    tendon length (ntendon)."""
+    return (np.empty((T, model.nv)), np.empty((T, model.nv)), np.empty((T, model.nv)),
+            np.empty((T, model.nu)), np.empty((T, model.ntendon)))
+
+
+def _drive(model, kp: float, kd: float, pretension: float) -> tuple:
+    """The recording drive's PD gains per dof (scaled by the dof's own inertia ``dof_M0``) and
+    the controls that hold every tendon actuator at ``pretension`` N (zero for the others)."""
+    import mujoco
+
+    mass = np.maximum(np.array(model.dof_M0), 0.05)
+    tendon = model.actuator_trntype == int(mujoco.mjtTrn.mjTRN_TENDON)
+    c0 = np.where(tendon, -pretension / np.maximum(np.abs(model.actuator_gear[:, 0]), 1e-12), 0.0)
+    return kp * mass, kd * mass, c0
 
 
 def _simulate_substeps(model, duration, seed, kp, kd, amplitude, pretension, lengths, substeps):
@@ -195,16 +206,9 @@ def _simulate_substeps(model, duration, seed, kp, kd, amplitude, pretension, len
     dt = model.opt.timestep
     t_all, qr, qdr, _ = excitation(duration, dt, model.nv, seed, amplitude)
     T = len(t_all) // substeps
-    q = np.empty((T, model.nv))
-    qd = np.empty((T, model.nv))
-    eff = np.empty((T, model.nv))
-    act = np.empty((T, model.nu))
-    ten_len = np.empty((T, model.ntendon))
+    q, qd, eff, act, ten_len = _buffers(model, T)
     mujoco.mj_forward(model, d)
-    mass = np.maximum(np.array(model.dof_M0), 0.05)
-    kp_v, kd_v = kp * mass, kd * mass
-    tendon = model.actuator_trntype == int(mujoco.mjtTrn.mjTRN_TENDON)
-    c0 = np.where(tendon, -pretension / np.maximum(np.abs(model.actuator_gear[:, 0]), 1e-12), 0.0)
+    kp_v, kd_v, c0 = _drive(model, kp, kd, pretension)
     before = None                                            # (qfrc_actuator, actuator_force)
     for i in range(T * substeps):
         mujoco.mj_forward(model, d)
