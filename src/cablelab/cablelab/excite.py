@@ -160,11 +160,8 @@ def _window(t: np.ndarray, duration: float):
     and second derivatives."""
     fade = min(FADE_S, duration / 4)
 
-    def ramp(x):
-        return _smoothstep(x, fade)
-
-    a, ad, add = ramp(t)
-    b, bd, bdd = ramp(duration - t)
+    a, ad, add = _smoothstep(t, fade)
+    b, bd, bdd = _smoothstep(duration - t, fade)
     return a * b, ad * b - a * bd, add * b - 2 * ad * bd + a * bdd
 
 

@@ -39,6 +39,7 @@ from ..control_loop import ControlLoop
 from .inputs import ERROR, WARN
 from .params import Param
 from .plant_node import PlantNode
+from .status import add_problem
 
 __all__ = ["ControlLoopNode", "LoopSpinner"]
 
@@ -250,15 +251,12 @@ class ControlLoopNode(PlantNode):
         if ring is not None:
             values.update({"samples awaiting publication": str(ring.backlog),
                            "samples lost (publisher behind)": str(ring.lost)})
-            problem = ""
             if self._child is not None and self._child.poll() is not None:
-                problem = f"publisher process ended (exit {self._child.returncode}): samples not published"
-                level = max(level, ERROR)
+                level, msg = add_problem(level, msg, ERROR, f"publisher process ended (exit "
+                                         f"{self._child.returncode}): samples not published")
             elif ring.lost:
-                problem = f"{ring.lost} samples lost: the publisher process fell behind"
-                level = max(level, WARN)
-            if problem:
-                msg = problem if msg == "ok" else f"{msg}; {problem}"
+                level, msg = add_problem(level, msg, WARN,
+                                         f"{ring.lost} samples lost: the publisher process fell behind")
         return level, msg, values
 
     def summary(self) -> dict:
