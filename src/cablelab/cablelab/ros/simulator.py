@@ -51,6 +51,7 @@ class SimulatorNode(PlantNode):
         self.done = False
         self.pub_gate = None       # the state publisher the start gate counts subscribers of
         self.wait_subs = 0         # no start gate unless the node calls start_gate()
+        self.last_publish = 0.0    # wall time of the last published state
 
     def state_publishers(self, *kinds_topics) -> list:
         """A publisher (the state QoS, :func:`~cablelab.ros.qos.publisher_qos`) per ``(message
@@ -71,16 +72,21 @@ class SimulatorNode(PlantNode):
         self.period = period
         self.clock = ClockPublisher(self)
         self.publish_description(desc)
-        self.start_stepping(period, markers_topic, frame, lambda: self.sim.t, markers_rate, publish_first)
+        self.start_stepping(period, markers_topic, frame, lambda: self.sim.t, markers_rate, publish_first=False)
+        if publish_first:
+            self._publish()
 
     def tick(self) -> None:
-        """The timer: with a ``lock``, the start gate and lock-step decide whether time moves
-        now (:meth:`PlantNode.may_step`); then :meth:`advance`."""
+        """The timer: the start gate and, with a ``lock``, lock-step decide whether time moves
+        now (:meth:`PlantNode.may_step`, without a lock :meth:`PlantNode.waiting_for_subscribers`);
+        then :meth:`advance`."""
         kind = FREE
         if self.lock is not None:
             kind = self.may_step(self.lock, self.pub_gate, self.publish_state, self.republish_every)
             if kind is None:
                 return
+        elif self.waiting_for_subscribers(self.pub_gate, self.last_publish, self._publish, self.republish_every):
+            return
         self.advance(kind)
 
     def advance(self, kind: str = ADVANCE) -> None:
@@ -90,8 +96,13 @@ class SimulatorNode(PlantNode):
         if self.done:
             return
         self.step(kind, self.inputs.fresh(self.command, time.monotonic()))
-        self.publish_state()
+        self._publish()
         self.done = bool(self.duration) and self.sim.t >= self.duration - 1e-9
+
+    def _publish(self) -> None:
+        """:meth:`publish_state`, its wall time kept (:attr:`last_publish`, the start gate's)."""
+        self.publish_state()
+        self.last_publish = time.monotonic()
 
     def step(self, kind: str, fresh: bool) -> None:
         """One period of physics (override); ``fresh``: the command input is fresh."""

@@ -11,7 +11,6 @@ generalised force on it), ``cable_tensions`` (the ``tendons``), ``ground_truth/j
 from __future__ import annotations
 
 import math
-import time
 
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
@@ -47,17 +46,12 @@ class MjcfSimNode(SimulatorNode):
         if (values := self.take_command("effort_commands", msg)) is not None:
             self.ctrl = [float(x) for x in values]
 
-    def tick(self) -> None:
-        if not self.waiting_for_subscribers(self.pub_js, self.last_publish, self.publish_state):
-            super().tick()
-
     def step(self, kind: str, fresh: bool) -> None:
         if not fresh:
             self.ctrl = [0.0] * self.sim.model.nu       # no (fresh) command: drives off
         self.sim.advance(self.ctrl, self.period)
 
     def publish_state(self) -> None:
-        self.last_publish = time.monotonic()
         t, q, qd, effort, tension = self.sim.state()
         if not all(math.isfinite(x) for x in q):
             raise CablelabError("cable_sim_node --plant mjcf: the simulation diverged (NaN state)")
