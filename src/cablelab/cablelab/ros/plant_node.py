@@ -280,11 +280,12 @@ class PlantNode(Node):
         return True
 
     def command_input(self, topic: str, length: int, timeout: float, qos=None, raw: bool = False,
-                      polled: bool = False):
+                      polled: bool = False, required: bool = True):
         """A simulator's commands: input ``effort_commands`` (``length`` values, stale after
-        ``timeout`` s wall) and its std_msgs/Float64MultiArray subscription on ``topic`` calling
-        ``self.on_command`` (:meth:`subscribe`; ``qos`` default: a stream's)."""
-        self.inputs.add("effort_commands", timeout=timeout, length=length)
+        ``timeout`` s wall; ``required`` as :meth:`InputMonitor.add
+        <cablelab.ros.inputs.InputMonitor.add>`) and its std_msgs/Float64MultiArray subscription
+        on ``topic`` calling ``self.on_command`` (:meth:`subscribe`; ``qos`` default: a stream's)."""
+        self.inputs.add("effort_commands", timeout=timeout, length=length, required=required)
         return self.subscribe(Float64MultiArray, topic, self.on_command, qos or stream_qos(), raw, polled)
 
     def start_stepping(self, period: float, markers_topic: str, frame, stamp, markers_rate: float,

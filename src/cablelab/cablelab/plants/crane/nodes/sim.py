@@ -25,7 +25,6 @@ from ..sim import live_sim
 from ....ros import convert
 from ....ros.inputs import ERROR
 from ....ros.lockstep import LockStep
-from ....ros.qos import stream_qos
 from ....ros.simulator import ADVANCE, SimulatorNode
 from ....ros.status import add_problem
 from .parameters import SIM as PARAMETERS
@@ -39,11 +38,10 @@ class CraneSimNode(SimulatorNode):
         self.rate, self.u = v.rate, None
         self.lock = LockStep(v.lockstep, wait_first=False, timeout=v.lockstep_timeout)
         self.start_gate()
-        self.inputs.add("effort_commands", timeout=v.command_timeout, length=3)
         self.pub_js, self.pub_tip, self.pub_pay, self.pub_truth = self.state_publishers(
             (JointState, topics.JOINT_STATES), (PoseStamped, topics.TIP_POSE),
             (PoseStamped, topics.PAYLOAD_POSE), (JointState, topics.SWING_TRUTH))
-        self.create_subscription(Float64MultiArray, topics.EFFORT_COMMANDS, self.on_command, stream_qos())
+        self.command_input(topics.EFFORT_COMMANDS, 3, v.command_timeout)
         self.start_simulation(desc, 1.0 / self.rate, topics.MARKERS,
                               lambda: state_markers(desc, self.sim.state()[1]), v.markers_rate)
 

@@ -21,7 +21,6 @@ from ..live import LiveLeg
 from ..markers import sim_markers
 from ....ros import convert
 from ....ros.lockstep import LockStep
-from ....ros.qos import stream_qos
 from ....ros.simulator import SimulatorNode
 from .parameters import SIM as PARAMETERS
 
@@ -34,10 +33,9 @@ class LegSimNode(SimulatorNode):
         self.leg = LiveLeg(desc, v.mass_scale, v.preload, v.z0_offset, v.rate)
         self.sim, self.tau, self.reading = self.leg.sim, 0.0, None
         self.lock = LockStep(v.lockstep, wait_first=False, timeout=v.lockstep_timeout)
-        self.inputs.add("effort_commands", timeout=v.command_timeout, length=1, required=False)
         self.pub_js, self.pub_contact, self.pub_truth = self.state_publishers(
             (JointState, topics.JOINT_STATES), (JointState, topics.CONTACT), (JointState, topics.GROUND_TRUTH))
-        self.create_subscription(Float64MultiArray, topics.EFFORT_COMMANDS, self.on_command, stream_qos())
+        self.command_input(topics.EFFORT_COMMANDS, 1, v.command_timeout, required=False)
         self.start_simulation(desc, 1.0 / v.rate, topics.MARKERS, lambda: sim_markers(self.sim),
                               v.markers_rate, publish_first=False)
 
