@@ -136,7 +136,7 @@ def start_position(description=None) -> np.ndarray:
 #: the CDPR's experiment design (``cablelab excite``), registered by the package. Base period
 #: 60 s, six harmonics (up to 0.1 Hz): the speed limit caps a harmonic's amplitude at v / omega,
 #: so a 20 s base period (0.95 m at 0.3 m/s) could not cross the box; the offsets' internal-force
-#: part shows through the change of W's null space, and on the CAROCA the condition number of
-#: (offsets, m, mx, my) falls about as the fourth power of the travel
+#: part shows through the change of W's null space, so the condition number of (offsets, m, mx,
+#: my) falls steeply with the travel
 EXCITER = Exciter(limits=excite_limits, motion_dataset=motion_dataset, reference_topic=REFERENCE,
                   base_hz=1 / 60, harmonics=6, trajectory="pose", start=start_position)
