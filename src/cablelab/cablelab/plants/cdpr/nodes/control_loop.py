@@ -107,7 +107,7 @@ class CdprControlLoop(ControlLoopNode):
         self.n = len(c.cables)
         self.reference = ReferenceTable(self.rate, v.settle, v.trajectory_speed)
         self.law = ReferenceLaw(LiveController(c, desc.gravity, controller_config(v, c.platform_mass)),
-                                self.reference.at)
+                                self.reference.at, self.reference.rows, self.rate)
         self.extras_every = v.extras_every
         self.hardware = hardware = self._hardware(v.hardware, desc)
         self.simulated = isinstance(hardware, SimulatedCdpr)
