@@ -46,7 +46,7 @@ class ReferenceLaw:
     """
 
     def __init__(self, controller: LiveController, reference: Callable[[float], tuple],
-                 rows: Callable[[int, int], tuple] | None = None, rate: float | None = None, block: int = 50):
+                 rows: Callable[[int, int], tuple] | None = None, rate: float | None = None, block: int = 64):
         if rows is not None and not (rate and rate > 0):
             raise ValueError(f"ReferenceLaw: a reference grid needs its rate > 0 Hz, got {rate}")
         self.controller = controller
@@ -81,15 +81,22 @@ class ReferenceLaw:
         i = int(t * self.rate + 0.5) - self._k0
         return i if 0 <= i < len(plan.t) and abs(plan.t[i] - t) <= 1e-9 else -1
 
-    def prepare_next(self, t: float) -> None:
-        """Prepare the reference terms of stamp ``t`` (the next period), off the deadline path:
-        with a grid, plan the next ``block`` periods when the plan ends (nothing otherwise)."""
+    def prepare_next(self, t: float, spare: bool = True) -> None:
+        """Prepare the reference terms of stamp ``t`` (the next period), off the deadline path.
+        With a grid: plan the ``block`` periods from ``t`` when the plan has less than a quarter
+        of a block left and there is time to ``spare``; without time to spare (the loop is
+        catching up), only the terms of ``t`` alone when the plan does not hold it (cheaper than
+        a block)."""
         if self.rows is None:
             self.prepared = self.terms(t)
-        elif self._row(t) < 0:
+            return
+        i = self._row(t)
+        if spare and (i < 0 or len(self.plan) - i < max(1, self.block // 4)):
             k0 = int(t * self.rate + 0.5)
             stamps, pos, vel, acc = self.rows(k0, self.block)
             self.plan, self._k0 = self.controller.plan(stamps, pos, vel, acc), k0
+        elif i < 0:
+            self.prepared = self.terms(t)
 
     def update(self, state: HardwareState) -> np.ndarray | None:
         if self.rows is not None:

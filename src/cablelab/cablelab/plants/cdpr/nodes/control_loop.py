@@ -148,7 +148,7 @@ class CdprControlLoop(ControlLoopNode):
             self.estimates_rejected += 1
 
     def after_cycle(self, state) -> None:
-        self.law.prepare_next(state.t + 1.0 / self.rate)
+        self.law.prepare_next(state.t + 1.0 / self.rate, spare=not self.loop.behind())
 
     def extend_status(self, level, msg, values):
         level, msg, values = super().extend_status(level, msg, values)
