@@ -83,15 +83,15 @@ class ReferenceLaw:
 
     def prepare_next(self, t: float, spare: bool = True) -> None:
         """Prepare the reference terms of stamp ``t`` (the next period), off the deadline path.
-        With a grid: plan the ``block`` periods from ``t`` when the plan has less than a quarter
-        of a block left and there is time to ``spare``; without time to spare (the loop is
+        With a grid: plan the ``block`` periods from ``t`` when the plan has less than a
+        sixteenth of a block left and there is time to ``spare``; without time to spare (the loop is
         catching up), only the terms of ``t`` alone when the plan does not hold it (cheaper than
         a block)."""
         if self.rows is None:
             self.prepared = self.terms(t)
             return
         i = self._row(t)
-        if spare and (i < 0 or len(self.plan) - i < max(1, self.block // 4)):
+        if spare and (i < 0 or len(self.plan) - i < max(1, self.block // 16)):
             k0 = int(t * self.rate + 0.5)
             stamps, pos, vel, acc = self.rows(k0, self.block)
             self.plan, self._k0 = self.controller.plan(stamps, pos, vel, acc), k0
