@@ -12,7 +12,8 @@ reference grid: :meth:`LiveController.prepare` once per period, as the ``pd_feed
 does) and ``planned`` (with the reference table's grid, as the loop runs: the reference terms of
 64 periods at once, :meth:`LiveController.plan`, and :meth:`LiveController.planned_law` per
 period). The two alternate ``--repeat`` times; each part's figure is its least mean over the
-repeats (the machine may be shared). Hot caches: a loop that sleeps between periods pays more
+repeats (the machine may be shared); ``prepare_next_max`` is the longest single
+``prepare_next`` (planned: one block at once). Hot caches: a loop that sleeps between periods pays more
 (``bench_realtime.py``'s ``cpu_per_cycle_ms`` is the loop's process in real time).
 
     ./run python bench/bench_loop_cpu.py [--periods 5000] [--repeat 3] [--json]
@@ -47,10 +48,11 @@ def _one(planned: bool, periods: int) -> dict:
     layout = StateLayout.of(state)
     row = np.empty(layout.width)
     spent = dict.fromkeys(PARTS, 0.0)
+    most = 0.0                             # the longest prepare_next (a block planned at once)
     clock = time.thread_time
     for k in range(periods + 200):
         if k == 200:                       # warm-up done: count from here
-            spent = dict.fromkeys(PARTS, 0.0)
+            spent, most = dict.fromkeys(PARTS, 0.0), 0.0
         c0 = clock()
         state = hw.read()
         c1 = clock()
@@ -67,8 +69,10 @@ def _one(planned: bool, periods: int) -> dict:
         c6 = clock()
         for part, dt in zip(PARTS, (c1 - c0, c2 - c1, c3 - c2, c5 - c4, c6 - c5)):
             spent[part] += dt
+        most = max(most, c5 - c4)
     out = {part: 1e3 * s / periods for part, s in spent.items()}
     out["total"] = sum(out.values())
+    out["prepare_next_max"] = 1e3 * most
     return out
 
 
@@ -91,7 +95,7 @@ def main(argv=None) -> int:
         return 0
     print(f"CPU ms per period (thread CPU, least mean of {a.repeat} tries of {a.periods} periods)")
     print(f"{'part':14s} {'per_period':>11s} {'planned':>9s}")
-    for part in (*PARTS, "total"):
+    for part in (*PARTS, "total", "prepare_next_max"):
         print(f"{part:14s} {best['per_period'][part]:11.4f} {best['planned'][part]:9.4f}")
     return 0
 
