@@ -25,10 +25,12 @@ SIM = (
     Param("rate", 1000.0, "simulation and publishing rate", "Hz", ge=1.0, le=100000.0),
     Param("command_timeout", 0.5, "a torque command older than this means zero torque",
           "s wall", gt=0.0),
-    Param("lockstep", False, "once commands flow, advance only when the torque answering the last "
-          "state arrived"),
+    Param("lockstep", False, "time starts with the torque answering the start state, then advance "
+          "only when the torque answering the last state arrived"),
     Param("lockstep_timeout", 10.0, "lock-step: without an answer for this long, back to real time",
           "s wall", gt=0.0),
+    Param("lockstep_resend", 0.25, "lock-step: the start state is resent this often until its answer "
+          "arrives", "s wall", gt=0.0, le=60.0),
     markers_rate(f"{topics.MARKERS}: body, links, spring coloured by its force, foot"),
 )
 
