@@ -7,10 +7,11 @@ excitation) and the condition numbers of the pair before (in a recording that co
 after. One row per entry of :data:`CASES`: (plant, parameters, a function returning the
 description and the dataset of the confounding recording). The leg's design time includes
 building its steady-hop library (once per process; every leg row here starts without it). The
-leg has two more rows (:func:`leg_rows`): the design evaluating the steady-hop levels' rows
-themselves (:func:`cablelab.plants.leg.excite.motion_rows`, what it evaluated before it took
-their triangular factors), and ``cablelab excite BAG --params F0,m --duration 60`` as a user
-runs it (a process: imports, the bag, the design, the reference written).
+leg has more rows (:func:`leg_rows`): building the library alone; the design with the library
+built, on the levels' triangular factors (what it evaluates) and on the levels' rows themselves
+(:func:`cablelab.plants.leg.excite.motion_rows`, what it evaluated before); and
+``cablelab excite BAG --params F0,m --duration 60`` as a user runs it (a process: imports, the
+bag, the library, the design, the reference written).
 """
 from __future__ import annotations
 
@@ -147,16 +148,23 @@ def leg_rows(dsc, ds) -> None:
     from cablelab.excite import get_exciter, register_exciter
     from cablelab.plants.leg.excite import motion_rows
 
+    from cablelab.plants.leg.excite import hop_library
+
     ex = get_exciter("leg")
     _forget_leg_library()
-    register_exciter("leg", dataclasses.replace(ex, motion_dataset=motion_rows))
-    try:
-        w0, c0 = time.monotonic(), time.process_time()
-        r = design("leg", dsc, ["F0", "m"], duration=60.0, before_ds=ds)
-        _row("leg (levels' rows)", "F0,m", time.monotonic() - w0, time.process_time() - c0,
-             r.condition_before, r.condition_after)
-    finally:
-        register_exciter("leg", ex)
+    w0, c0 = time.monotonic(), time.process_time()
+    hop_library(dsc)
+    print(f"| leg: the steady-hop library alone | | | {time.monotonic() - w0:.1f} | "
+          f"{time.process_time() - c0:.1f} | | |", flush=True)
+    for label, variant in (("levels' factors", ex), ("levels' rows", dataclasses.replace(ex, motion_dataset=motion_rows))):
+        register_exciter("leg", variant)
+        try:
+            w0, c0 = time.monotonic(), time.process_time()
+            r = design("leg", dsc, ["F0", "m"], duration=60.0, before_ds=ds)
+            _row(f"leg: design on the {label}, library built", "F0,m", time.monotonic() - w0,
+                 time.process_time() - c0, r.condition_before, r.condition_after)
+        finally:
+            register_exciter("leg", ex)
     with tempfile.TemporaryDirectory() as d:
         bag = _leg_low_hops_bag(Path(d) / "low_hops")
         u0 = resource.getrusage(resource.RUSAGE_CHILDREN)
@@ -166,7 +174,7 @@ def leg_rows(dsc, ds) -> None:
                              check=True, capture_output=True, text=True).stdout
         u1 = resource.getrusage(resource.RUSAGE_CHILDREN)
         j = json.loads(out)
-        _row("leg (`cablelab excite BAG`, a process)", "F0,m", time.monotonic() - w0,
+        _row("leg: `cablelab excite BAG` (a process)", "F0,m", time.monotonic() - w0,
              (u1.ru_utime + u1.ru_stime) - (u0.ru_utime + u0.ru_stime), j["condition_before"], j["condition_after"])
 
 
