@@ -182,7 +182,9 @@ def motion_dataset(t, q, qd, qdd, description) -> Dataset:
     information as the level's rows (condition numbers equal to rounding, the test's oracle), at
     as many rows as there are bases. ``y`` is zero (the design needs no output). The design
     evaluates the dataset hundreds of times; built from the rows it took most of the design's
-    time."""
+    time. (A column that is not a basis, the any-plant ``torque_sensor_offset``'s column of ones,
+    is not reproduced: the rows themselves did not weigh it by the time shares either; the leg
+    designs for its own effects.)"""
     heights, dss = hop_library(description)
     w = level_shares(q, heights)
     key = _key(description)

@@ -40,6 +40,7 @@ class LegSimNode(SimulatorNode):
         self.pub_js, self.pub_contact, self.pub_truth = self.state_publishers(
             (JointState, topics.JOINT_STATES), (JointState, topics.CONTACT), (JointState, topics.GROUND_TRUTH))
         self.command_input(topics.EFFORT_COMMANDS, 1, v.command_timeout, required=False)
+        self.start_gate()
         self.start_simulation(desc, 1.0 / v.rate, topics.MARKERS, lambda: sim_markers(self.sim),
                               v.markers_rate, publish_first=v.lockstep)
 
