@@ -468,7 +468,8 @@ def design(plant_name: str, desc, params: Sequence[str], *, duration: float = 60
         values: for a design naming the delay ``tau`` (linearised, :class:`Linearised`): the
             delay it is linearised at (``tau``, default 0) and values of the linear parameters
             the model output is evaluated at (default: the fit on ``before_ds``,
-            :func:`linear_values`).
+            :func:`linear_values`; on a plant with a ``remeasure`` hook, the fit on the designed
+            motion's own dataset, whose measurement the plant synthesises).
     """
     import scipy.optimize
 
