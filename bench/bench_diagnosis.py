@@ -27,7 +27,10 @@ found >= 95 %, parameter p95 <= 3 %, 0 % false significant on controls. Every ca
 numbers before and after are printed in its own table. ``crane_delay=N``: a 20-45 ms measurement
 delay hidden in 60 s of slow sines (0.015-0.035 Hz; ``draw_delay_case``), diagnosed as it is (the
 delay should not be found), then ``excite``'s design for (tau, I_tot) with tau linearised, and the
-designed run diagnosed (time_delay first and significant, tau within 10 %).
+designed run diagnosed (time_delay first and significant, tau within 10 %). ``cdpr_delay=N``: the
+same for the CDPR (bench/cases_cdpr_delay.py ``draw_delay_case``: a 10-30 ms dynamometer delay
+hidden in 60 s of slow sines, then the design for (tau, m_a), tau's column the fitted residual's
+change with the wrench re-formed at the delayed pose).
 
     nice -n 10 ./run python bench/bench_diagnosis.py --designed crane=12,cdpr=4
 
