@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from cases_cdpr import LIMITS, delay_visibility, draw_case, tabulated, write_bag  # noqa: F401 (the generator's interface)
+from cases_cdpr import LIMITS, delay_visibility, draw_case, tabulated, write_bag
 from cases_common import PlantCase
 
 #: what the designed run must separate: the delay and the accelerated mass (a delay shifts the
@@ -71,6 +71,10 @@ def slow_sines(amp, hz, phase):
         return centre + amp * np.sin(arg), amp * w * np.cos(arg), -amp * w * w * np.sin(arg)
 
     return fn
+
+
+#: the generator's interface for bench_diagnosis.py: cases_cdpr's simulator and bag writer
+__all__ = ["PAIR", "delay_visibility", "draw_delay_case", "slow_sines", "tabulated", "write_bag"]
 
 
 if __name__ == "__main__":      # ./run python bench/cases_cdpr_delay.py: first recordings' visibility
