@@ -294,7 +294,7 @@ class Linearised:
         d = np.diff(np.asarray(t, float))
         return 0.5 * float(np.median(d)) if d.size else 1e-3
 
-    def _residual(self, ds, tau: float):
+    def residual(self, ds, tau: float):
         """``(r, valid)``: the fit's residual at the delay ``tau`` and the linear parameters at
         ``theta``, and where the delayed dataset is valid."""
         ev = self.model.evaluate(ds, {"tau": tau})
@@ -304,8 +304,8 @@ class Linearised:
     def tau_column(self, ds) -> np.ndarray:
         """(N, C) ``c = -d r / d tau`` at ``tau0`` (NaN where a delayed dataset is not valid)."""
         h = self.step(ds.t)
-        rp, okp = self._residual(ds, self.tau0 + h)
-        rm, okm = self._residual(ds, self.tau0 - h)
+        rp, okp = self.residual(ds, self.tau0 + h)
+        rm, okm = self.residual(ds, self.tau0 - h)
         col = (rm - rp) / (2.0 * h)
         col[~(okp & okm)] = np.nan
         return col

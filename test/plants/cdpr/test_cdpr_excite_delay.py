@@ -62,8 +62,8 @@ def test_tau_column_is_the_residual_change_of_a_simulated_delay(tmp_path):
              **{f"b[{n}]": v for n, v in zip(cases_cdpr.WINCHES, tr["b"])}}
     lin = E.Linearised(model, theta)
     col = lin.tau_column(ds[0.0])
-    r0, ok0 = lin._residual(ds[0.0], 0.0)
-    r1, ok1 = lin._residual(ds[delta], 0.0)
+    r0, ok0 = lin.residual(ds[0.0], 0.0)
+    r1, ok1 = lin.residual(ds[delta], 0.0)
     ok = ok0 & ok1 & np.isfinite(col).all(axis=1)
     assert ok.sum() > 0.95 * np.sum(ds[0.0].valid)     # (valid: the workbench leaves winches at rest out)
     change = (r1 - r0)[ok]
@@ -101,8 +101,8 @@ def test_design_column_is_the_residual_change_of_delayed_feedforward_tensions():
     assert theta["m"] == pytest.approx(desc.cdpr.platform_mass, rel=1e-6)
     lin = E.Linearised(base, theta)
     col = lin.tau_column(now)
-    r0, ok0 = lin._residual(now, 0.0)
-    r1, ok1 = lin._residual(delayed, 0.0)
+    r0, ok0 = lin.residual(now, 0.0)
+    r1, ok1 = lin.residual(delayed, 0.0)
     ok = ok0 & ok1 & np.isfinite(col).all(axis=1)
     change = (r1 - r0)[ok]
     assert np.abs(r0[ok]).max() < 1e-6 * np.abs(now.y).max()
