@@ -48,6 +48,8 @@ class CdprSimNode(PlantNode):
         self.start_stepping(1.0 / v.rate if self.real_time else 0.0002, topics.MARKERS,
                             lambda: sim_markers(self.description, self.sim), lambda: self.sim.time,
                             v.markers_rate)
+        # /diagnostics and the 3D view run right after a step, never just before the next one
+        self.defer_timers(t for t in self.timers if t is not self.timer)
 
     @property
     def done(self) -> bool:
@@ -68,7 +70,12 @@ class CdprSimNode(PlantNode):
 
     def tick(self) -> None:
         """Timer: the start gate, then :meth:`SimStepper.steps_due <cablelab.plants.cdpr.stepping.
-        SimStepper.steps_due>` steps (real time: the first on time, the rest late)."""
+        SimStepper.steps_due>` steps (real time: the first on time, the rest late), then a due
+        deferred timer (/diagnostics or the 3D view)."""
+        self.advance()
+        self.run_deferred()
+
+    def advance(self) -> None:
         if self.stepper.k == 0 and self.wait_subs:
             if self.waiting_for_subscribers(self.out.pub_js, self.stepper.last_publish, self.publish_state):
                 return
