@@ -11,7 +11,9 @@ needs and drops the rest:
 * every ready subscription is drained (``take_message`` until empty), one sample per topic per
   round in the order the node created its subscriptions (so a backlog on two topics keeps its
   interleaving), each message going straight to its callback;
-* ready timers are called (``call_timer`` then the callback), before the subscriptions;
+* ready timers are called (``call_timer`` then the callback) after the subscriptions were
+  drained: a timer sees every sample that came before it woke (e.g. a simulator's deadline sees
+  the command that arrived with it);
 * entities created after :meth:`add_node` (e.g. a subscription made in a callback) are picked up
   on the next wait (the wait set is rebuilt when the node's entity lists change);
 * *polled* subscriptions (:func:`poll`) are left out of the wait set: their samples wake nobody
@@ -350,6 +352,8 @@ class FastExecutor:
         if not timers_ready and not subs_ready and not services_ready:
             return
         self.wakeups += 1
+        # drain every queue, one sample per topic per round
+        self.taken += _take_all([e for p, e in self._subs if p in subs_ready])
         for tmr, h, ptr in self._timers:
             if ptr in timers_ready and h.is_timer_ready():
                 h.call_timer()
@@ -359,8 +363,6 @@ class FastExecutor:
                 request, header = h.service_take_request(srv.srv_type.Request)
                 if header is not None:
                     srv.send_response(srv.callback(request, srv.srv_type.Response()), header)
-        # drain every queue, one sample per topic per round
-        self.taken += _take_all([e for p, e in self._subs if p in subs_ready])
 
     def shutdown(self, timeout_sec: float | None = None) -> bool:
         if self._stack is not None:

@@ -22,7 +22,6 @@ from std_msgs.msg import Float64MultiArray
 
 from ....description import load_description
 from ....ros import rawmsg
-from ....ros.fastspin import take_newest
 from ....ros.plant_node import PlantNode
 from ....ros.qos import stream_qos
 from .. import topics
@@ -50,10 +49,10 @@ class CdprSimNode(PlantNode):
         self.use_fast_executor()
         self.ready = None           # (joint state bytes, rest, s of work) of a step computed ahead
         self.rest = None            # the rest of the last published sample, still to publish
-        # a command wakes the node (keep-last 1: the newest); real time: a deadline takes one
-        # that came in the same wake-up first
-        self.commands = self.command_input(topics.EFFORT_COMMANDS, self.sim.n, v.command_timeout,
-                                           stream_qos(1) if self.real_time else stream_qos(), raw=True)
+        # a command wakes the node (keep-last 1: the newest; the fast executor takes it before a
+        # deadline of the same wake-up)
+        self.command_input(topics.EFFORT_COMMANDS, self.sim.n, v.command_timeout,
+                           stream_qos(1) if self.real_time else stream_qos(), raw=True)
         self.start_stepping(1.0 / v.rate if self.real_time else 0.0002, topics.MARKERS,
                             lambda: sim_markers(self.description, self.sim), lambda: self.sim.time,
                             v.markers_rate)
@@ -99,8 +98,6 @@ class CdprSimNode(PlantNode):
             if self.waiting_for_subscribers(self.out.pub_js, self.stepper.last_publish, self.publish_state):
                 return
             self.publish_state()
-        if self.real_time:
-            take_newest(self.commands)     # an answer that came in this wake-up, before the deadline
         for i in range(self.stepper.steps_due(time.monotonic())):
             if self.stepper.ahead:
                 self.publish_ready()
