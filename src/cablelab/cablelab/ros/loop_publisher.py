@@ -7,13 +7,15 @@ priority (``niceness``), wakes every ``batch`` s, takes every record written sin
 publishes each with the plant's cycle publisher (a class named ``package.module:Class`` whose
 ``publish(state, command, cycle)`` the loop would otherwise call in its own thread, e.g.
 :class:`cablelab.plants.cdpr.nodes.control_loop.CdprCyclePublisher`). It ends when the loop
-closes the ring (after publishing what is left) or when the loop's process is gone.
+closes the ring (after publishing what is left and waiting, up to ``ack_wait`` s, until every
+reliable subscriber acknowledged it) or when the loop's process is gone.
 
 Run as ``python -m cablelab.ros.loop_publisher CONFIG_JSON [--ros-args ...]`` (the loop's own ROS
 arguments, so that remappings apply to the child's publishers too). CONFIG_JSON keys: ``ring``
 (shared-memory name), ``layout`` (:meth:`StateLayout.to_dict`), ``publisher`` (class spec),
 ``config`` (its configuration), ``node`` (node name), ``batch`` (s), ``niceness``, ``parent``
-(pid of the loop), ``domain_id`` (the loop's ROS domain), ``match_wait`` (s, :func:`wait_for_matches`).
+(pid of the loop), ``domain_id`` (the loop's ROS domain), ``match_wait`` (s, :func:`wait_for_matches`),
+``ack_wait`` (s, :func:`wait_for_acks`; default 10).
 """
 from __future__ import annotations
 
@@ -62,6 +64,17 @@ def wait_for_matches(node, timeout: float, least: float = 0.5) -> bool:
         time.sleep(0.02)
 
 
+def wait_for_acks(node, timeout: float) -> bool:
+    """Wait up to ``timeout`` s until every matched reliable subscriber acknowledged every sample
+    the node published: the writers' history ends with this process, and a recorder a few
+    batches behind still needs its last samples. Whether all were acknowledged."""
+    from rclpy.duration import Duration
+
+    t_end = time.monotonic() + timeout
+    return all([pub.wait_for_all_acked(Duration(seconds=max(0.0, t_end - time.monotonic())))
+                for pub in node.publishers])
+
+
 def run(config: dict, ros_args: list[str]) -> int:
     import rclpy
     from rclpy.node import Node
@@ -101,6 +114,7 @@ def run(config: dict, ros_args: list[str]) -> int:
             if ending and ring.backlog == 0:
                 break
             time.sleep(batch)
+        wait_for_acks(node, float(config.get("ack_wait", 10.0)))
     finally:
         node.destroy_node()
         rclpy.try_shutdown()
