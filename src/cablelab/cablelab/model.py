@@ -93,19 +93,20 @@ class Model:
                 ds = e.transform(ds, vals)
         return ds
 
-    def regressor(self, ds: Dataset, values: Mapping[str, float] | None = None
-                  ) -> tuple[np.ndarray, list[Param], np.ndarray]:
-        """Free regressor and the known part.
+    def regressor(self, ds: Dataset) -> tuple[np.ndarray, list[Param], np.ndarray]:
+        """Free regressor and the known part (the effects' higher-order output terms at
+        :attr:`at` and the fixed parameters: :meth:`evaluate` takes other values).
 
-        Args:
-            values: parameter values by name for the effects' higher-order output terms
-                (over :attr:`at` and the fixed parameters).
         Returns:
             ``(Phi, params, y_known)``: Phi (N, C, p) for the free linear parameters, their
             :class:`Param` list, and (N, C) the contribution of the fixed parameters and of the
             effects' higher-order terms; filtered by the dataset's parallel filter when it
             declares one (``ds.parallel_hz``).
         """
+        return self._regressor(ds, None)
+
+    def _regressor(self, ds: Dataset, values: Mapping[str, float] | None
+                   ) -> tuple[np.ndarray, list[Param], np.ndarray]:
         blocks, cols = [], []
         for e in self.effect_objects:
             blk = e.block(ds)
@@ -156,7 +157,7 @@ class Model:
         effects' higher-order output terms): the transformed dataset and its regressor, built
         once (what a fit solves and predicts with)."""
         ds2 = self.apply_nonlinear(ds, values)
-        phi, cols, y_known = self.regressor(ds2, values)
+        phi, cols, y_known = self._regressor(ds2, values) if self.higher_order else self.regressor(ds2)
         return Evaluation(ds2, phi, cols, y_known)
 
     def _higher_order(self, ds: Dataset, values: Mapping[str, float] | None) -> np.ndarray | None:
