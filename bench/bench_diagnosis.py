@@ -27,7 +27,10 @@ found >= 95 %, parameter p95 <= 3 %, 0 % false significant on controls. Every ca
 numbers before and after are printed in its own table. ``crane_delay=N``: a 20-45 ms measurement
 delay hidden in 60 s of slow sines (0.015-0.035 Hz; ``draw_delay_case``), diagnosed as it is (the
 delay should not be found), then ``excite``'s design for (tau, I_tot) with tau linearised, and the
-designed run diagnosed (time_delay first and significant, tau within 10 %).
+designed run diagnosed (time_delay first and significant, tau within 10 %). ``cdpr_delay=N``: the
+same for the CDPR (bench/cases_cdpr_delay.py ``draw_delay_case``: a 10-30 ms dynamometer delay
+hidden in 60 s of slow sines, then the design for (tau, m_a), tau's column the fitted residual's
+change with the wrench re-formed at the delayed pose).
 
     nice -n 10 ./run python bench/bench_diagnosis.py --designed crane=12,cdpr=4
 
@@ -314,7 +317,8 @@ def main() -> None:
     bench.parser.add_argument("--designed", default="", metavar="P=N",
                               help="designed-experiment cases instead of the others (crane=N, cdpr=N, "
                                    "leg=N: draw_designed_case of bench/cases_<plant>.py; crane_delay=N: "
-                                   "draw_delay_case of bench/cases_crane.py; seeds from "
+                                   "draw_delay_case of bench/cases_crane.py; cdpr_delay=N: draw_delay_case "
+                                   "of bench/cases_cdpr_delay.py; seeds from "
                                    + ", ".join(f"{v} ({k})" for k, v in DESIGNED_SEEDS.items()) + ")")
     bench.parser.add_argument("--workers", type=int, default=1,
                               help="processes for the --designed cases (default 1)")
@@ -352,9 +356,11 @@ def main() -> None:
 
 
 #: plant -> first seed of its designed-experiment cases
-DESIGNED_SEEDS = {"crane": 6000, "leg": 7000, "cdpr": 7000, "crane_delay": 8000}
-#: designed-case families beyond each plant's ``draw_designed_case``: name -> (plant, draw function)
-DESIGNED_DRAW = {"crane_delay": ("crane", "draw_delay_case")}
+DESIGNED_SEEDS = {"crane": 6000, "leg": 7000, "cdpr": 7000, "crane_delay": 8000, "cdpr_delay": 9000}
+#: designed-case families beyond each plant's ``draw_designed_case``: name -> (plant, draw
+#: function[, generator module when not the plant's own])
+DESIGNED_DRAW = {"crane_delay": ("crane", "draw_delay_case"),
+                 "cdpr_delay": ("cdpr", "draw_delay_case", "cases_cdpr_delay")}
 
 
 def designed(bench, spec: str, workers: int = 1) -> None:
@@ -385,8 +391,8 @@ def _designed_job(job, workdir: str) -> dict:
     import importlib
 
     p, k = job
-    plant, draw = DESIGNED_DRAW.get(p, (p, "draw_designed_case"))
-    gen = importlib.import_module(PLANT_CASES[plant][0])
+    plant, draw, *module = DESIGNED_DRAW.get(p, (p, "draw_designed_case"))
+    gen = importlib.import_module(module[0] if module else PLANT_CASES[plant][0])
     case = getattr(gen, draw)(DESIGNED_SEEDS[p] + k)
     own = getattr(gen, "run_designed_case", None)    # a plant whose loop is its own (leg)
     r = own(case, workdir, diagnose_case) if own else run_designed_case(case, gen, workdir)

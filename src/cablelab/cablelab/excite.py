@@ -250,13 +250,20 @@ LINEARISED = ("tau",)
 
 class Linearised:
     """A model with its delay ``tau`` (:mod:`cablelab.effects.delay`) as one more regressor column,
-    linearised at ``tau0``: the delay evaluates the model on the motion at ``t - tau``, so its
-    output is ``y(t; tau) = y0(t - tau)`` and ``d y / d tau = -d y0 / dt`` (y0: the model's output
-    ``Phi theta + y_known`` at ``tau0``, with the linear parameters at ``theta``). That column's
-    information, jointly with the model's linear columns, is what :func:`condition` and
-    :func:`block_conditions` measure (they only call ``regressor``). The time derivative of the
-    stacked motions of :func:`_stacked_motion` is smooth across blocks (each starts and ends at
-    rest at the same point).
+    linearised at ``tau0``: the sensitivity of the residual the fit sees to the delay. A fit
+    evaluates the model on the dataset the delay transforms (``model.apply_nonlinear(ds, {"tau":
+    tau})``: the motion at ``t - tau``, and on a plant with a ``remeasure`` hook its outputs
+    re-formed from the raw measurement, the CDPR's wrench ``W(pose(t - tau)) t_meas(t)``); its
+    residual is ``r(tau) = y(tau) - Phi(tau) theta - y_known(tau)``, so near ``tau0`` the data
+    ask ``y - Phi theta - y_known = c (tau - tau0)`` with the column ``c = -d r / d tau``. On a plant
+    whose outputs the delay leaves alone (the crane) that is ``d y / d tau = -d y0 / dt``, minus
+    the time derivative of the model output ``y0 = Phi theta + y_known``; on the CDPR it is
+    ``-W dt_meas/dt`` (the change of the measured tensions within tau) when the model explains
+    the measurement. ``c`` is a central difference of ``r`` at ``tau0 +- h`` with ``h`` half the
+    sample period (:meth:`step`). That column's information, jointly with the model's linear
+    columns, is what :func:`condition` and :func:`block_conditions` measure (they only call
+    ``regressor``). The stacked motions of :func:`_stacked_motion` are smooth across blocks
+    (each starts and ends at rest at the same point), so the shift may cross them.
 
     Args:
         model: the model holding ``time_delay``.
@@ -275,29 +282,39 @@ class Linearised:
     def fixed(self):
         return self.model.fixed
 
-    def _evaluated(self, ds):
-        """The model at ``tau0``: ``(y0, valid, phi, cols, y_known)``, y0 = ``Phi theta + y_known``."""
-        ds2 = self.model.apply_nonlinear(ds, {"tau": self.tau0})
-        phi, cols, y_known = self.model.regressor(ds2)
-        theta = np.array([self.theta.get(c.name, 0.0) for c in cols])
-        return phi @ theta + y_known, np.asarray(ds2.valid, bool), phi, cols, y_known
-
     @staticmethod
-    def _column(y0, valid, t) -> np.ndarray:
-        col = -np.gradient(y0, np.asarray(t, float), axis=0)
-        col[~valid] = np.nan
-        return col
+    def step(t) -> float:
+        """The difference step in tau, s: half the sample period. The delay interpolates every
+        shifted signal linearly between samples, so within one sample interval the transformed
+        dataset is linear in tau; a step up to one period then gives the interpolation's own
+        slope (for a regressor linear in the shifted signals, the central difference of the
+        samples, the same for any such step, with no truncation error), while a longer step
+        would average the slope over neighbouring intervals. Half a period keeps ``tau0 +- h``
+        inside the intervals on either side of ``tau0`` whatever its fraction of a sample."""
+        d = np.diff(np.asarray(t, float))
+        return 0.5 * float(np.median(d)) if d.size else 1e-3
+
+    def residual(self, ds, tau: float):
+        """``(r, valid)``: the fit's residual at the delay ``tau`` and the linear parameters at
+        ``theta``, and where the delayed dataset is valid."""
+        ev = self.model.evaluate(ds, {"tau": tau})
+        theta = np.array([self.theta.get(c.name, 0.0) for c in ev.columns])
+        return ev.lhs - ev.phi @ theta, np.asarray(ev.ds.valid, bool)
 
     def tau_column(self, ds) -> np.ndarray:
-        """(N, C) ``d y / d tau`` at ``tau0`` (NaN where the delayed dataset is not valid)."""
-        y0, valid, *_ = self._evaluated(ds)
-        return self._column(y0, valid, ds.t)
+        """(N, C) ``c = -d r / d tau`` at ``tau0`` (NaN where a delayed dataset is not valid)."""
+        h = self.step(ds.t)
+        rp, okp = self.residual(ds, self.tau0 + h)
+        rm, okm = self.residual(ds, self.tau0 - h)
+        col = (rm - rp) / (2.0 * h)
+        col[~(okp & okm)] = np.nan
+        return col
 
     def regressor(self, ds):
         from .effects.base import Param
 
-        y0, valid, phi, cols, y_known = self._evaluated(ds)
-        col = self._column(y0, valid, ds.t)
+        phi, cols, y_known = self.model.regressor(self.model.apply_nonlinear(ds, {"tau": self.tau0}))
+        col = self.tau_column(ds)
         return (np.concatenate([phi, col[:, :, None]], axis=2),
                 list(cols) + [Param("tau", "s", self.tau0, doc="delay, linearised")], y_known)
 
@@ -451,7 +468,8 @@ def design(plant_name: str, desc, params: Sequence[str], *, duration: float = 60
         values: for a design naming the delay ``tau`` (linearised, :class:`Linearised`): the
             delay it is linearised at (``tau``, default 0) and values of the linear parameters
             the model output is evaluated at (default: the fit on ``before_ds``,
-            :func:`linear_values`).
+            :func:`linear_values`; on a plant with a ``remeasure`` hook, the fit on the designed
+            motion's own dataset, whose measurement the plant synthesises).
     """
     import scipy.optimize
 
@@ -478,23 +496,27 @@ def design(plant_name: str, desc, params: Sequence[str], *, duration: float = 60
     t = np.arange(0.0, duration, 1.0 / fs)
     probe = ex.motion_dataset(t, *scaled_motion(np.ones(shape), t, lim, ex.base_hz, duration), desc)
     model, _ = model_for(plant, desc, params, probe)
-    if effects or fixed:
-        from .model import Model
+    from .model import Model
 
+    if effects or fixed:
         model = Model(plant.name, tuple(dict.fromkeys(tuple(model.effects) + tuple(effects))), dict(fixed or {}))
         for name in params:
             if name in model.fixed:
                 raise CablelabError(f"--params {name!r} is also fixed; name free parameters")
     if any(p in LINEARISED for p in params):
-        if getattr(plant, "remeasure", None) is not None:
-            # its outputs are re-formed from the raw measurement at the delayed motion, so the
-            # output's sensitivity to tau is not the model output's time derivative alone
-            raise CablelabError(f"--params tau: plant {plant.name} re-forms its outputs under a delay "
-                                f"(remeasure hook); the linearised delay column is for plants whose "
-                                f"outputs the delay does not re-form (tested: the crane)")
         vals = dict(values or {})
         tau0 = float(vals.pop("tau", 0.0))
-        model = Linearised(model, linear_values(model, before_ds, vals, probe), tau0)
+        if getattr(plant, "remeasure", None) is not None:
+            # the delay re-forms the outputs from the raw measurement the plant synthesises for a
+            # designed motion (the CDPR: the described platform's feedforward tensions): the model
+            # is evaluated where it explains that measurement, its fit on the motion's own
+            # dataset. At the recording's values the difference between the recording's load and
+            # the synthesised one would stay in the residual, and its change under a delay (the
+            # wrench map's motion times that tension difference) is not the delay's column.
+            own = Model(plant.name, tuple(model.effects), {**model.fixed, "tau": tau0})
+            model = Linearised(model, linear_values(own, probe, vals), tau0)
+        else:
+            model = Linearised(model, linear_values(model, before_ds, vals, probe), tau0)
         if not np.any(np.abs(np.nan_to_num(model.tau_column(probe))) > 0):
             raise CablelabError("--params tau: the model's output is zero on a designed motion, so a "
                                 "delay has nothing to shift; give the recording (BAG) whose fit "

@@ -13,8 +13,9 @@ DESCRIPTION = (
     "Design an excitation: a finite Fourier series per joint (Swevers et al.) whose coefficients "
     "minimise the condition number of the regressor of the model holding the named parameters, "
     "scaled into the machine's joint ranges, speeds and accelerations (a delay tau of time_delay "
-    "is designable, not on the CDPR, through its linearised column, minus the time derivative of the model's output "
-    "with the parameters fitted on BAG); written as a bag of the "
+    "is designable through its linearised column: the change of the fit's residual with tau, minus the "
+    "time derivative of the model's output with the parameters fitted on BAG where the delay leaves the "
+    "outputs alone); written as a bag of the "
     "plant's reference topic that the plant's controller node plays "
     "(pd_feedforward --plant P --ros-args -p reference_bag:=REF).")
 
