@@ -6,10 +6,16 @@ Prints wall and CPU seconds of :func:`cablelab.excite.design` (target: < 30 s wa
 excitation) and the condition numbers of the pair before (in a recording that confounds it) and
 after. One row per entry of :data:`CASES`: (plant, parameters, a function returning the
 description and the dataset of the confounding recording). The leg's design time includes
-building its steady-hop library (once per description).
+building its steady-hop library (once per process; every leg row here starts without it). The
+leg has more rows (:func:`leg_rows`): building the library alone; the design with the library
+built, on the levels' triangular factors (what it evaluates) and on the levels' rows themselves
+(:func:`cablelab.plants.leg.excite.motion_rows`, what it evaluated before); and
+``cablelab excite BAG --params F0,m --duration 60`` as a user runs it (a process: imports, the
+bag, the library, the design, the reference written).
 """
 from __future__ import annotations
 
+import json
 import sys
 import tempfile
 import time
@@ -58,8 +64,8 @@ def _axis_one_way():
     return dsc, ds
 
 
-def _leg_low_hops():
-    """The leg hopping 4 mm under the apex controller (a 2.7 N spring preload hidden)."""
+def _leg_low_hops_bag(path: Path) -> Path:
+    """The leg hopping 4 mm under the apex controller (a 2.7 N spring preload hidden), 30 s."""
     import cablelab.plants.leg as leg_pkg
     from cablelab.plants.leg.excite import closed_loop
     from cablelab.plants.leg.hybrid import LegParams
@@ -67,10 +73,15 @@ def _leg_low_hops():
 
     text = (Path(leg_pkg.__file__).parent / "data" / "leg.yaml").read_text()
     nominal = LegParams()
+    write_bag(path, closed_loop(nominal.replace(F0=2.7), nominal.z_td + 0.004, 30.0,
+                                controller_params=nominal), text)
+    return path
+
+
+def _leg_low_hops():
+    """The leg hopping 4 mm under the apex controller (a 2.7 N spring preload hidden)."""
     with tempfile.TemporaryDirectory() as d:
-        write_bag(Path(d) / "b", closed_loop(nominal.replace(F0=2.7), nominal.z_td + 0.004, 30.0,
-                                             controller_params=nominal), text)
-        _, dsc, ds = load(Path(d) / "b")
+        _, dsc, ds = load(_leg_low_hops_bag(Path(d) / "b"))
     return dsc, ds
 
 
@@ -117,6 +128,56 @@ CASES = [
 ]
 
 
+def _row(plant, shown, wall, cpu, before, after):
+    print(f"| {plant} | {shown} | 60 s | {wall:.1f} | {cpu:.1f} | {before:.3g} | {after:.3g} |", flush=True)
+
+
+def _forget_leg_library():
+    from cablelab.plants.leg import excite as leg_excite
+
+    leg_excite._LIBRARY.clear()
+    leg_excite._FACTORS.clear()
+
+
+def leg_rows(dsc, ds) -> None:
+    """The leg's design on the levels' rows (as it was), and ``cablelab excite`` in a process."""
+    import dataclasses
+    import resource
+    import subprocess
+
+    from cablelab.excite import get_exciter, register_exciter
+    from cablelab.plants.leg.excite import motion_rows
+
+    from cablelab.plants.leg.excite import hop_library
+
+    ex = get_exciter("leg")
+    _forget_leg_library()
+    w0, c0 = time.monotonic(), time.process_time()
+    hop_library(dsc)
+    print(f"| leg: the steady-hop library alone | | | {time.monotonic() - w0:.1f} | "
+          f"{time.process_time() - c0:.1f} | | |", flush=True)
+    for label, variant in (("levels' factors", ex), ("levels' rows", dataclasses.replace(ex, motion_dataset=motion_rows))):
+        register_exciter("leg", variant)
+        try:
+            w0, c0 = time.monotonic(), time.process_time()
+            r = design("leg", dsc, ["F0", "m"], duration=60.0, before_ds=ds)
+            _row(f"leg: design on the {label}, library built", "F0,m", time.monotonic() - w0,
+                 time.process_time() - c0, r.condition_before, r.condition_after)
+        finally:
+            register_exciter("leg", ex)
+    with tempfile.TemporaryDirectory() as d:
+        bag = _leg_low_hops_bag(Path(d) / "low_hops")
+        u0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+        w0 = time.monotonic()
+        out = subprocess.run([sys.executable, "-m", "cablelab.cli", "excite", str(bag), "--params", "F0,m",
+                              "--duration", "60", "-o", str(Path(d) / "ref"), "--json"],
+                             check=True, capture_output=True, text=True).stdout
+        u1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+        j = json.loads(out)
+        _row("leg: `cablelab excite BAG` (a process)", "F0,m", time.monotonic() - w0,
+             (u1.ru_utime + u1.ru_stime) - (u0.ru_utime + u0.ru_stime), j["condition_before"], j["condition_after"])
+
+
 def main() -> int:
     print("| plant | params | duration | wall s | CPU s | condition before | after |")
     print("| --- | --- | --- | --- | --- | --- | --- |")
@@ -125,12 +186,14 @@ def main() -> int:
         if recording not in recordings:
             recordings[recording] = recording()
         dsc, ds = recordings[recording]
+        if plant == "leg":
+            _forget_leg_library()
         w0, c0 = time.monotonic(), time.process_time()
         r = design(plant, dsc, params, duration=60.0, before_ds=ds)
         shown = ",".join(params) if len(params) < 4 else f"{params[0]}..{params[-1]} ({len(params)})"
-        print(f"| {plant} | {shown} | 60 s | {time.monotonic() - w0:.1f} | "
-              f"{time.process_time() - c0:.1f} | {r.condition_before:.3g} | {r.condition_after:.3g} |",
-              flush=True)
+        _row(plant, shown, time.monotonic() - w0, time.process_time() - c0, r.condition_before, r.condition_after)
+        if plant == "leg":
+            leg_rows(dsc, ds)
     return 0
 
 

@@ -87,6 +87,9 @@ class Exciter:
         start: ``fn(description) -> (n,)``: where the machine rests when the reference starts
             (e.g. the simulator's start pose), or None: at the centre of the limits' box. The
             designed reference then begins with a lead-in from there (:func:`lead_in`).
+        stacked: whether the dataset of motions stacked on one time axis keeps each motion's
+            rows apart (one row per reference sample), so one evaluation serves the cost and
+            its gradient; None: probed on two stacked motions.
     """
 
     limits: Callable
@@ -98,6 +101,7 @@ class Exciter:
     grid: float = 10.0
     trajectory: str = "joint"
     start: Callable | None = None
+    stacked: bool | None = None
 
 
 _EXCITERS: dict[str, Exciter] = {}
@@ -526,8 +530,8 @@ def design(plant_name: str, desc, params: Sequence[str], *, duration: float = 60
 
     # stacked evaluation when the plant's dataset keeps one sample per reference sample (not the
     # leg's, built per hop): checked once on two stacked motions
-    probe2 = ex.motion_dataset(*_stacked_motion(np.ones((2, n)), basis, t, lim, shape), desc)
-    stacked = probe2.n == 2 * len(t)
+    stacked = ex.stacked if ex.stacked is not None else \
+        ex.motion_dataset(*_stacked_motion(np.ones((2, n)), basis, t, lim, shape), desc).n == 2 * len(t)
 
     def conditions(xs):
         if stacked:

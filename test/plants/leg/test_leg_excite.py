@@ -12,9 +12,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings, strategies as st
 
 import cablelab.plants.leg as leg_pkg
 from cablelab.cli import main
+from cablelab.description import load_description
 from cablelab.excite import get_exciter, read_reference
 from cablelab.fit import identify
 from cablelab.plants.leg.control import ApexController
@@ -70,3 +72,37 @@ def test_designed_apex_schedule_separates_preload_and_mass(low_hops, tmp_path, c
     assert r.params["F0"] == pytest.approx(2.7, abs=0.15)
     assert r.params["m"] == pytest.approx(TRUTH.m, rel=0.01)
     assert abs(r.params["F0"] - 2.7) < abs(r0.params["F0"] - 2.7)
+
+
+@settings(max_examples=12, deadline=None)
+@given(shares=st.lists(st.floats(0.0, 1.0), min_size=5, max_size=5).filter(lambda w: sum(w) > 1e-3),
+       pair=st.sampled_from([("F0", "m"), ("F0", "dm_f"), ("k2", "k3"), ("c_td", "F0"), ("Fc", "d_s")]))
+def test_design_dataset_gives_every_model_the_information_of_the_rows(shares, pair):
+    """The design evaluates the triangular factors of the steady-hop levels' rows, not the rows:
+    the condition number of any leg model (every candidate effect, fixed and free parameters) on
+    a schedule equals the one on the row-by-row dataset (oracle: :func:`motion_rows`, the levels'
+    rows themselves), while the factors hold a few rows per level."""
+    from cablelab.effects import get_effect
+    from cablelab.excite import condition
+    from cablelab.model import Model
+    from cablelab.plants.leg.excite import hop_library, motion_dataset, motion_rows
+
+    desc = load_description(DESC)
+    heights, dss = hop_library(desc)
+    # a schedule spending the drawn time shares at the library heights (samples at the levels)
+    counts = np.round(400 * np.asarray(shares) / sum(shares)).astype(int)
+    q = np.repeat(heights, counts)
+    t = np.arange(len(q)) * 0.1
+    z = np.zeros_like(q)
+    fixed = {"m": 1.55} if "dm_f" in pair else {}
+    owners = {n: e for e in CANDIDATE_EFFECTS for n in [p.name for p in get_effect(e, "leg").params]}
+    model = Model("leg", tuple(dict.fromkeys(("leg_inertia", "stance_damping", "flight_damping")
+                                             + tuple(owners[n] for n in pair if n in owners))), fixed)
+    rows, factors = motion_rows(t, q, z, z, desc), motion_dataset(t, q, z, z, desc)
+    assert factors.n * 100 < rows.n                          # 15 rows per level instead of 2440
+    assert condition(model, factors, pair) == pytest.approx(condition(model, rows, pair), rel=1e-8)
+    assert condition(model, factors) == pytest.approx(condition(model, rows), rel=1e-8)
+
+
+CANDIDATE_EFFECTS = ("leg_inertia", "stance_damping", "flight_damping", "impact_restitution", "spring_preload",
+                     "spring_nonlinearity", "guide_coulomb_friction", "phase_effective_mass")

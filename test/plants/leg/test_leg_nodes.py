@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 import time
 
+import numpy as np
 import pytest
 
 
@@ -76,3 +77,36 @@ def test_estimator_without_contact_says_so(ros_context):
     level, msg, values = node.status()
     assert "phase from height" in msg and values["phase source"].startswith("height")
     node.destroy_node()
+
+
+@pytest.mark.parametrize("state_first", [True, False])
+def test_estimator_pairs_each_state_with_its_samples_switch(ros_context, state_first):
+    """The state and the switch reading of a sample come on two topics in either order; the
+    node's estimates equal those of the ROS-free estimator fed each sample with its own switch
+    reading (oracle: :class:`HopEstimator` on the simulated run), touch-downs included."""
+    from cablelab.plants.leg.estimator import HopEstimator
+    from cablelab.plants.leg.excite import closed_loop
+    from cablelab.plants.leg.hybrid import LegParams
+    from cablelab.plants.leg.nodes.estimator import make_node
+    from cablelab.ros import convert
+
+    p = LegParams()
+    run = closed_loop(p, p.z_td + 0.012, 1.5, z0=p.z_td + 0.03, seed=None)
+    node = make_node()
+    out = []
+    node.pub = type("Pub", (), {"publish": staticmethod(out.append)})()
+    for t, z, c, tau in zip(run.t, run.z_meas, run.contact, run.tau):
+        state = convert.joint_state_msg(t, ["body", "motor"], [z, 0.0], [0.0, 0.0], [0.0, tau])
+        switch = convert.joint_state_msg(t, ["contact"], [c])
+        for msg, cb in ((state, node.on_state), (switch, node.on_contact))[:: 1 if state_first else -1]:
+            cb(msg)
+    node.destroy_node()
+    ref = HopEstimator(p)
+    want = [ref.step(t, z, c, tau) for t, z, c, tau in zip(run.t, run.z_meas, run.contact, run.tau)]
+    assert len(out) == len(want)
+    got = np.array([[convert.joint_state_arrays(m)[0], m.position[1], m.position[2]] for m in out])
+    exp = np.array([[t, e.phase, e.apex_height] for t, e in zip(run.t, want)])
+    np.testing.assert_allclose(got[:, 0], exp[:, 0], rtol=0, atol=1e-9)
+    assert np.array_equal(got[:, 1], exp[:, 1])              # every sample's phase: touch-downs on time
+    np.testing.assert_allclose(got[:, 2], exp[:, 2], rtol=0, atol=1e-12, equal_nan=True)
+    assert {0, 1} <= set(got[:, 1].astype(int))

@@ -76,3 +76,29 @@ def test_description_without_link_length_fails_in_one_line(tmp_path):
 
     with pytest.raises(CablelabError, match=r"leg\.link_length: missing required key"):
         load_description(bad)
+
+
+def test_a_start_state_resent_until_answered_is_one_sample(tmp_path):
+    """A lock-stepped simulator resends its start state until the controller answers it: the bag
+    then holds that sample several times. The dataset is the one of the bag without the repeats
+    (oracle: the same run written once per sample)."""
+    import dataclasses
+
+    import numpy as np
+
+    from cablelab.plants.leg.excite import closed_loop
+
+    run = closed_loop(TRUE, TRUE.z_td + 0.012, 3.0, z0=TRUE.z_td + 0.03, seed=None)
+    rep = np.r_[0, 0, 0, np.arange(len(run.t))]                 # the start state three more times
+    resent = dataclasses.replace(run, **{f.name: getattr(run, f.name)[rep] for f in dataclasses.fields(run)
+                                         if isinstance(getattr(run, f.name), np.ndarray)})
+    write_bag(tmp_path / "once", run, DESC.read_text())
+    write_bag(tmp_path / "resent", resent, DESC.read_text())
+    _, _, a = load(tmp_path / "once")
+    _, _, b = load(tmp_path / "resent")
+    assert b.n == a.n == len(run.t)
+    np.testing.assert_array_equal(b.t, a.t)
+    np.testing.assert_array_equal(b.valid, a.valid)
+    np.testing.assert_allclose(b.y[a.valid], a.y[a.valid], rtol=0, atol=1e-12)
+    for k in ("acc", "stance", "impulse_td"):
+        np.testing.assert_allclose(b.signals[k][a.valid], a.signals[k][a.valid], rtol=0, atol=1e-12)

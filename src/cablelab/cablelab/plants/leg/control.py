@@ -21,7 +21,8 @@ from .sim import DT, LegSim, open_loop
 def next_apex(p: LegParams, h: float, T: float, P: float, dt: float = DT, horizon: float = 1.5) -> float:
     """Height (m) of the apex after one stride of the hybrid model from an apex at height ``h``
     (at rest in flight) under eq. 26 with amplitude T; NaN if no apex within ``horizon`` s."""
-    sim = LegSim(p, h, 0.0, phase=FLIGHT, dt=dt)
+    sim = _stepper(p, dt)
+    sim.reset(h, 0.0, phase=FLIGHT)
     law = open_loop(T, P)
     q, v = sim._q, sim._v
     n = int(horizon / dt)
@@ -38,6 +39,21 @@ def next_apex(p: LegParams, h: float, T: float, P: float, dt: float = DT, horizo
             return zp + 0.5 * vp * a * dt
         zp, vp = z, zd
     return math.nan
+
+
+def _stepper(p: LegParams, dt: float) -> LegSim:
+    """One :class:`LegSim` per (parameters, period), reset for each stride (compiling the MuJoCo
+    model took as long as simulating the stride)."""
+    key = (p, dt)
+    sim = _STEPPERS.get(key)
+    if sim is None:
+        if len(_STEPPERS) >= 16:
+            _STEPPERS.clear()
+        sim = _STEPPERS[key] = LegSim(p, p.z_td, 0.0, phase=FLIGHT, dt=dt)
+    return sim
+
+
+_STEPPERS: dict = {}
 
 
 @dataclass

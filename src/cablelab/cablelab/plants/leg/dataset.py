@@ -269,14 +269,18 @@ def dataset(bag, description, options: DatasetOptions) -> Dataset:
     js = bag.joint_state(topics.JOINT_STATES)
     if "body" not in js.names:
         raise CablelabError(f"{bag.path}: /leg/joint_states has no joint 'body' (has {js.names})")
-    z = js.position[:, js.names.index("body")]
-    tau = js.effort[:, js.names.index("motor")] if "motor" in js.names else np.zeros_like(z)
+    # a lock-stepped simulator resends its start state until the controller answers it: one
+    # sample per stamp (the first)
+    once = np.r_[True, np.diff(js.t) > 0] if len(js.t) else np.ones(0, bool)
+    t_js = js.t[once]
+    z = js.position[once, js.names.index("body")]
+    tau = js.effort[once, js.names.index("motor")] if "motor" in js.names else np.zeros_like(z)
     tau = np.nan_to_num(tau)
     contact = None
     if bag.has(topics.CONTACT):
         c = bag.joint_state(topics.CONTACT)
-        contact = np.interp(js.t, c.t, c.position[:, 0]) > 0.5
+        contact = np.interp(t_js, c.t, c.position[:, 0]) > 0.5
     if contact is None:       # (said as a warning of the input checks: check_bag below)
         leg = leg_of(description)
-        contact = estimate_series(js.t, z, None, tau, leg.params(description.gravity))["phase"]
-    return dataset_from_arrays(js.t, z, contact, tau, description, options, source=str(bag.path))
+        contact = estimate_series(t_js, z, None, tau, leg.params(description.gravity))["phase"]
+    return dataset_from_arrays(t_js, z, contact, tau, description, options, source=str(bag.path))

@@ -158,7 +158,9 @@ def run_over_dds(bag: Path, logs: Path, duration: float, domain: int, reference:
         launch.wait_for_subscribers([topics.JOINT_STATES, topics.CONTACT], timeout=90,
                                     node_name="payload_estimator")
         launch.wait_for_subscribers([topics.HOP_ESTIMATE], timeout=90, node_name="pd_feedforward")
-        launch.node("sim", "cable_sim_node", "leg", {"preload": LOOP_F0, "lockstep": True})
+        # time starts once the recorder and the estimator have the start state (start gate)
+        launch.node("sim", "cable_sim_node", "leg", {"preload": LOOP_F0, "lockstep": True,
+                                                     "wait_for_subscribers": 2})
         with SimProgress(launch.probe(), duration, "leg designed") as bar:
             bar.wait_for(launch, duration, "leg", logs)
         time.sleep(1.0)                     # let the recorder take the last messages

@@ -30,6 +30,7 @@ import math
 import numpy as np
 
 from ...dataset import Dataset
+from ...errors import CablelabError
 from ...excite import Exciter, Limits
 from .topics import REFERENCE
 
@@ -102,13 +103,16 @@ def hop_library(description) -> tuple[np.ndarray, list[Dataset]]:
     :data:`LEVELS` desired apex heights (m, absolute) spread over :data:`APEX_RANGE` and, per
     height, the leg dataset of the controller hopping there after it settled (valid rows only).
     Cached per description."""
-    from .description import leg_of
-
-    leg = leg_of(description)
-    key = (leg, float(description.gravity))
+    key = _key(description)
     if key not in _LIBRARY:
         _LIBRARY[key] = _build_library(description)
     return _LIBRARY[key]
+
+
+def _key(description):
+    from .description import leg_of
+
+    return leg_of(description), float(description.gravity)
 
 
 _LIBRARY: dict = {}
@@ -140,25 +144,71 @@ def level_shares(q: np.ndarray, heights: np.ndarray) -> np.ndarray:
     return w / max(w.sum(), 1e-300)
 
 
-def motion_dataset(t, q, qd, qdd, description) -> Dataset:
-    """The leg dataset an apex-height schedule ``q(t)`` (m) gives, for the design: the rows of
-    the steady-hop library, each level's scaled by the square root of the schedule's time share
+def _signal_names(ds: Dataset) -> list[str]:
+    """The dataset's per-sample float signals (the regressor bases of :mod:`.dataset`)."""
+    return [k for k, v in ds.signals.items()
+            if isinstance(v, np.ndarray) and v.ndim == 1 and v.dtype.kind == "f" and len(v) == ds.n]
+
+
+def _motion(parts, description, source: str) -> Dataset:
+    """A design dataset from ``parts``: ``(weight, signals dict, y)`` per library level."""
+    sig = {k: np.concatenate([w * s[k] for w, s, _ in parts]) for k in parts[0][1]}
+    y = np.concatenate([w * yy for w, _, yy in parts])
+    zd = sig["zd"]
+    return Dataset(plant="leg", t=np.arange(len(y)) * 1e-3, y=y, channels=("body",), units=("N",),
+                   signals=sig, actuators=("body",), act_vel=zd[:, None], act_units=(("N", "m"),),
+                   inputs={"velocity": zd}, description=description, source=source)
+
+
+def motion_rows(t, q, qd, qdd, description) -> Dataset:
+    """The leg dataset an apex-height schedule ``q(t)`` (m) gives, row for row: the rows of the
+    steady-hop library, each level's scaled by the square root of the schedule's time share
     there (module doc). The signals are the regressor bases of :mod:`.dataset`."""
     heights, dss = hop_library(description)
     w = level_shares(q, heights)
-    keep = [(j, d) for j, d in enumerate(dss) if w[j] > 0]
-    names = [k for k, v in dss[0].signals.items()
-             if isinstance(v, np.ndarray) and v.ndim == 1 and v.dtype.kind == "f" and len(v) == dss[0].n]
-    sig = {k: np.concatenate([math.sqrt(w[j]) * d.signals[k] for j, d in keep]) for k in names}
-    y = np.concatenate([math.sqrt(w[j]) * d.y for j, d in keep])
-    tt = np.concatenate([d.t for _, d in keep])
-    zd = sig["zd"]
-    return Dataset(plant="leg", t=np.arange(len(tt)) * 1e-3, y=y, channels=("body",), units=("N",),
-                   signals=sig, actuators=("body",), act_vel=zd[:, None], act_units=(("N", "m"),),
-                   inputs={"velocity": zd}, description=description, source="designed apex schedule")
+    names = _signal_names(dss[0])
+    return _motion([(math.sqrt(w[j]), {k: d.signals[k] for k in names}, d.y) for j, d in enumerate(dss) if w[j] > 0],
+                   description, "designed apex schedule")
+
+
+def motion_dataset(t, q, qd, qdd, description) -> Dataset:
+    """What the design evaluates for an apex-height schedule ``q(t)`` (m): :func:`motion_rows`
+    with every level's thousands of rows replaced by the few rows of its triangular factor.
+
+    Every leg effect's regressor column is one of the bases (a signal, or its negative), so the
+    information matrix of any leg model on a level's rows is ``M^T S^T S M`` (S: the level's
+    bases, one column each; M: the model's selection and signs), and ``S^T S = R^T R`` with R
+    from the QR decomposition of S: the rows of R, as signals, give every model the same
+    information as the level's rows (condition numbers equal to rounding, the test's oracle), at
+    as many rows as there are bases. ``y`` is zero (the design needs no output). The design
+    evaluates the dataset hundreds of times; built from the rows it took most of the design's
+    time. (A column that is not a basis, the any-plant ``torque_sensor_offset``'s column of ones,
+    is not reproduced: the rows themselves did not weigh it by the time shares either; the leg
+    designs for its own effects.)"""
+    heights, dss = hop_library(description)
+    w = level_shares(q, heights)
+    key = _key(description)
+    factors = _FACTORS.get(key)
+    if factors is None:
+        factors = _FACTORS[key] = [_factor(d) for d in dss]
+    return _motion([(math.sqrt(w[j]), f, np.zeros((len(f["zd"]), 1))) for j, f in enumerate(factors) if w[j] > 0],
+                   description, "designed apex schedule (triangular factors of the levels' rows)")
+
+
+def _factor(ds: Dataset) -> dict:
+    """The triangular factor R (``S^T S = R^T R``) of a level's bases S, as signals by name."""
+    names = _signal_names(ds)
+    s = np.column_stack([ds.signals[k] for k in names])
+    if not np.isfinite(s).all():
+        raise CablelabError(f"{ds.source}: non-finite regressor bases in the steady-hop library")
+    r = np.linalg.qr(s, mode="r")
+    return {k: r[:, i].copy() for i, k in enumerate(names)}
+
+
+_FACTORS: dict = {}
 
 
 #: the leg's experiment design (``cablelab excite``): an apex-height schedule, registered by the
 #: package; base period 50 s, the slowest change the speed limit leaves room for
 EXCITER = Exciter(limits=excite_limits, motion_dataset=motion_dataset, reference_topic=REFERENCE,
-                  base_hz=0.02, harmonics=3, rate_hz=10.0)
+                  base_hz=0.02, harmonics=3, rate_hz=10.0, stacked=False)

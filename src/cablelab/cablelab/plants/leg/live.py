@@ -32,6 +32,13 @@ class LiveLeg:
         self.sim = LegSim(truth, nominal.z_td + z0_offset, 0.0, dt=1.0 / rate)
         self.resolution, self.rate = leg.encoder_resolution, rate
         self.z_prev: float | None = None
+        self.zd = 0.0
+
+    def reading(self) -> tuple[float, float, float]:
+        """The encoder reading of the current state without stepping: ``(z, zd, theta)`` as
+        :meth:`step` returns it (velocity 0 before the first step)."""
+        z = float(quantise(self.sim.z, self.resolution))
+        return z, self.zd, float(motor_angle(z, self.sim.p.L))
 
     def step(self, tau: float) -> tuple[float, float, float]:
         """Advance one period; ``(z, zd, theta)``: the encoder height (m), its backward-difference
@@ -39,6 +46,6 @@ class LiveLeg:
         s = self.sim
         s.step(tau if s.phase == STANCE else 0.0)
         z = float(quantise(s.z, self.resolution))
-        zd = 0.0 if self.z_prev is None else (z - self.z_prev) * self.rate
+        self.zd = 0.0 if self.z_prev is None else (z - self.z_prev) * self.rate
         self.z_prev = z
-        return z, zd, float(motor_angle(z, s.p.L))
+        return z, self.zd, float(motor_angle(z, s.p.L))

@@ -251,6 +251,8 @@ def quantise(z, resolution: float, offset: float = 0.0):
     offset ``offset``; scalar or array."""
     if resolution <= 0:
         return z
+    if type(z) is float:        # one sample (the live loops): round() rounds half to even as np.round
+        return round((z + offset) / resolution) * resolution - offset
     return np.round((np.asarray(z) + offset) / resolution) * resolution - offset
 
 

@@ -6,7 +6,7 @@ specs (:class:`cablelab.ros.params.Param`) each node declares with descriptors a
 from __future__ import annotations
 
 from .. import topics
-from ....ros.params import Param, markers_rate
+from ....ros.params import START_GATE, Param, markers_rate, merge
 from ....ros.reference import reference_bag_param
 
 __all__ = ["SIM", "ESTIMATOR", "CONTROLLER", "DESCRIPTION"]
@@ -16,7 +16,7 @@ DESCRIPTION = Param("description", "", "plant description: YAML file or text (em
                     "package's data/leg.yaml)")
 
 #: ``cable_sim_node --plant leg``: the true leg, start height, rate
-SIM = (
+SIM = merge((
     DESCRIPTION,
     Param("mass_scale", 1.0, "true mass / the description's mass", gt=0.0, le=100.0),
     Param("preload", float("nan"), "true spring preload F_0 (NaN = the description's)", "N",
@@ -25,12 +25,14 @@ SIM = (
     Param("rate", 1000.0, "simulation and publishing rate", "Hz", ge=1.0, le=100000.0),
     Param("command_timeout", 0.5, "a torque command older than this means zero torque",
           "s wall", gt=0.0),
-    Param("lockstep", False, "once commands flow, advance only when the torque answering the last "
-          "state arrived"),
+    Param("lockstep", False, "time starts with the torque answering the start state, then advance "
+          "only when the torque answering the last state arrived"),
     Param("lockstep_timeout", 10.0, "lock-step: without an answer for this long, back to real time",
           "s wall", gt=0.0),
+    Param("lockstep_resend", 0.25, "lock-step: the start state is resent this often until its answer "
+          "arrives", "s wall", gt=0.0, le=60.0),
     markers_rate(f"{topics.MARKERS}: body, links, spring coloured by its force, foot"),
-)
+), START_GATE)
 
 #: ``payload_estimator --plant leg``: the hop estimator's phase detection
 ESTIMATOR = (

@@ -1,10 +1,14 @@
 """Leg simulator node: steps the hybrid plant (:class:`~..live.LiveLeg`) at ``rate`` with the latest
 ``/leg/effort_commands`` torque (stale -> 0) and publishes ``/leg/joint_states`` (``body``: encoder
 height, backward-difference velocity, F_in; ``motor``: theta, 0, torque), ``/leg/contact``,
-``/leg/ground_truth/state``, ``/clock`` and ``/plant_description``. ``lockstep``: once commands
-flow, a state is followed by the torque answering it (estimator and controller in between) before
-the simulation advances (:class:`cablelab.ros.lockstep.LockStep`), so a loaded machine slows the
-run down instead of delaying the stance torque by a whole flight.
+``/leg/ground_truth/state``, ``/clock`` and ``/plant_description``. ``lockstep``: the start state
+is published (and resent every ``lockstep_resend`` s) until the torque answering it arrives, and
+from then on a state is followed by the torque answering it (estimator and controller in between)
+before the simulation advances (:class:`cablelab.ros.lockstep.LockStep`), so a loaded machine
+slows the run down instead of delaying the stance torque by a whole flight, and no stance passes
+without the controller while the nodes are still discovering each other (in real time the leg
+fell from its start height and bounced with zero torque for the 0.4 s the controller's commands
+took to arrive on an idle machine, a recording unlike any the controller makes).
 Parameters: :data:`.parameters.SIM`.
 """
 from __future__ import annotations
@@ -31,13 +35,14 @@ class LegSimNode(SimulatorNode):
         v = self.declare_params(PARAMETERS)
         desc = load_leg_description(v.description)
         self.leg = LiveLeg(desc, v.mass_scale, v.preload, v.z0_offset, v.rate)
-        self.sim, self.tau, self.reading = self.leg.sim, 0.0, None
-        self.lock = LockStep(v.lockstep, wait_first=False, timeout=v.lockstep_timeout)
+        self.sim, self.tau, self.reading = self.leg.sim, 0.0, self.leg.reading()
+        self.lock = LockStep(v.lockstep, wait_first=True, timeout=v.lockstep_timeout, resend=v.lockstep_resend)
         self.pub_js, self.pub_contact, self.pub_truth = self.state_publishers(
             (JointState, topics.JOINT_STATES), (JointState, topics.CONTACT), (JointState, topics.GROUND_TRUTH))
         self.command_input(topics.EFFORT_COMMANDS, 1, v.command_timeout, required=False)
+        self.start_gate()
         self.start_simulation(desc, 1.0 / v.rate, topics.MARKERS, lambda: sim_markers(self.sim),
-                              v.markers_rate, publish_first=False)
+                              v.markers_rate, publish_first=v.lockstep)
 
     def extend_status(self, level, msg, values):
         values["events"] = str(len(self.sim.events))
