@@ -1,6 +1,7 @@
-"""The crane dataset's default conditioning is a parallel filter: derivatives at fs / 10, the
+"""The crane dataset's parallel filter (``--crane-filter parallel``): derivatives at fs / 10, the
 efforts and every regressor column low-passed at 3 Hz alike, so the identification equations
-stay exact where the payload's swing puts content near the cut-off.
+stay exact where the payload's swing puts content near the cut-off; the default filters the
+positions alone at 3 Hz.
 
 Oracle: the MuJoCo crane (plants/crane/sim.py) without noise, and the model evaluated at the
 simulator's own parameters (nothing fitted): its prediction must match the recorded efforts."""
@@ -8,13 +9,13 @@ from functools import partial
 
 import numpy as np
 
-from cablelab.conditioning import Conditioning
 from cablelab.model import Model
 from cablelab.plant_interface import DatasetOptions
 from cablelab.plants.crane import dataset as CD
 from cablelab.plants.crane import plant as C
 from cablelab.plants.crane.dataset import CRANE_CUTOFF_HZ
 from cablelab.plants.crane.model import CraneParams
+from cablelab.plants.crane.options import CraneOptions
 from cablelab.plants.crane.sim import CraneTruth, reference_trajectory, simulate
 from cablelab.description import load_description
 
@@ -37,11 +38,18 @@ def _relative_model_error(options=None):
     return ds, np.sqrt(np.mean(res ** 2, axis=0)) / np.sqrt(np.mean(ds.y[ok] ** 2, axis=0))
 
 
-def test_default_conditioning_keeps_the_equations_exact():
-    ds, err = _relative_model_error()
+def test_parallel_filter_keeps_the_equations_exact():
+    ds, err = _relative_model_error(DatasetOptions(plant=CraneOptions(crane_filter="parallel")))
     assert ds.parallel_hz == CRANE_CUTOFF_HZ
     assert np.all(err < 0.01), err
-    # the positions alone filtered at the same cut-off (``--cutoff 3``): the regressor loses the
+    # the default, the positions alone filtered at the same cut-off: the regressor loses the
     # swing's content near 3 Hz that the efforts keep (moves at 0.2-1 Hz: 4-24 % of the efforts)
-    _, err_pos = _relative_model_error(DatasetOptions(conditioning=Conditioning(cutoff_hz=CRANE_CUTOFF_HZ)))
+    ds_pos, err_pos = _relative_model_error()
+    assert not ds_pos.parallel_hz
     assert err_pos.max() > 10 * err.max(), (err_pos, err)
+
+
+def test_crane_filter_is_a_plant_option():
+    opts = DatasetOptions.build(C.PLANT, {"crane_filter": "parallel"})
+    assert opts.plant_options(CraneOptions).crane_filter == "parallel"
+    assert CraneOptions().crane_filter == "positions"

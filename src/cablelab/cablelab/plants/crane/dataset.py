@@ -19,6 +19,7 @@ from ...dataset import STANDARD_GRAVITY, Dataset
 from ...plant_interface import DatasetOptions
 from .dynamics_generated import regressor
 from .model import JOINTS
+from .options import CraneOptions
 from .swing import estimate_swing
 
 from .topics import JOINT_STATE, JOINT_STATES, PAYLOAD_POSE, POSE, TIP_POSE
@@ -27,13 +28,15 @@ SWING_NAMES = ("theta1", "theta2", "rope_length")
 #: given). The payload swings at sqrt(g / d) / (2 pi) ~ 0.6-1 Hz and the excitation stays below
 #: ~0.5 Hz, while motion-capture noise is differentiated twice for the swing accelerations: the
 #: generic fs / 10 (10 Hz at 100 Hz) lets 1 mm of noise become metres per second squared (002 sec.
-#: 5.1.3 chose its filters case by case; this is the case for the crane). It is a parallel filter
-#: (:mod:`cablelab.parallel_filter`): the derivatives are taken at fs / 10 and the efforts and every
-#: regressor column are low-passed at this cut-off alike. Filtering the positions alone at 3 Hz
-#: attenuated the swing's 1.5-3 Hz content (twice the swing frequency, in the centripetal and
-#: Coriolis terms) in the regressor but not in the efforts: a model error of 2-5 % of the torques
-#: that moved 0.2 % of the payload mass into the hoist and luff offsets (2-3 % of them) on designed
-#: runs, whatever the noise.
+#: 5.1.3 chose its filters case by case; this is the case for the crane). By default the positions
+#: are filtered at it and differentiated; the plant option ``crane_filter="parallel"``
+#: (:mod:`.options`) takes the derivatives at fs / 10 and low-passes the efforts and every
+#: regressor column at this cut-off alike (:mod:`cablelab.parallel_filter`). Filtering the
+#: positions alone attenuates the swing's 1.5-3 Hz content (twice the swing frequency, in the
+#: centripetal and Coriolis terms) in the regressor but not in the efforts: a model error of 2-5 %
+#: of the torques that moved 0.2 % of the payload mass into the hoist and luff offsets (2-3 % of
+#: them) on designed runs; the parallel filter in turn made the counterbalance and delay estimates
+#: of the plain and delay benchmark cases worse, so it is not the default.
 CRANE_CUTOFF_HZ = 3.0
 
 __all__ = ["check_bag", "check_measurements", "dataset", "dataset_from_arrays"]
@@ -56,14 +59,17 @@ def dataset_from_arrays(t, q_joints, effort, t_mocap, tip, payload, description,
         effort: (N, 3) [slew N m, luff N m, hoist N].
         t_mocap, tip, payload: (M,), (M, 3), (M, 3) motion capture (NaN rows = dropouts).
         description: :class:`~cablelab.description.Description` with a ``crane`` section.
-        options: the conditioning (defaults when None).
+        options: the conditioning and the crane's own options (:class:`.options.CraneOptions`:
+            ``crane_filter``); defaults when None.
     """
     opts = (options or DatasetOptions()).conditioning
     t = np.asarray(t, dtype=float)
     parallel = None
     if opts.cutoff_hz is None:
         fs = 1.0 / float(np.median(np.diff(t[np.isfinite(t)]))) if np.isfinite(t).sum() > 1 else 0.0
-        if fs / 10.0 > CRANE_CUTOFF_HZ:   # derivatives at fs / 10, both sides at CRANE_CUTOFF_HZ
+        mode = (options or DatasetOptions()).plant_options(CraneOptions).crane_filter
+        if mode == "parallel" and fs / 10.0 > CRANE_CUTOFF_HZ:   # derivatives at fs / 10, both
+            # sides of the fit at CRANE_CUTOFF_HZ
             opts, parallel = dataclasses.replace(opts, cutoff_hz=fs / 10.0, effort_cutoff_hz=None), CRANE_CUTOFF_HZ
         else:
             opts = dataclasses.replace(opts, cutoff_hz=CRANE_CUTOFF_HZ)
