@@ -182,6 +182,14 @@ def _motion(case: PlantCase, rng):
 PAIR = tuple(f"b[{n}]" for n in WINCHES) + ("m", "mx", "my")
 
 
+#: length of the designed run, s. The offsets' error is the noise's: exact without noise, and
+#: with it about 1 / sqrt(length) once the design crosses the workspace box (the dynamometers'
+#: AR(1) noise puts up to (1 + ar) / (1 - ar) = 9 times its white variance into the slow band
+#: the offsets are seen in); ``python bench/cases_cdpr.py --designed`` prints the error the
+#: covariance predicts for 60, 120 and 240 s designs
+DESIGNED_S = 240.0
+
+
 def draw_designed_case(seed: int, kind: str | None = None) -> PlantCase:
     """A case whose first recording does not separate what is hidden: the platform carries an
     unknown payload (total mass m, centre of mass x_G, y_G off the platform origin, in the
@@ -207,7 +215,7 @@ def draw_designed_case(seed: int, kind: str | None = None) -> PlantCase:
     case.options = {"tensions": "dynamometer"}
     case.family = f"designed {kind}"
     sway, first_s = float(rng.uniform(0.03, 0.08)), 30.0
-    tr.update(first_s=first_s, designed_s=60.0, sway=sway, reference=_sway(sway, first_s))
+    tr.update(first_s=first_s, designed_s=DESIGNED_S, sway=sway, reference=_sway(sway, first_s))
     return case
 
 
@@ -383,5 +391,53 @@ def _visibility_table(first_seed: int = 3000, n: int = 60) -> None:
               f"{tr['move_time']:12.2f}  {1e3 * tr['tau']:6.1f}  {delay_visibility(case):10.2f}  {tr['redraws']:7d}")
 
 
+def predicted_offset_error(case: PlantCase, t, p, a) -> float:
+    """|error| / |b| of the dynamometer offsets that the covariance of a channel-weighted least
+    squares fit predicts for the platform motion ``p``, ``a`` (N, 3) sampled at ``t`` (this
+    generator's structure matrix and noise: independent per-cable sigmas mapped through W, the
+    AR(1) noise's low-frequency variance (1 + ar) / (1 - ar) times the white one), with the
+    parameters of the fitted model: b (8), m, mx, my, m_a and its three first moments."""
+    tr = case.truth
+    W = structure_matrix(cable_directions(p, tr["r_p"])[0])              # (N, 6, 8)
+    X = np.zeros((len(t), 6, 15))
+    X[:, :, :8] = W
+    X[:, 2, 8] = G
+    X[:, 3:, 9], X[:, 3:, 10] = np.cross([1.0, 0, 0], [0, 0, G]), np.cross([0, 1.0, 0], [0, 0, G])
+    X[:, :3, 11] = a
+    for k in range(3):
+        X[:, 3:, 12 + k] = np.cross(np.eye(3)[k], a)
+    sig = tr["noise_rel"] * mean_tension(tr["m"])
+    C = np.einsum("nij,j,nkj->nik", W, sig ** 2, W) * (1 + tr["ar"]) / (1 - tr["ar"])
+    sc = np.sqrt(np.einsum("nii->i", C) / len(t))                          # channel weights 1 / sigma_c
+    Xw = X / sc[None, :, None]
+    Ai = np.linalg.inv(np.einsum("nip,niq->pq", Xw, Xw))
+    cov = Ai @ np.einsum("nip,nij,njq->pq", Xw, C / np.outer(sc, sc)[None], Xw) @ Ai
+    return float(np.sqrt(np.trace(cov[:8, :8])) / np.linalg.norm(tr["b"]))
+
+
+def _designed_length_table(seeds=(7000, 7001, 7002, 7004), lengths=(60.0, 120.0, 240.0)) -> None:
+    """Print, for designed cases, ``cablelab excite``'s condition number and the offsets' error
+    the fit's covariance predicts (:func:`predicted_offset_error`) for designs of each length."""
+    from cablelab.description import parse_description, read_yaml
+    from cablelab.excite import design
+
+    print("seed  " + "  ".join(f"{s:>5.0f} s: condition  predicted |db|/|b|" for s in lengths))
+    for seed in seeds:
+        case = draw_designed_case(seed)
+        desc = parse_description(read_yaml(case.description))
+        row = []
+        for s in lengths:
+            d = design("cdpr", desc, PAIR, duration=s, seed=seed, effects=case.effects, fixed=case.fixed)
+            t = np.arange(0.0, s, 1.0 / case.fs)
+            p, _, a = tabulated(d.t, d.q, d.qd, d.qdd)(t)
+            row.append(f"{d.condition_after:18.0f}  {100 * predicted_offset_error(case, t, p, a):16.2f} %")
+        print(f"{seed}  " + "  ".join(row), flush=True)
+
+
 if __name__ == "__main__":      # ./run python bench/cases_cdpr.py: the delay cases of bench_diagnosis
-    _visibility_table()
+    import sys
+
+    if "--designed" in sys.argv:  # the designed cases' predicted offset error vs design length
+        _designed_length_table()
+    else:
+        _visibility_table()

@@ -35,6 +35,15 @@ def test_joint_state_bytes_equal_rclpy_decoding():
     assert reader.parsed == 5
     # a message object goes through rclpy's path unchanged
     assert rawmsg.joint_state_arrays(cases[0], reader)[1] == [f"j{i}" for i in range(8)]
+    # a layout change that keeps the size (names of the same length, one field moved to
+    # another) is seen: names and fields follow the message
+    swapped = convert.joint_state_msg(2.0, [f"k{i}" for i in range(8)], rng.normal(size=8), None, None)
+    moved = convert.joint_state_msg(3.0, [f"k{i}" for i in range(8)], None, rng.normal(size=8), None)
+    for msg in (swapped, moved, swapped):
+        want = convert.joint_state_arrays(msg)
+        got = rawmsg.joint_state_arrays(serialize_message(msg), reader)
+        assert got[1] == want[1] and all(_same(g, w) for g, w in zip(got[2:], want[2:]))
+    assert reader.parsed == 8
 
 
 def test_multidof_bytes_equal_rclpy_decoding():

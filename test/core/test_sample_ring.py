@@ -127,7 +127,9 @@ def test_state_layout_round_trip(ring_factory):
         row = ring.slot()
         layout.pack(row, state, command)
         ring.commit()
-    other = HardwareState(1.0, np.ones(n), np.ones(n), np.ones(n), {"quat": np.ones(4), "unknown": np.ones(2)})
+    # a measured NaN is kept: an extra is left out only when all its values are NaN
+    other = HardwareState(1.0, np.ones(n), np.ones(n), np.ones(n),
+                          {"quat": np.array([np.nan, 1.0, np.nan, 1.0]), "unknown": np.ones(2)})
     layout.pack(ring.slot(), other, cmd)
     ring.commit()
     rows = ring.take()
@@ -145,3 +147,4 @@ def test_state_layout_round_trip(ring_factory):
             np.testing.assert_array_equal(c, command)
     s, _ = layout.unpack(rows[2])
     assert set(s.extra) == {"quat"}
+    np.testing.assert_array_equal(s.extra["quat"], [np.nan, 1.0, np.nan, 1.0])

@@ -7,7 +7,10 @@ per period, at absolute deadlines, in one thread (no DDS between the robot and i
 then ``state = hardware.read()``, ``command = law.update(state)``, ``hardware.write(command)``:
 that is the deadline path, timed as the loop body. Everything else (publishing the state for
 recorders and estimators, taking a new estimate, preparing the next reference) goes in the
-``after_write(state, command)`` hook, after the command is out.
+``after_write(state, command)`` hook, after the command is out; the hook can ask
+:meth:`ControlLoop.behind` whether the next deadline has already passed, and leave what can wait
+(taking inputs, diagnostics, planning ahead) to a period with time to spare, so that catching up
+after a stall costs each period no more than its body.
 
 Cycles are counted as ``bench/rcl_floor/floor.c`` counts its bare timer, so the two compare: a
 wake-up a period or more after its deadline is a *late* cycle (the loop then runs the periods
@@ -181,6 +184,10 @@ class ControlLoop:
         if self.started:
             self.started = False
             self.hardware.stop()
+
+    def behind(self) -> bool:
+        """True when the next period's deadline has passed (the loop is catching up)."""
+        return self.started and self.clock() >= self.start_wall + self.k * self.period
 
     def cycle(self) -> tuple[HardwareState, np.ndarray | None]:
         """One untimed read -> update -> write (the body, also for tests)."""

@@ -90,6 +90,9 @@ class Exciter:
         stacked: whether the dataset of motions stacked on one time axis keeps each motion's
             rows apart (one row per reference sample), so one evaluation serves the cost and
             its gradient; None: probed on two stacked motions.
+        tune: ``fn(params) -> {field: value}``: fields of this exciter chosen by the named
+            parameters (e.g. a family fast enough to show a delay, or slow and wide enough to show
+            what the travel reveals); None: the same fields for every design.
     """
 
     limits: Callable
@@ -102,6 +105,7 @@ class Exciter:
     trajectory: str = "joint"
     start: Callable | None = None
     stacked: bool | None = None
+    tune: Callable | None = None
 
 
 _EXCITERS: dict[str, Exciter] = {}
@@ -486,6 +490,7 @@ def design(plant_name: str, desc, params: Sequence[str], *, duration: float = 60
     t0 = time.monotonic()
     plant = get_plant(plant_name)
     ex = get_exciter(plant_name)
+    ex = replace(ex, **ex.tune(tuple(params))) if ex.tune is not None else ex
     lim = ex.limits(desc)
     total = duration
     lead_s, lead = lead_in(ex.start(desc), lim, ex.rate_hz) if ex.start is not None else (0.0, None)

@@ -94,24 +94,15 @@ class StateLayout:
     def unpack(self, row: np.ndarray) -> tuple[HardwareState, np.ndarray | None]:
         """The (state, command) of a record (arrays are copies: the ring's slot is reused). An
         extra the state did not have (all NaN in the record) is left out."""
-        s = self._slices
+        p, v, e, c, extras = self._plan
         row = np.array(row, dtype=float)
+        nan = np.isnan(row)
         extra = {}
-        for name, key in self._extra_keys:
-            v = row[s[key]]
-            if not np.isnan(v).all():
-                extra[name] = v
-        command = row[s["command"]] if row[-1] != 0.0 else None
-        return (HardwareState(float(row[0]), row[s["position"]], row[s["velocity"]], row[s["effort"]], extra),
-                command)
-
-    @property
-    def _slices(self) -> dict[str, slice]:
-        cache = self.__dict__.get("_cache")
-        if cache is None:
-            cache = self.slices()
-            object.__setattr__(self, "_cache", cache)
-        return cache
+        for name, sl in extras:
+            if not nan[sl.start] or not nan[sl].all():      # (the first value decides most often)
+                extra[name] = row[sl]
+        command = row[c] if row[-1] != 0.0 else None
+        return HardwareState(float(row[0]), row[p], row[v], row[e], extra), command
 
     @property
     def _extra_keys(self) -> tuple[tuple[str, str], ...]:

@@ -179,7 +179,9 @@ def test_hardware_seam():
         k = int(round(t * 500.0))
         now[0] = max(now[0], t) + wake.pop(k, 0.0) / 500.0
 
-    loop = ControlLoop(hw, Hold(), 500.0, warmup=0.0, clock=lambda: now[0], sleep=sleep)
+    behind = []
+    loop = ControlLoop(hw, Hold(), 500.0, warmup=0.0, clock=lambda: now[0], sleep=sleep,
+                       after_write=lambda state, command: behind.append(loop.behind()))
     loop.start()
     p0 = hw.sim.truth_pose()[0].copy()
     loop.run_until(0.1)
@@ -187,6 +189,8 @@ def test_hardware_seam():
     # deadlines 0..49; period 2 woke 2.5 periods late: it and period 3 (run at once after it,
     # 1.5 periods behind) are late, period 4 (0.5 behind) is not
     assert s.cycles == 50 and s.late == 2 and s.dropped == 0 and s.missed_cycles == 2
+    # after the writes of periods 2 and 3 the next deadline had passed (catching up), never else
+    assert [k for k, b in enumerate(behind) if b] == [2, 3]
     assert hw.braked == 50 and np.linalg.norm(hw.sim.truth_pose()[0] - p0) < 0.02
     assert hw.sim.time == pytest.approx(0.1)    # one period of physics per write
 

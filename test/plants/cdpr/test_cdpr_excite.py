@@ -129,3 +129,25 @@ def test_too_short_for_the_lead_in_is_a_one_line_error(tmp_path, capsys):
                  "--duration", "10", "-o", str(tmp_path / "ref")]) != 0
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "--duration 10" in err[0] and "from the machine's start" in err[0], err
+
+
+@pytest.mark.parametrize("base_hz", [0.05, 0.1])
+def test_tune_chooses_the_family_by_the_named_parameters(monkeypatch, base_hz):
+    """``Exciter.tune`` sets the Fourier family per design: with one harmonic of ``base_hz`` the
+    designed motion after the lead-in is that sine under the fade window, so its speed's spectrum
+    peaks at ``base_hz`` (oracle: the FFT of the written reference); the CDPR's own choice keeps
+    the 20 s, five-harmonic family for a delay and the 60 s one otherwise."""
+    import dataclasses
+
+    from cablelab import excite as E
+
+    ex = get_exciter("cdpr")
+    assert ex.tune(("tau", "m_a")) == {"base_hz": 0.05, "harmonics": 5} and ex.tune(("m",)) == {}
+    monkeypatch.setitem(E._EXCITERS, "cdpr", dataclasses.replace(
+        ex, tune=lambda params: {"base_hz": base_hz, "harmonics": 1}))
+    d = E.design("cdpr", default_description(), ["b[winch_1]", "m"], duration=60.0, max_iter=2)
+    k = int(round(d.lead_in * 100))
+    v = d.qd[k:] - d.qd[k:].mean(axis=0)
+    spec = np.abs(np.fft.rfft(v, axis=0)).sum(axis=1)
+    f = np.fft.rfftfreq(len(v), 0.01)
+    assert f[np.argmax(spec)] == pytest.approx(base_hz, abs=0.02)

@@ -58,7 +58,7 @@ def test_tau_column_is_the_residual_change_of_a_simulated_delay(tmp_path):
     model = workbench.build_model(plant, desc, case.effects + ("tension_sensor_offset", "time_delay"),
                                   fixed=case.fixed)
     m = tr["m"]
-    theta = {"m": m, "mx": 0.0, "my": 0.0, "m_a": m,
+    theta = {"m": m, "mx": 0.0, "my": 0.0, "m_a": m, "mx_a": 0.0, "my_a": 0.0, "mz_a": 0.0,
              **{f"b[{n}]": v for n, v in zip(cases_cdpr.WINCHES, tr["b"])}}
     lin = E.Linearised(model, theta)
     col = lin.tau_column(ds[0.0])

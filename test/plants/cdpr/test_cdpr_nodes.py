@@ -205,7 +205,7 @@ def test_controller_prepares_ahead_and_estimator_batches(ros_context):
     """The 1 kHz fast paths give the same outputs as the plain per-sample laws (the oracle:
     LiveController.update / LiveEstimator.update on the same inputs): the controller's reference
     terms prepared after the previous command (reference streamed two periods ahead), a new
-    estimate invalidating them; the estimator's batch mode estimating the newest sample of the
+    estimate preparing them again with its mass; the estimator's batch mode estimating the newest sample of the
     period."""
     from geometry_msgs.msg import InertiaStamped
     from std_msgs.msg import Float64MultiArray
@@ -239,7 +239,7 @@ def test_controller_prepares_ahead_and_estimator_batches(ros_context):
         ctl.on_reference(refs[0])
         ctl.on_reference(refs[1])
         for k in range(12):
-            if k == 6:      # a new estimate: the terms prepared with the old mass are not used
+            if k == 6:      # a new estimate: the terms prepared with the old mass are prepared anew
                 ctl.on_estimate(convert.inertia_msg(tt[k], 600.0, [0.05, -0.02, float("nan")]))
                 oracle.estimate(tt[k], 600.0, np.array([0.05, -0.02]))
             q, qd = rng.normal(-4000, 30, 8), rng.normal(0, 3, 8)
@@ -249,8 +249,8 @@ def test_controller_prepares_ahead_and_estimator_batches(ros_context):
                                       tr.acceleration[k]))
         got = np.array([m.data for m in sent])
         np.testing.assert_allclose(got, np.array(want), rtol=1e-12, atol=1e-9)
-        # every command but the first and the one after the new estimate used prepared terms
-        assert ctl.stream.prepared_used == 10 and ctl.status()[2]["commands prepared ahead"] == "10"
+        # every command but the first used prepared terms (the new estimate prepared them again)
+        assert ctl.stream.prepared_used == 11 and ctl.status()[2]["commands prepared ahead"] == "11"
 
         # estimator, batch mode: one estimate per poll, of the newest tension sample
         est.stream.batch = True

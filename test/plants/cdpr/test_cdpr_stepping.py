@@ -73,6 +73,41 @@ def test_real_time_brakes_hold_the_last_command_when_stale():
     assert s.fallbacks_running == 1 and s.missed_steps == 2
 
 
+def test_a_step_ahead_is_the_deadline_step_published_at_its_deadline():
+    """The step the answer to the last state drives, computed when the answer came, writes what
+    the deadline would have written and is counted like it: on time at its deadline (the first
+    step due then), fresh (command age one period); nothing goes ahead for an answer to another
+    state, for a command naming none, twice, or in lock-step."""
+    rate = 100.0
+    fast, hw = stepper(True, rate)
+    slow, hw2 = stepper(True, rate)
+    for s in (fast, slow):
+        assert s.due(100.0) == 0 and s.time_left(100.0) == pytest.approx(0.01)
+    u = np.array([1.0, 2.0])
+    for k in range(3):
+        for s in (fast, slow):
+            s.command(u + k, s.sim.time)             # the answer to the last published state
+        assert fast.step_ahead(100.0 + k / rate + 0.004) and fast.ahead
+        assert not fast.step_ahead(100.0 + k / rate + 0.005)      # one step ahead at most
+        assert fast.due(100.0 + k / rate + 0.005) == 0            # its deadline has not come
+        due = 100.0 + (k + 1) / rate + 0.0002
+        assert fast.due(due) == 1 and slow.due(due) == 1          # then it is the step due
+        slow.step(due, fresh=True)
+        fast.published(due)
+        slow.published(due)
+        assert not fast.ahead and fast.sim.time == slow.sim.time
+        assert [(w, list(c)) for w, c in hw.writes] == [(w, list(c)) for w, c in hw2.writes]
+    assert fast.command_age == slow.command_age == [3, 0, 0] and fast.missed_steps == slow.missed_steps == 0
+    assert fast.late_steps == 0 and fast.time_left(100.0 + 3 / rate) == pytest.approx(0.01)
+    fast.command(u, fast.sim.time - 1 / rate)        # answers an older state
+    assert not fast.step_ahead(100.04)
+    fast.command(u, None)                            # names no state
+    assert not fast.step_ahead(100.04) and len(hw.writes) == 3
+    lock, _ = stepper(False)
+    lock.command(u, 0.0)
+    assert not lock.step_ahead(1.0)
+
+
 def test_lock_step_waits_for_the_answer_then_times_out():
     s, hw = stepper(False)
     s.published(50.0)

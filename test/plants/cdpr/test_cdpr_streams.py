@@ -96,11 +96,18 @@ def test_commands_wait_for_the_reference_of_their_stamp(desc):
     # a state whose reference never comes goes ahead with the latest after sync_wait
     s.state((tt[2] + 1e-3, [], q, qd, None), now=20.0)
     assert s.ready(now=20.001) is None and s.ready(now=20.006) is not None
-    # an implausible estimate is counted, a good one drops what was prepared with the old mass
+    # an implausible estimate is counted, a good one prepares again what was prepared with the
+    # old mass (at once: off the state -> command path), equal to the law with the new mass
     s.estimate(tt[2], 1e6, np.zeros(3))
     s.prepare_next(tt[1])
+    old = s.prepared
     s.estimate(tt[2], 600.0, np.array([0.01, 0.0, np.nan]))
-    assert s.estimates_rejected == 1 and s.prepared is None and s.controller.mass == 600.0
+    assert s.estimates_rejected == 1 and s.controller.mass == 600.0
+    assert s.prepared is not old and s.prepared.t == tt[2]
+    oracle.estimate(tt[2], 600.0, np.array([0.01, 0.0]))
+    want = oracle.prepare(tt[2], tr.position[2], ONE, tr.velocity[2], tr.acceleration[2])
+    np.testing.assert_allclose(s.prepared.tensions_ff, want.tensions_ff, rtol=1e-12)
+    assert not np.allclose(old.tensions_ff, want.tensions_ff)
     # /diagnostics: the counts and the live feedforward mass; ERROR before a description
     level, msg, values = s.report(0, "ok", {}, "PDFF", 7)
     assert values == {"mode": "PDFF", "commands": "7", "skipped": "0", "estimates rejected": "1",

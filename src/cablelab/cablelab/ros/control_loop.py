@@ -8,7 +8,8 @@ through a shared-memory ring, :mod:`cablelab.sample_ring` and :mod:`cablelab.ros
 so that publishing costs the loop's process one record copy and never holds its GIL at a
 deadline; or a thread of this process; or this thread), takes what arrived on its input topics
 without waiting (e.g. a live estimate: ``fastspin.take_newest`` on a keep-last-1 queue that no
-executor waits on), and publishes /diagnostics once a second.
+executor waits on), and publishes /diagnostics once a second; while the loop is catching up after
+a stall (:meth:`ControlLoop.behind`) those two wait for the first period with time to spare.
 
 A plant's loop node (``plants/<plant>/nodes/control_loop.py``) subclasses :class:`ControlLoopNode`:
 it builds its hardware and law and calls :meth:`ControlLoopNode.setup_loop`, and overrides
@@ -110,6 +111,7 @@ class ControlLoopNode(PlantNode):
         self.last_problem = ""
         self.cycle_pub = None       # the plant's cycle publisher (publisher loop or thread)
         self._cycle = 0
+        self._take_due = False      # an input take waits for a period with time to spare
         self._next_diag = 0.0
         self._queue = None
         self._thread = None
@@ -196,10 +198,14 @@ class ControlLoopNode(PlantNode):
         if self._cpu0 is None and self.loop.stats.cycles:
             self._cpu0 = (time.process_time(), self.loop.stats.cycles)    # the counted cycles start
         if self._cycle % self.take_every == 0:
+            self._take_due = True
+        behind = self.loop.behind()
+        if self._take_due and not behind:
+            self._take_due = False
             self.take_inputs()
         self.after_cycle(state)
         now = time.monotonic()
-        if now >= self._next_diag:
+        if now >= self._next_diag and not behind:
             self._next_diag = now + 1.0
             if self._queue is not None:
                 self._queue.put(_DIAG)

@@ -11,14 +11,19 @@ needs and drops the rest:
 * every ready subscription is drained (``take_message`` until empty), one sample per topic per
   round in the order the node created its subscriptions (so a backlog on two topics keeps its
   interleaving), each message going straight to its callback;
-* ready timers are called (``call_timer`` then the callback), before the subscriptions;
+* ready timers are called (``call_timer`` then the callback) after the subscriptions were
+  drained: a timer sees every sample that came before it woke (e.g. a simulator's deadline sees
+  the command that arrived with it);
 * entities created after :meth:`add_node` (e.g. a subscription made in a callback) are picked up
   on the next wait (the wait set is rebuilt when the node's entity lists change);
 * *polled* subscriptions (:func:`poll`) are left out of the wait set: their samples wake nobody
   and wait in the DDS queue until the node takes them with :func:`drain` (e.g. a controller takes
   the reference and the estimate when a state arrives; an estimator takes its 1 kHz inputs in
   batches on a timer). Every Python wake-up costs tens of microseconds of CPU at 1 kHz, so a node
-  that wakes once per cycle instead of three times leaves the CPU to the loop's critical path.
+  that wakes once per cycle instead of three times leaves the CPU to the loop's critical path;
+* *deferred* timers (:func:`defer`) are left out of the wait set too: the node calls the due ones
+  itself with :func:`run_deferred` where they cannot delay its deadline work (e.g. a simulator's
+  /diagnostics and 3D view right after a step's state went out, not just before the next step).
 
 Services are answered (synchronous callbacks). Not serviced: clients, guard conditions and
 waitables (the QoS event handlers that log incompatible-QoS warnings). Use it for nodes that have
@@ -31,7 +36,7 @@ from __future__ import annotations
 from contextlib import ExitStack
 
 __all__ = ["FastExecutor", "supports", "set_realtime_priority", "set_cpu_affinity", "set_background",
-           "set_latency_slice", "set_idle_class", "poll", "drain", "take_newest"]
+           "set_latency_slice", "set_idle_class", "poll", "drain", "take_newest", "defer", "run_deferred"]
 
 
 def set_realtime_priority(priority: int) -> str:
@@ -169,6 +174,33 @@ def poll(node, subscription) -> None:
     polled.add(subscription)
 
 
+def defer(node, timer) -> None:
+    """Leave ``timer`` of ``node`` out of :class:`FastExecutor`'s wait set: it runs only when the
+    node calls :func:`run_deferred`. With another executor the timer runs as usual (and
+    :func:`run_deferred` finds it not due)."""
+    deferred = getattr(node, "_deferred_timers", None)
+    if deferred is None:
+        deferred = node._deferred_timers = set()
+    deferred.add(timer)
+
+
+def run_deferred(timers, limit: int | None = None) -> int:
+    """Call each of ``timers`` that is due (as an executor would: the timer's next call is
+    scheduled, then its callback runs), at most ``limit`` of them (None: all), in order; returns
+    how many ran."""
+    ran = 0
+    for tmr in timers:
+        if limit is not None and ran >= limit:
+            break
+        with tmr.handle:
+            if not tmr.handle.is_timer_ready():
+                continue
+            tmr.handle.call_timer()
+        tmr.callback()
+        ran += 1
+    return ran
+
+
 def drain(*subscriptions) -> int:
     """Take every queued sample of ``subscriptions`` and call each one's callback, one sample per
     subscription per round in the given order (so two streams published in step, e.g. a pose and
@@ -252,6 +284,8 @@ class FastExecutor:
         self._context = context
         self.node = None
         self._key = None
+        self._raw_key = None
+        self._filtered = None
         self._ws = None
         self._stack = None
         self.taken = 0          # messages handed to callbacks (for statistics)
@@ -267,10 +301,17 @@ class FastExecutor:
         return True
 
     def _entities(self):
+        """(subscriptions, timers, services) of the wait set; rebuilt only when the node's
+        entity lists or its polled / deferred sets changed (compared by identity: cheap)."""
         node = self.node
         polled = getattr(node, "_polled_subscriptions", ())
-        subs = tuple(s for s in node.subscriptions if s not in polled)
-        return subs, tuple(node.timers), tuple(node.services)
+        deferred = getattr(node, "_deferred_timers", ())
+        raw = (tuple(node._subscriptions), tuple(node._timers), tuple(node._services), len(polled), len(deferred))
+        if raw != self._raw_key:
+            self._raw_key = raw
+            self._filtered = (tuple(s for s in raw[0] if s not in polled),
+                              tuple(t for t in raw[1] if t not in deferred), raw[2])
+        return self._filtered
 
     def _rebuild(self, subs, timers, services) -> None:
         from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
@@ -311,6 +352,8 @@ class FastExecutor:
         if not timers_ready and not subs_ready and not services_ready:
             return
         self.wakeups += 1
+        # drain every queue, one sample per topic per round
+        self.taken += _take_all([e for p, e in self._subs if p in subs_ready])
         for tmr, h, ptr in self._timers:
             if ptr in timers_ready and h.is_timer_ready():
                 h.call_timer()
@@ -320,13 +363,11 @@ class FastExecutor:
                 request, header = h.service_take_request(srv.srv_type.Request)
                 if header is not None:
                     srv.send_response(srv.callback(request, srv.srv_type.Response()), header)
-        # drain every queue, one sample per topic per round
-        self.taken += _take_all([e for p, e in self._subs if p in subs_ready])
 
     def shutdown(self, timeout_sec: float | None = None) -> bool:
         if self._stack is not None:
             self._stack.close()
             self._stack = None
         self._ws = None
-        self._key = None
+        self._key = self._raw_key = None
         return True

@@ -19,7 +19,7 @@ from ..description import load_description
 from ..errors import CablelabError
 from . import convert
 from .diagnostics import Diagnostics
-from .fastspin import drain, poll, take_newest
+from .fastspin import defer, drain, poll, run_deferred, take_newest
 from .inputs import InputMonitor
 from .lockstep import ADVANCE, FREE, RESEND
 from .markers import start_markers
@@ -52,6 +52,7 @@ class PlantNode(Node):
         self.keep_first_description = False  # True: later /plant_description messages are ignored
         self._desc_pub = None
         self.polled = []     # subscriptions left out of the executor's wait set (subscribe(polled=True))
+        self.deferred = []   # timers left out of the executor's wait set (defer_timers)
         self._raw_readers = {}
         self.latency = Latency()  # per-sample processing time a node measures (latency.since(t0))
 
@@ -177,6 +178,20 @@ class PlantNode(Node):
         if newest:
             return sum(take_newest(sub) for sub in self.polled)
         return drain(*self.polled)
+
+    def defer_timers(self, timers) -> None:
+        """Leave ``timers`` (e.g. the /diagnostics and 3D-view timers) out of the fast
+        executor's wait set (:func:`~cablelab.ros.fastspin.defer`): they run when the node calls
+        :meth:`run_deferred`, at a point where they cannot delay its deadline work."""
+        for tmr in timers:
+            if tmr not in self.deferred:
+                defer(self, tmr)
+                self.deferred.append(tmr)
+
+    def run_deferred(self, limit: int | None = 1) -> int:
+        """Run the due :attr:`deferred` timers, at most ``limit`` (None: all) per call, the rest
+        on the next call (:func:`~cablelab.ros.fastspin.run_deferred`); returns how many ran."""
+        return run_deferred(self.deferred, limit) if self.deferred else 0
 
     def decode_raw(self, name: str, kind, msg):
         """The arrays of a ``kind`` message (``JointState``:

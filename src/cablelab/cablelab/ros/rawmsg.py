@@ -20,6 +20,8 @@ sent; the tests check every patched template against ``deserialize_message``.
 """
 from __future__ import annotations
 
+import struct
+
 import numpy as np
 
 from .. import cdr
@@ -145,31 +147,44 @@ class RawReader:
     and a reference per cycle spent a third of its time there. A stream keeps its *layout* (names,
     sequence lengths, frame id) from sample to sample, so the layout is parsed once
     (:func:`cablelab.cdr.walk`) and reused while the bytes that fix it (everything but the
-    numeric values, :meth:`cablelab.cdr.Layout.numeric_mask`) stay the same; the numbers are then
+    numeric values and the alignment padding, :meth:`cablelab.cdr.Layout.numeric_mask`) stay the
+    same: they are compared as a few byte runs, a microsecond per message; the numbers are then
     read through :func:`numpy.frombuffer` at known offsets. A message with another layout is
     parsed anew; bytes that are not a valid message raise ``ValueError``.
 
     Args:
         msg_type: the rclpy message class (e.g. ``sensor_msgs.msg.JointState``).
+
+    Attributes:
+        memo: per-layout cache of the decoding functions (what they derive from the layout once,
+            e.g. the joint names); emptied when the layout changes.
     """
 
     def __init__(self, msg_type):
         self.type_name = type_name(msg_type)
         self._layout = None
-        self._keep = None
-        self._struct = None
+        self._size = -1
+        self._runs = ()         # (start, end, bytes) of every run of layout-fixing bytes
+        self.memo: dict = {}
         self.parsed = 0         # layouts parsed (1 for a well-behaved stream)
 
     def layout(self, raw) -> cdr.Layout:
         """The :class:`cablelab.cdr.Layout` of ``raw`` (cached while the structure repeats)."""
         lay = self._layout
-        a = np.frombuffer(raw, dtype=np.uint8)
-        if lay is not None and a.size == lay.size and np.array_equal(a[self._keep], self._struct):
-            return lay
-        lay = cdr.walk(self.type_name, bytes(raw))
-        self._keep = np.flatnonzero(~lay.numeric_mask())
-        self._struct = a[self._keep].copy()
+        if lay is not None and len(raw) == self._size:
+            for a, b, want in self._runs:
+                if raw[a:b] != want:
+                    break
+            else:
+                return lay
+        buf = bytes(raw)
+        lay = cdr.walk(self.type_name, buf)
+        keep = ~lay.numeric_mask()
+        edges = np.flatnonzero(np.diff(np.concatenate(([False], keep, [False])).astype(np.int8)))
+        self._runs = tuple((int(a), int(b), buf[a:b]) for a, b in zip(edges[::2], edges[1::2]))
+        self._size = len(buf)
         self._layout = lay
+        self.memo = {}
         self.parsed += 1
         return lay
 
@@ -190,9 +205,42 @@ class RawReader:
         off, _, dt = lay.spans[path + ".nanosec"]
         return sec + int(np.frombuffer(raw, dtype=dt, count=1, offset=off)[0]) * 1e-9
 
+    @staticmethod
+    def stamp_reader(lay: cdr.Layout, path: str = "header.stamp"):
+        """``read(raw) -> s`` of a builtin_interfaces/Time field of this layout (int32 sec and
+        uint32 nanosec, consecutive): one ``struct`` unpack per message."""
+        off, _, dt = lay.spans[path + ".sec"]
+        fmt = struct.Struct(dt[0] + "iI")
+
+        def read(raw) -> float:
+            sec, nsec = fmt.unpack_from(raw, off)
+            return sec + nsec * 1e-9
+
+        return read
+
 
 def _raw(msg) -> bool:
     return isinstance(msg, (bytes, bytearray, memoryview))
+
+
+def _field(lay: cdr.Layout, path: str):
+    """``read(raw) -> float64 copy`` of a numeric field of this layout, or None when absent."""
+    span = lay.spans.get(path)
+    if span is None:
+        return None
+    off, count, dt = span
+    frombuffer, f8 = np.frombuffer, np.float64
+
+    def read(raw) -> np.ndarray:
+        return frombuffer(raw, dtype=dt, count=count, offset=off).astype(f8)
+
+    return read
+
+
+def _joint_state_plan(lay: cdr.Layout):
+    names = [lay.strings[f"name[{i}]"] for i in range(lay.seqlen.get("name", 0))]
+    return (RawReader.stamp_reader(lay), names, _field(lay, "position"), _field(lay, "velocity"),
+            _field(lay, "effort"))
 
 
 def joint_state_arrays(msg, reader: RawReader):
@@ -202,12 +250,38 @@ def joint_state_arrays(msg, reader: RawReader):
     if not _raw(msg):
         return convert.joint_state_arrays(msg)
     lay = reader.layout(msg)
-    names = [lay.strings[f"name[{i}]"] for i in range(lay.seqlen.get("name", 0))]
-    v = reader.values
-    return reader.stamp(msg, lay), names, v(msg, lay, "position"), v(msg, lay, "velocity"), v(msg, lay, "effort")
+    plan = reader.memo.get("joint_state")
+    if plan is None:
+        plan = reader.memo["joint_state"] = _joint_state_plan(lay)
+    stamp, names, pos, vel, eff = plan
+    return (stamp(msg), list(names), None if pos is None else pos(msg), None if vel is None else vel(msg),
+            None if eff is None else eff(msg))
 
 
 _P0 = "points[0]."
+
+
+def _multidof_plan(lay: cdr.Layout):
+    """(stamp reader, [(keys, split, offset, count, dtype)]): the first point's translation and
+    rotation (7 consecutive float64), its linear and angular velocity, its linear and angular
+    acceleration (6 each), each block read with one ``frombuffer`` and split at ``split``."""
+    spans = lay.spans
+    blocks = []
+    if _P0 + "transforms[0].translation.x" in spans:
+        blocks.append((("position", "quaternion"), _P0 + "transforms[0].translation",
+                       _P0 + "transforms[0].rotation", "xyzw"))
+        for fld, name in (("velocities", "velocity"), ("accelerations", "acceleration")):
+            if f"{_P0}{fld}[0].linear.x" in spans:
+                blocks.append(((f"linear_{name}", f"angular_{name}"), f"{_P0}{fld}[0].linear",
+                               f"{_P0}{fld}[0].angular", "xyz"))
+    plan = []
+    for keys, first, second, f2 in blocks:
+        offs = [spans[f"{first}.{c}"] for c in "xyz"] + [spans[f"{second}.{c}"] for c in f2]
+        off, _, dt = offs[0]
+        if any(o != off + 8 * i or d != dt for i, (o, _, d) in enumerate(offs)):
+            raise ValueError(f"{lay.size}-byte MultiDOFJointTrajectory: {first} and {second} not contiguous")
+        plan.append((keys, 3, off, len(offs), dt))
+    return RawReader.stamp_reader(lay), plan
 
 
 def multidof_arrays(msg, reader: RawReader) -> dict:
@@ -216,24 +290,20 @@ def multidof_arrays(msg, reader: RawReader) -> dict:
     if not _raw(msg):
         return convert.multidof_arrays(msg)
     lay = reader.layout(msg)
-    out = {"t": reader.stamp(msg, lay), "position": None, "quaternion": None,
+    plan = reader.memo.get("multidof")
+    if plan is None:
+        plan = reader.memo["multidof"] = _multidof_plan(lay)
+    stamp, blocks = plan
+    out = {"t": stamp(msg), "position": None, "quaternion": None,
            "linear_velocity": None, "angular_velocity": None,
            "linear_acceleration": None, "angular_acceleration": None}
-    spans = lay.spans
-    if _P0 + "transforms[0].translation.x" not in spans:
-        return out
-
-    def vec(prefix: str, fields: str = "xyz") -> np.ndarray:
-        off, _, dt = spans[f"{prefix}.{fields[0]}"]
-        return np.frombuffer(msg, dtype=dt, count=len(fields), offset=off).astype(np.float64)
-
-    out["position"] = vec(_P0 + "transforms[0].translation")
-    out["quaternion"] = vec(_P0 + "transforms[0].rotation", "xyzw")
-    for field, prefix in (("velocities", "velocity"), ("accelerations", "acceleration")):
-        if f"{_P0}{field}[0].linear.x" in spans:
-            out[f"linear_{prefix}"] = vec(f"{_P0}{field}[0].linear")
-            out[f"angular_{prefix}"] = vec(f"{_P0}{field}[0].angular")
+    for (a, b), split, off, count, dt in blocks:
+        v = np.frombuffer(msg, dtype=dt, count=count, offset=off).astype(np.float64)
+        out[a], out[b] = v[:split], v[split:]
     return out
+
+
+_U32 = {"<": struct.Struct("<I"), ">": struct.Struct(">I")}
 
 
 def command_arrays(msg) -> tuple[np.ndarray, float | None]:
@@ -254,7 +324,7 @@ def command_arrays(msg) -> tuple[np.ndarray, float | None]:
     if n < 12 or b[0] != 0 or b[1] not in (0, 1):
         raise ValueError("not a CDR-serialised Float64MultiArray")
     order = "<" if b[1] == 1 else ">"
-    u32 = np.dtype(order + "u4")
+    u32 = _U32[order].unpack_from
     pos = 4
 
     def word() -> int:
@@ -262,7 +332,7 @@ def command_arrays(msg) -> tuple[np.ndarray, float | None]:
         pos += -(pos - 4) % 4
         if pos + 4 > n:
             raise ValueError("Float64MultiArray bytes end inside a field")
-        v = int(np.frombuffer(b, u32, 1, pos)[0])
+        v = u32(b, pos)[0]
         pos += 4
         return v
 

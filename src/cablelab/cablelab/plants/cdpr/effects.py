@@ -5,7 +5,7 @@ forces N, moments N m about the platform origin, world axes) from the measured t
 wrench matrix W at the desired (or measured) pose. The model explains it as (001 eq. 10-13)
 
     W t = [m g_up; (m x_G R e_x + m y_G R e_y) x g_up]      (cdpr_gravity: m, mx, my)
-          + [m_a a; 0]                                      (platform_inertia)
+          + [m_a a; R [mx_a, my_a, mz_a] x a]                (platform_inertia)
           + W (R/r) (F_c sign(qdot) + F_v qdot)             (winch friction, motor tensions only)
           + W b                                             (tension_sensor_offset, dynamometers)
 
@@ -53,25 +53,34 @@ def _wrench_only(ds: Dataset, blk: np.ndarray) -> np.ndarray:
     return np.concatenate([blk, np.zeros((blk.shape[0], extra, blk.shape[2]))], axis=1)
 
 
-def _gravity(ds: Dataset) -> np.ndarray:
-    g = ds.gravity
-    n = ds.n
-    up = np.zeros((n, 3))
-    up[:, 2] = g
+def _platform_axes(ds: Dataset) -> np.ndarray:
+    """(N, 3, 3) the platform's axes (columns) in world axes per sample (level: the world's)."""
     R = ds.signals.get("R")
-    ex = np.broadcast_to([1.0, 0.0, 0.0], (n, 3)) if R is None else R[:, :, 0]
-    ey = np.broadcast_to([0.0, 1.0, 0.0], (n, 3)) if R is None else R[:, :, 1]
-    out = np.zeros((n, 6, 3))
+    return np.broadcast_to(np.eye(3), (ds.n, 3, 3)) if R is None else R
+
+
+def _gravity(ds: Dataset) -> np.ndarray:
+    up = np.zeros((ds.n, 3))
+    up[:, 2] = ds.gravity
+    R = _platform_axes(ds)
+    out = np.zeros((ds.n, 6, 3))
     out[:, :3, 0] = up
-    out[:, 3:, 1] = cross(ex, up)
-    out[:, 3:, 2] = cross(ey, up)
+    out[:, 3:, 1] = cross(R[:, :, 0], up)
+    out[:, 3:, 2] = cross(R[:, :, 1], up)
     return _wrench_only(ds, out)
 
 
 def _inertia(ds: Dataset) -> np.ndarray:
+    # 001 eq. 10's spatial inertia times the acceleration of a translating platform:
+    # [m_a a; MS_a x a], MS_a = R [mx_a, my_a, mz_a] its first moment (001 eq. 11's MS_p; no
+    # angular acceleration, no gyroscopic term: the platform keeps its orientation). Unlike the
+    # weight's, the moment of m a also sees the height of the centre of mass (mz_a).
     a = ds.require_signal("acc")
-    out = np.zeros((ds.n, 6, 1))
+    R = _platform_axes(ds)
+    out = np.zeros((ds.n, 6, 4))
     out[:, :3, 0] = a
+    for k in range(3):
+        out[:, 3:, 1 + k] = cross(R[:, :, k], a)
     return _wrench_only(ds, out)
 
 
@@ -116,11 +125,20 @@ CDPR_GRAVITY = register(Effect(
 PLATFORM_INERTIA = register(Effect(
     id="platform_inertia",
     plants=("cdpr",),
-    params=(Param("m_a", "kg", 366.0, 0.0, np.inf, "mass accelerated with the platform"),),
-    explanation="the cables also accelerate the moving mass (m a in the force balance)",
+    params=(Param("m_a", "kg", 366.0, 0.0, np.inf, "mass accelerated with the platform"),
+            Param("mx_a", "kg m", 0.0, -np.inf, np.inf, "its first moment m_a x_G (platform frame)"),
+            Param("my_a", "kg m", 0.0, -np.inf, np.inf, "its first moment m_a y_G (platform frame)"),
+            Param("mz_a", "kg m", 0.0, -np.inf, np.inf, "its first moment m_a z_G (platform frame)")),
+    explanation="the cables also accelerate the moving mass (m a in the force balance, m r_G x a "
+                "in the moment balance)",
     signature="mass estimate swings with the vertical acceleration (lift and lower phases)",
     reference="001 eq. 10",
     regressor=_inertia,
+    physical=lambda ds: (
+        Physical("m_a", "kg", lambda p: p["m_a"], "mass accelerated with the platform (001 eq. 10)"),
+        Physical("x_Ga", "m", lambda p: p["mx_a"] / p["m_a"], "its centre of mass x, platform frame"),
+        Physical("y_Ga", "m", lambda p: p["my_a"] / p["m_a"], "its centre of mass y, platform frame"),
+        Physical("z_Ga", "m", lambda p: p["mz_a"] / p["m_a"], "its centre of mass z, platform frame")),
 ))
 
 PULLEY_GEOMETRY = register(Effect(

@@ -82,7 +82,7 @@ def estimate_arrays(arr: CdprArrays, description, effects=(), params: dict | Non
         fixed = {"r_p": params["r_p"]} if "r_p" in params and "pulley_geometry" in effs else {}
         # W_I-based friction/offset columns: good to first order in r_p
         ident = identify(Model("cdpr", effs, fixed), ds)
-        params.update({k: v for k, v in ident.params.items() if k not in ("m", "mx", "my", "m_a")})
+        params.update({k: v for k, v in ident.params.items() if k not in ("m", "mx", "my", "m_a", "mx_a", "my_a", "mz_a")})
     n = arr.tensions.shape[1]
     t = arr.tensions.copy()
     names = [f"winch_{i}" for i in range(1, n + 1)]

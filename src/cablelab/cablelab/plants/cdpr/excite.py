@@ -3,8 +3,9 @@ platform, 001 assumption 1) follows the designed Fourier series inside a box of 
 where every cable stays taut and below its maximum tension, and the dataset the CDPR effects see
 for such a motion.
 
-The box (:func:`excite_limits`): centred between the exit points, first a share of their span
-(x, y) and of their height (z), then shrunk until the tensions of the controller's feedforward
+The box (:func:`excite_limits`): centred between the exit points, first a share of the footprint
+the platform's anchors can cover inside the exit points' (x, y) and a share of the exit points'
+height (z), then shrunk until the tensions of the controller's feedforward
 distribution (001 eq. 14 nearest the preload, :func:`.control.feedforward_tensions`) stay
 between :data:`MIN_TENSION` and the drives' maximum (``max_torque`` R/r) on a grid of the box,
 for the empty platform and for it with :data:`PAYLOAD_FACTOR` times its mass, at every
@@ -36,10 +37,13 @@ PAYLOAD_FACTOR = 2.0
 #: speed (m/s) and acceleration (m/s^2) limits of the platform per axis
 SPEED = (0.3, 0.3, 0.2)
 ACCEL = (0.4, 0.4, 0.3)
-#: first box: share of the exit points' span (x, y) around their centre, and z range as shares
-#: of the exit points' height
-SPAN_SHARE = 0.35
-Z_SHARE = (0.2, 0.4)
+#: first box: share of the half-span the platform's anchors can travel inside the exit points'
+#: footprint (the exit points' half-span minus the anchors'), around the exit points' centre, and
+#: the z range as shares of the exit points' height. Offsets seen through W(p) separate from the
+#: weight only as far as the platform travels (the internal-force part of the offsets shows
+#: through the change of W's null space, first order in the displacement)
+SPAN_SHARE = 0.8
+Z_SHARE = (0.2, 0.5)
 
 
 def _max_tension(c) -> float:
@@ -78,8 +82,9 @@ def excite_limits(description) -> Limits:
     acceleration limits."""
     c, g = description.cdpr, description.gravity
     A = np.asarray(c.exit_points, float)
+    B = np.asarray(c.anchor_points, float)
     centre = 0.5 * (A.min(axis=0) + A.max(axis=0))
-    half = SPAN_SHARE * 0.5 * np.ptp(A, axis=0)
+    half = SPAN_SHARE * np.maximum(0.5 * np.ptp(A, axis=0) - np.abs(B).max(axis=0), 0.05)
     ztop = A[:, 2].min()
     lo = np.array([centre[0] - half[0], centre[1] - half[1], Z_SHARE[0] * ztop])
     hi = np.array([centre[0] + half[0], centre[1] + half[1], Z_SHARE[1] * ztop])
@@ -128,6 +133,17 @@ def start_position(description=None) -> np.ndarray:
     return pick_and_place(np.array([0.0])).position[0]
 
 
-#: the CDPR's experiment design (``cablelab excite``), registered by the package
+def _family(params) -> dict:
+    """A delay shows through the tensions' change within tau (the platform's jerk): a design
+    naming ``tau`` keeps a 20 s base period with five harmonics (up to 0.25 Hz); the others use
+    :data:`EXCITER`'s slow, wide family."""
+    return {"base_hz": 0.05, "harmonics": 5} if "tau" in params else {}
+
+
+#: the CDPR's experiment design (``cablelab excite``), registered by the package. Base period
+#: 60 s, six harmonics (up to 0.1 Hz): the speed limit caps a harmonic's amplitude at v / omega,
+#: so a 20 s base period (0.95 m at 0.3 m/s) could not cross the box; the offsets' internal-force
+#: part shows through the change of W's null space, so the condition number of (offsets, m, mx,
+#: my) falls steeply with the travel
 EXCITER = Exciter(limits=excite_limits, motion_dataset=motion_dataset, reference_topic=REFERENCE,
-                  base_hz=0.05, harmonics=5, trajectory="pose", start=start_position)
+                  base_hz=1 / 60, harmonics=6, trajectory="pose", start=start_position, tune=_family)

@@ -174,7 +174,9 @@ def pose_geometry(exit_points: np.ndarray, anchor_points: np.ndarray, position: 
                   rotation: np.ndarray | None = None, pulley_radius: float = 0.0,
                   swivel_axes: np.ndarray | None = None):
     """One pose, fast (live nodes at 1 kHz): the same directions and lengths as
-    :func:`cable_geometry` for a single pose, on (n,) arrays without the batch machinery.
+    :func:`cable_geometry` for a single pose, on (n,) arrays without the batch machinery. A
+    ``position`` of shape (N, 1, 3) (and no rotation) gives N poses at once, the same arithmetic
+    broadcast: ``(N, n, 3)`` directions and ``(N, n)`` lengths.
 
     Returns:
         ``(directions (n, 3), lengths (n,), anchors (n, 3))`` as in :class:`CableGeometry`.
@@ -184,16 +186,16 @@ def pose_geometry(exit_points: np.ndarray, anchor_points: np.ndarray, position: 
     d = position + bw - A
     r = float(pulley_radius)
     if r <= 0.0:
-        L = np.sqrt((d * d).sum(1))
-        return -d / L[:, None], L, bw
+        L = np.sqrt((d * d).sum(-1))
+        return -d / L[..., None], L, bw
     z = swivel_axes
-    dz = (d * z).sum(1)
-    hv = d - dz[:, None] * z
-    h = np.sqrt((hv * hv).sum(1))
+    dz = (d * z).sum(-1)
+    hv = d - dz[..., None] * z
+    h = np.sqrt((hv * hv).sum(-1))
     vx = h - r
     D2 = vx * vx + dz * dz
     lc = np.sqrt(D2 - r * r)
     cx = (r * vx - lc * dz) / D2
     cz = (r * dz + lc * vx) / D2
-    e = ((r * (1.0 + cx) / h)[:, None] * hv + (r * cz)[:, None] * z - d) / lc[:, None]
+    e = ((r * (1.0 + cx) / h)[..., None] * hv + (r * cz)[..., None] * z - d) / lc[..., None]
     return e, r * (np.pi - np.arctan2(cz, cx)) + lc, bw

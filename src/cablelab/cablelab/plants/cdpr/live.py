@@ -15,10 +15,11 @@ import numpy as np
 
 from .description import CdprDescription
 from .control import PdffConfig, pdff_torques
-from .estimation import mass_com_from_wrench, tensions_from_torques
+from .estimation import mass_com_from_wrench, tensions_from_torques, winch_friction
 from .geometry import pose_geometry, quat_to_matrix, wrench_matrix
 
-__all__ = ["EstimatorConfig", "LiveEstimator", "ControllerConfig", "LiveController"]
+__all__ = ["EstimatorConfig", "LiveEstimator", "ControllerConfig", "LiveController", "ReferenceTerms",
+           "ReferencePlan"]
 
 OK, WARN, ERROR = 0, 1, 2
 
@@ -90,6 +91,10 @@ def _feedforward_one(W: np.ndarray, mass: float, acc: np.ndarray, gravity: float
     else:
         t = preload + pinv @ rhs
     return np.maximum(t, min_tension)
+
+
+def _stale_mass(nominal: float) -> tuple[int, str]:
+    return (WARN, f"live mass estimate stale or missing: nominal mass {nominal:.0f} kg in the feedforward")
 
 
 def _is_identity(q: np.ndarray) -> bool:
@@ -264,6 +269,37 @@ class ReferenceTerms:
     status: list
 
 
+@dataclass(frozen=True)
+class ReferencePlan:
+    """What :meth:`LiveController.plan` computed for N reference stamps at once (level platform):
+    the terms of the law that depend on the reference only, not on the motor state nor on the
+    live estimate, so that a control loop whose reference is known ahead does the geometry and
+    the W^+ of eq. 14 vectorised over a block of periods instead of once per period.
+
+    With ``q_d``, ``q_d'`` the IGM and rates of :meth:`LiveController.prepare` and
+    ``M = W^T (W W^T)^-1`` (n, 6) the right inverse of W, 001 eq. 14 for a mass m and CoM
+    (c_x, c_y, 0) is ``max(t_p + M (w - t_p W 1), t_min)`` with w = m [f; c x f], f = a + g: linear
+    in (1, m, m c_x, m c_y) with the rows of ``ff`` (base = t_p - t_p M W 1, then M [f; 0],
+    M [0; (0, -f_z, f_y)], M [0; (f_z, 0, -f_x)]).
+
+    Attributes (N stamps, n cables): ``t`` (N,) stamps, s; ``reference`` the (position, velocity,
+    acceleration) rows it was made from; ``valid`` (N,) False where the reference position is not
+    finite (the law then takes the per-sample path, which says why); ``pd``
+    (N, n) ``kp q_d + kd q_d'``; ``friction`` (N, n) the friction compensation of eq. 15 on q_d';
+    ``ff`` (N, 4, n) the feedforward rows above (None for PD).
+    """
+
+    t: np.ndarray
+    reference: tuple
+    valid: np.ndarray
+    pd: np.ndarray
+    friction: np.ndarray
+    ff: np.ndarray | None
+
+    def __len__(self) -> int:
+        return len(self.t)
+
+
 @dataclass
 class LiveController:
     """Motor torques from the latest motor state, reference and (optional) live estimate."""
@@ -277,6 +313,20 @@ class LiveController:
     _t_est: float | None = None
     _t_filter: float | None = None
 
+    def __post_init__(self):
+        d = self.desc        # the description's arrays, built once (its properties build them per call)
+        self._exit, self._anchor, self._swivel = d.exit_points, d.anchor_points, d.swivel_axes
+        self._anchor_reach = 2.0 * np.abs(self._anchor[:, :2]).max()
+        self._coef = np.zeros(4)            # (1, m, m c_x, m c_y) of the planned feedforward
+        self._coef_key = None
+        self._stale = None                  # (nominal mass, its status line)
+
+    def _model_radius(self) -> float:
+        cfg = self.config
+        if cfg.model == "I":
+            return 0.0
+        return cfg.gains.pulley_radius if cfg.gains.pulley_radius is not None else self.desc.pulley_radius
+
     def estimate(self, t: float, mass: float, com=None) -> bool:
         """Feed one live estimate (stamp t); rejected (False) when invalid. A CoM that is not
         finite or lies farther from the platform origin than twice its farthest cable anchor (in
@@ -286,7 +336,7 @@ class LiveController:
         if not np.isfinite(mass) or not (lo * nom <= mass <= hi * nom):
             return False
         c = np.zeros(2) if com is None else np.asarray(com, float)[:2]
-        if not np.all(np.isfinite(c)) or np.abs(c).max() > 2.0 * np.abs(self.desc.anchor_points[:, :2]).max():
+        if not np.all(np.isfinite(c)) or np.abs(c).max() > self._anchor_reach:
             c = self.com
         if self.mass is None or self._t_filter is None:
             self.mass, self.com = float(mass), c
@@ -327,12 +377,10 @@ class LiveController:
         R = None
         if quat is not None and not _is_identity(np.asarray(quat, float)):
             R = quat_to_matrix(np.asarray(quat, float))
-        r = 0.0 if cfg.model == "I" else (cfg.gains.pulley_radius if cfg.gains.pulley_radius is not None
-                                           else d.pulley_radius)
         if geometry is not None:
             dirs, L, b = geometry.directions[0], geometry.lengths[0], geometry.anchors[0]
         else:
-            dirs, L, b = pose_geometry(d.exit_points, d.anchor_points, p, R, r, d.swivel_axes)
+            dirs, L, b = pose_geometry(self._exit, self._anchor, p, R, self._model_radius(), self._swivel)
         k = d.gear_ratio / d.drum_radius
         q_des = -k * L                                    # control.motor_angles
         qd_des = k * (dirs @ v)                           # control.motor_rates (no angular velocity)
@@ -343,8 +391,7 @@ class LiveController:
                 m, com = self.mass, self.com
             else:
                 m, com = cfg.nominal_mass, np.zeros(2)
-                self.status.append((WARN, "live mass estimate stale or missing: nominal mass "
-                                    f"{m:.0f} kg in the feedforward"))
+                self.status.append(_stale_mass(m))
             c3 = (com[0], com[1], 0.0) if cfg.use_com else None
             W = wrench if wrench is not None else _wrench_one(dirs, b)
             t_ff = _feedforward_one(W, m, a, self.gravity, c3, cfg.gains.preload, cfg.gains.min_tension,
@@ -367,3 +414,93 @@ class LiveController:
         if not self.status:
             self.status.append((OK, "PDFF" if self.config.feedforward else "PD"))
         return tau
+
+    def plan(self, t, position, velocity=None, acceleration=None) -> ReferencePlan:
+        """The reference terms of N stamps ``t`` (N,) of a level platform at once (:class:`ReferencePlan`):
+        :meth:`prepare`'s arithmetic vectorised over the stamps, without the live estimate.
+        ``position``, ``velocity``, ``acceleration``: (N, 3); a velocity or acceleration row that
+        is not finite counts as zero, as in :meth:`prepare`."""
+        cfg, d, g = self.config, self.desc, self.config.gains
+        t = np.asarray(t, float)
+        reference = (position, velocity, acceleration)
+        p = np.asarray(position, float).reshape(-1, 3)
+        valid = np.isfinite(p).all(1)
+        p = np.where(valid[:, None], p, 0.0)
+
+        def rows(x):
+            if x is None:
+                return np.zeros_like(p)
+            x = np.asarray(x, float).reshape(-1, 3)
+            return np.where(np.isfinite(x).all(1)[:, None], x, 0.0)
+
+        v, a = rows(velocity), rows(acceleration)
+        dirs, L, b = pose_geometry(self._exit, self._anchor, p[:, None, :], None, self._model_radius(), self._swivel)
+        k = d.gear_ratio / d.drum_radius
+        q_des = -k * L
+        qd_des = k * np.einsum("tni,ti->tn", dirs, v)
+        pd = g.kp * q_des + g.kd * qd_des
+        friction = winch_friction(qd_des, g.coulomb, g.viscous)
+        ff = None
+        if cfg.feedforward:
+            W = np.empty((len(p), 6, dirs.shape[1]))
+            W[:, :3] = dirs.transpose(0, 2, 1)                 # _wrench_one on every stamp
+            W[:, 3] = b[:, 1] * dirs[..., 2] - b[:, 2] * dirs[..., 1]
+            W[:, 4] = b[:, 2] * dirs[..., 0] - b[:, 0] * dirs[..., 2]
+            W[:, 5] = b[:, 0] * dirs[..., 1] - b[:, 1] * dirs[..., 0]
+            M = np.linalg.solve(W @ W.transpose(0, 2, 1), W).transpose(0, 2, 1)     # (N, n, 6)
+            f = a + np.array([0.0, 0.0, self.gravity])
+            zero = np.zeros(len(p))
+            ff = np.empty((len(p), 4, W.shape[2]))
+            ff[:, 0] = g.preload - g.preload * np.einsum("tij,tj->ti", M, W.sum(2))
+            ff[:, 1] = np.einsum("tij,tj->ti", M[..., :3], f)
+            ff[:, 2] = np.einsum("tij,tj->ti", M[..., 3:], np.stack([zero, -f[:, 2], f[:, 1]], 1))
+            ff[:, 3] = np.einsum("tij,tj->ti", M[..., 3:], np.stack([f[:, 2], zero, -f[:, 0]], 1))
+        return ReferencePlan(t, reference, valid, pd, friction, ff)
+
+    def planned_law(self, plan: ReferencePlan, i: int, q, qdot):
+        """Torques (n,) N m for row ``i`` of ``plan`` and the measured motor state: what
+        :meth:`prepare` then :meth:`law` give for that stamp, to round-off, with a few operations
+        on (n,) arrays (the control loop's per-period path). A row that is not valid, or a motor
+        state that is not two finite float (n,) arrays, takes :meth:`prepare` and :meth:`law`
+        (which check and say why)."""
+        cfg, g = self.config, self.config.gains
+        n = plan.pd.shape[1]
+        t = float(plan.t[i])
+        if (not plan.valid[i] or type(q) is not np.ndarray or type(qdot) is not np.ndarray
+                or q.shape != (n,) or qdot.shape != (n,) or q.dtype != float or qdot.dtype != float
+                or not np.isfinite(q @ qdot)):
+            # (q . q' is finite exactly when every term is, barring overflow, which also lands here)
+            p, v, a = (None if x is None else x[i] for x in plan.reference)
+            ref = self.prepare(t, p, None, v, a)
+            return None if ref is None else self.law(ref, q, qdot)
+        k = self.desc.drum_radius / self.desc.gear_ratio
+        tau = plan.pd[i] - g.kp * q
+        tau -= g.kd * qdot
+        if plan.ff is not None:
+            fresh = self._t_est is not None and t - self._t_est <= cfg.estimate_timeout
+            if fresh:
+                m, com = self.mass, self.com
+                key = (m, com[0], com[1]) if cfg.use_com else (m, 0.0, 0.0)
+            else:
+                key = (cfg.nominal_mass, 0.0, 0.0)
+            if key != self._coef_key:
+                m, cx, cy = key
+                self._coef[:] = (1.0, m, m * cx, m * cy)
+                self._coef_key = key
+            t_ff = self._coef @ plan.ff[i]
+            np.maximum(t_ff, g.min_tension, out=t_ff)
+            t_ff *= k
+            tau += t_ff
+            if fresh:
+                self.status = [(OK, "PDFF")]
+            else:
+                if self._stale is None or self._stale[0] != cfg.nominal_mass:
+                    self._stale = (cfg.nominal_mass, _stale_mass(cfg.nominal_mass))
+                self.status = [self._stale[1]]
+        else:
+            self.status = [(OK, "PD")]
+        np.maximum(tau, k * g.min_tension, out=tau)
+        tau += plan.friction[i]
+        np.maximum(tau, -g.max_torque, out=tau)
+        return np.minimum(tau, g.max_torque, out=tau)
+

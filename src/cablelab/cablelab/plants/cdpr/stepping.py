@@ -1,7 +1,9 @@
 """When the CDPR simulator node steps and with which torques (ROS-free).
 
 :class:`SimStepper` is the ``cable_sim_node``'s law over time: real time (``due``: the steps the
-wall clock says are due, catching up at most 20 at once) or lock-step (a step as soon as the
+wall clock says are due, catching up at most 20 at once; the step a command answering the last
+state drives computed as soon as that answer came, ``step_ahead``, so that its deadline only
+publishes the state) or lock-step (a step as soon as the
 command answering the last published state arrived, or after ``lockstep_timeout`` s wall without
 one); without a fresh command the winch brakes hold (:class:`~.hardware.WinchBrakes` inside
 :class:`~.hardware.SimulatedCdpr`); a scheduled mass change; the reference stamps published
@@ -75,7 +77,8 @@ class SimStepper:
         self.stale_command_steps = 0
         self.missed_steps = 0       # steps with any of: late, braked, stale command (each once)
         self.command_age = [0, 0, 0]   # steps whose command answers the state 1, 2, >= 3 periods back
-        self.k = 0
+        self.k = 0                  # steps computed
+        self.ahead = False          # the last step was computed ahead of its deadline (step_ahead)
         self.done = False
         self.last_publish = 0.0     # wall time of the last published state
         self._wall0 = None          # wall time of sim time 0 (real time)
@@ -115,17 +118,39 @@ class SimStepper:
     def due(self, now: float) -> int:
         """Real time: the steps due at wall time ``now`` (the first on time, the rest late; at most
         :data:`MAX_CATCH_UP`, those further behind dropped and counted)."""
+        published = self.k - self.ahead     # a step computed ahead is due at its deadline
         if self._wall0 is None:
-            self._wall0 = now - self.k / self.rate
-        due = int((now - self._wall0) * self.rate) - self.k
+            self._wall0 = now - published / self.rate
+        due = int((now - self._wall0) * self.rate) - published
         if self.commands and due > 1:
             self.late_steps += min(due, MAX_CATCH_UP) - 1   # ran at least one period after they were due
         if due > MAX_CATCH_UP - 1:                          # far behind: do not try to catch up forever
             if self.commands:
                 self.dropped_steps += due - MAX_CATCH_UP
-            self._wall0 = now - self.k / self.rate
+            self._wall0 = now - published / self.rate
             due = MAX_CATCH_UP
         return max(0, due)
+
+    def time_left(self, now: float) -> float:
+        """Real time: s of wall time from ``now`` to the deadline of the next state to publish
+        (inf before the first :meth:`due`)."""
+        if self._wall0 is None:
+            return float("inf")
+        return self._wall0 + (self.k - self.ahead + 1) / self.rate - now
+
+    def step_ahead(self, now: float) -> bool:
+        """Real time: when the last command answers the last published state, the step it drives
+        (the same step the deadline would run: the answer applied from that state's sim time on)
+        is computed now, as soon as the answer came; its state is published at its deadline
+        (:meth:`due` counts it there as the first step due, :attr:`ahead` until then). The
+        deadline then only publishes. False (nothing done) when the last command answers
+        another state (or does not say which), or a step is already ahead, or :attr:`done`."""
+        if not self.real_time or self.ahead or self.done or self.u_stamp is None \
+                or abs(self.u_stamp - self.sim.time) >= 0.5 / self.rate:
+            return False
+        self.step(now, fresh=True)
+        self.ahead = True
+        return True
 
     def steps_due(self, now: float) -> int:
         """The steps the node's timer runs at wall time ``now``: :meth:`due` in real time, one in
@@ -179,6 +204,7 @@ class SimStepper:
         """The state of the present sim time went out at wall time ``now``."""
         self.last_publish = now
         self.commands_at_pub = self.commands
+        self.ahead = False
 
     def reference_stamps(self, t: float) -> tuple[list[float], list[float]]:
         """Stamps of the reference samples to publish (before, after) the state of stamp ``t``:

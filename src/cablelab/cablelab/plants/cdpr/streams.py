@@ -117,7 +117,7 @@ class CommandStream:
     """Commands of motor states at the reference (and, awaited, the estimate) of their stamp.
 
     The reference of the next stamp is prepared (:meth:`prepare_next`) after a command, off the
-    state -> command path; a new estimate invalidates what was prepared with the previous mass.
+    state -> command path; a new estimate prepares it again at once with the new mass.
 
     Args:
         feedforward: PDFF (False: PD).
@@ -154,7 +154,11 @@ class CommandStream:
         if mass is None or self.controller is None:
             return
         if self.controller.estimate(t, mass, com[:2]):
-            self.prepared = None        # prepared with the previous mass: prepare anew
+            # prepared with the previous mass: prepared anew now, off the state -> command path
+            old, self.prepared = self.prepared, None
+            ref = None if old is None else self.refs.at(old.t)
+            if ref is not None:
+                self._prepare(ref)
         else:
             self.estimates_rejected += 1
 
@@ -199,9 +203,13 @@ class CommandStream:
         if self.controller is None or self.estimate_wait > 0 or not np.isfinite(t):
             return
         nxt = self.refs.after(t)
-        if nxt is None or self.prepared_for(nxt[0]) is not None:
-            return
-        stamp, (pos, quat, vel, acc) = nxt
+        if nxt is not None and self.prepared_for(nxt[0]) is None:
+            self._prepare(nxt)
+
+    def _prepare(self, ref) -> None:
+        """Prepare the reference terms of ``ref`` = (stamp, (position, quat, velocity,
+        acceleration)) with the present estimate."""
+        stamp, (pos, quat, vel, acc) = ref
         self.prepared = self.controller.prepare(stamp, pos, quat, vel, acc)
 
     def report(self, level: int, msg: str, values: dict, mode: str, commands: int) -> tuple[int, str, dict]:

@@ -144,3 +144,12 @@ class ReferenceTable:
             return pos[-1], vel[-1], acc[-1]
         tr = pick_and_place(np.array([max(0.0, t - self.settle) * self.speed]))
         return tr.position[0], tr.velocity[0] * self.speed, tr.acceleration[0] * self.speed ** 2
+
+    def rows(self, k0: int, count: int):
+        """(stamps (count,) s, positions, velocities, accelerations (count, 3)) of the grid stamps
+        ``(k0 + j) / rate``, j < count: :meth:`at` of each, as arrays (rows past the table hold
+        its last row)."""
+        k = np.minimum(np.arange(k0, k0 + count), len(self._table[0]) - 1)
+        k = np.maximum(k, 0)
+        pos, vel, acc = self._table
+        return np.arange(k0, k0 + count) / self.rate, pos[k], vel[k], acc[k]

@@ -107,7 +107,7 @@ class CdprControlLoop(ControlLoopNode):
         self.n = len(c.cables)
         self.reference = ReferenceTable(self.rate, v.settle, v.trajectory_speed)
         self.law = ReferenceLaw(LiveController(c, desc.gravity, controller_config(v, c.platform_mass)),
-                                self.reference.at)
+                                self.reference.at, self.reference.rows, self.rate)
         self.extras_every = v.extras_every
         self.hardware = hardware = self._hardware(v.hardware, desc)
         self.simulated = isinstance(hardware, SimulatedCdpr)
@@ -148,7 +148,7 @@ class CdprControlLoop(ControlLoopNode):
             self.estimates_rejected += 1
 
     def after_cycle(self, state) -> None:
-        self.law.prepare_next(state.t + 1.0 / self.rate)
+        self.law.prepare_next(state.t + 1.0 / self.rate, spare=not self.loop.behind())
 
     def extend_status(self, level, msg, values):
         level, msg, values = super().extend_status(level, msg, values)

@@ -43,18 +43,23 @@ class CdprController(PlantNode):
         self.inputs.add("payload_estimate", timeout=v.estimate_timeout, length=1, required=False)
         self.pub_cmd = self.create_publisher(Float64MultiArray, topics.EFFORT_COMMANDS, publisher_qos())
         self.listen_for_description(v.description, keep_first=True)     # it configures the law
-        # 1 kHz inputs as bytes in deep queues (a busy moment delays samples, drops none). Only a
-        # state wakes the node: the reference (published before its state) and the estimate wait
-        # queued until a state or the timer takes them; an awaited estimate still wakes it
+        # the reference and the estimate as bytes in deep queues (a busy moment delays samples,
+        # drops none); they wake nobody: the reference (published before its state) and the
+        # estimate wait queued until a state or the timer takes them (an awaited estimate still
+        # wakes the node). The states keep-last 1: after a busy moment the newest state is
+        # answered, not a backlog whose commands the simulator would only count as stale
         q = stream_qos(1000)
         self.subscribe(MultiDOFJointTrajectory, topics.REFERENCE, self.on_reference, q, raw=True, polled=True)
         self.subscribe(InertiaStamped, topics.PAYLOAD_ESTIMATE, self.on_estimate, q,
                        polled=not self.stream.awaits_estimate)
-        self.create_subscription(JointState, topics.JOINT_STATES, self.on_state, q, raw=True)
+        self.create_subscription(JointState, topics.JOINT_STATES, self.on_state, stream_qos(1), raw=True)
         self.player = self.play_reference(v.reference_bag, topics.REFERENCE, ("x", "y", "z"), platform=True)
-        self.create_timer(0.002, self.on_timer)
+        self._state_wall = -1.0     # wall time of the last state taken
+        self.timer = self.create_timer(0.002, self.on_timer)
         self.use_fast_executor()
         self.start_diagnostics()
+        # /diagnostics runs after a command or from the timer, never between a state and its command
+        self.defer_timers(t for t in self.timers if t is not self.timer)
 
     @property
     def controller(self):
@@ -85,22 +90,31 @@ class CdprController(PlantNode):
         here, else a little later (:meth:`on_timer`: DDS does not order samples across topics).
         The queued reference and estimate are taken after the command when the reference terms
         were prepared ahead (:meth:`CommandStream.prepare_next <cablelab.plants.cdpr.streams.
-        CommandStream.prepare_next>`): the state -> command path stays short."""
+        CommandStream.prepare_next>`), then a due /diagnostics: the state -> command path stays
+        short."""
         state = self.decode_raw("joint_states", JointState, msg)
         if state is None:
             return
+        self._state_wall = now = time.monotonic()
         if self.player is not None and math.isfinite(state[0]):
             self.player(state[0], ())        # the designed reference of this stamp, published first
         if self.stream.needs_inputs_first(state[0]):
             self.take_polled()          # the reference and estimate that came before it
-        self.stream.state(state, time.monotonic())
+        self.stream.state(state, now)
         self.command(self.stream.ready())
         self.take_polled()              # then prepare the next stamp's terms, off this path
         self.stream.prepare_next(state[0])
+        self.run_deferred()
 
     def on_timer(self) -> None:
-        self.take_polled()
-        self.command(self.stream.ready(time.monotonic()))
+        """A state still waiting for the reference (or the awaited estimate) of its stamp is
+        commanded once they came or it waited long enough; while states flow, their own callback
+        takes the queued inputs and the timer only runs a due /diagnostics."""
+        now = time.monotonic()
+        if self.stream.pending is not None or now - self._state_wall > 0.01:
+            self.take_polled()
+            self.command(self.stream.ready(now))
+        self.run_deferred()
 
     def command(self, state) -> None:
         """One command for ``state`` = (t, names, position, velocity, effort), if any."""

@@ -76,10 +76,14 @@ class CdprOutputs:
         self.pub_ref.publish(self.t_ref.data())
 
     def joints(self, t: float, angle, rate, torque) -> None:
+        self.pub_js.publish(self.joint_bytes(t, angle, rate, torque))
+
+    def joint_bytes(self, t: float, angle, rate, torque) -> bytes:
+        """The serialised joint states (motor angles, rates, torques of the winches) of stamp ``t``."""
         js = self.t_js
         js.stamp(t)
         js["position"][:], js["velocity"][:], js["effort"][:] = angle, rate, torque
-        self.pub_js.publish(js.data())
+        return js.data()
 
     def tensions(self, t: float, tension, length=None) -> None:
         ten = self.t_ten
@@ -94,20 +98,35 @@ class CdprOutputs:
 
     def simulator_sample(self, stepper, pose: bool = True, extras: bool = True) -> None:
         """One sample of the simulator node (a :class:`~cablelab.plants.cdpr.stepping.SimStepper`
-        at its present sim time): the reference samples due before the state, the joint states
-        and cable tensions, the reference samples due after it, then, with ``extras``, /clock, the
-        measured pose (``pose``) and the ground truth (off the controller's path)."""
+        at its present sim time), all of it now: :meth:`state_sample`, its joint states
+        published, then :meth:`rest_sample`."""
+        joints, rest = self.state_sample(stepper, pose, extras)
+        self.pub_js.publish(joints)
+        self.rest_sample(rest)
+
+    def state_sample(self, stepper, pose: bool = True, extras: bool = True) -> tuple[bytes, tuple]:
+        """The measurements at the stepper's present sim time: the reference samples due before
+        the state are published, the joint states are serialised (``joints``: the bytes to
+        publish on :attr:`pub_js`); ``rest`` is what :meth:`rest_sample` publishes after them
+        (cable tensions, the reference samples due after the state, and with ``extras`` /clock,
+        the measured pose (``pose``) and the ground truth: off the controller's path)."""
         sim, t = stepper.sim, stepper.sim.time
         ms = sim.measure()
         before, after = stepper.reference_stamps(t)
         for tr in before:
             self.reference(tr, *stepper.reference.at(tr))
-        self.joints(t, ms["motor_angle"], ms["motor_velocity"], ms["motor_torque"])
-        self.tensions(t, ms["tension"], ms["cable_length"])
-        for tr in after:
-            self.reference(tr, *stepper.reference.at(tr))
-        if extras:
-            self.extras(t, (ms["position"], ms["quat"]) if pose else None, sim.truth_pose())
+        rest = (t, ms["tension"], ms["cable_length"], [(tr, stepper.reference.at(tr)) for tr in after],
+                ((ms["position"], ms["quat"]) if pose else None, sim.truth_pose()) if extras else None)
+        return self.joint_bytes(t, ms["motor_angle"], ms["motor_velocity"], ms["motor_torque"]), rest
+
+    def rest_sample(self, rest: tuple) -> None:
+        """Publish the ``rest`` of a :meth:`state_sample`."""
+        t, tension, length, refs, extras = rest
+        self.tensions(t, tension, length)
+        for tr, ref in refs:
+            self.reference(tr, *ref)
+        if extras is not None:
+            self.extras(t, *extras)
 
     def extras(self, t: float, pose=None, truth=None) -> None:
         """/clock, the measured pose ``(position, quat wxyz)`` and the ground truth pose (and

@@ -3,10 +3,16 @@ pulleys, friction winches) driven by ``/cdpr/effort_commands``.
 
 Publishes the winch joint states, the cable tensions, the measured pose, the pick-and-place
 reference of 001 sec. II-C, the ground truth, ``/clock`` and ``/plant_description`` (CONTRACT sec.
-2; pre-serialised, :meth:`.outputs.CdprOutputs.simulator_sample`). When it steps and with which
-torques (real time at ``rate`` Hz, or lock-step with the controller as fast as possible; without a
-fresh command the winch brakes hold) is :class:`cablelab.plants.cdpr.stepping.SimStepper`; brakes
-and slack cables are WARN on /diagnostics. Parameters: :data:`.parameters.SIM`.
+2; pre-serialised, :class:`.outputs.CdprOutputs`). When it steps and with which torques (real time
+at ``rate`` Hz, or lock-step with the controller as fast as possible; without a fresh command the
+winch brakes hold) is :class:`cablelab.plants.cdpr.stepping.SimStepper`; brakes and slack cables
+are WARN on /diagnostics. Parameters: :data:`.parameters.SIM`.
+
+Real time, a deadline publishes the joint states and little else: a command that answers the last
+state wakes the node, which computes the step it drives at once (``SimStepper.step_ahead``), then
+publishes the rest of the last sample (tensions, reference, /clock, pose, truth) and runs a due
+/diagnostics or 3D view, while the controller works on its next terms; without such an answer the
+deadline steps with the last command as before and publishes everything.
 """
 from __future__ import annotations
 
@@ -41,26 +47,38 @@ class CdprSimNode(PlantNode):
         if not self.real_time and v.rt_priority > 0:
             self.get_logger().warning("rt_priority ignored: lock-step mode runs as fast as possible")
         self.use_fast_executor()
-        # real time: the commands wait queued (keep-last 1) until the step that applies them takes
-        # the newest (one wake-up per step, the timer's); lock-step: a command wakes the node
-        self.command_input(topics.EFFORT_COMMANDS, self.sim.n, v.command_timeout, stream_qos(1)
-                           if self.real_time else stream_qos(), raw=True, polled=self.real_time)
+        self.ready = None           # (joint state bytes, rest, s of work) of a step computed ahead
+        self.rest = None            # the rest of the last published sample, still to publish
+        # a command wakes the node (keep-last 1: the newest; the fast executor takes it before a
+        # deadline of the same wake-up)
+        self.command_input(topics.EFFORT_COMMANDS, self.sim.n, v.command_timeout,
+                           stream_qos(1) if self.real_time else stream_qos(), raw=True)
         self.start_stepping(1.0 / v.rate if self.real_time else 0.0002, topics.MARKERS,
                             lambda: sim_markers(self.description, self.sim), lambda: self.sim.time,
                             v.markers_rate)
+        # /diagnostics and the 3D view run after a step or an answer, never just before a deadline
+        self.defer_timers(t for t in self.timers if t is not self.timer)
 
     @property
     def done(self) -> bool:
-        return self.stepper.done
+        return self.stepper.done and not self.stepper.ahead
 
     def extend_status(self, level, msg, values):
         return self.stepper.report(level, msg, values)
 
     def on_command(self, msg: Float64MultiArray) -> None:
-        """An effort command (serialised bytes, :func:`~cablelab.ros.rawmsg.command_arrays`)."""
+        """An effort command (serialised bytes, :func:`~cablelab.ros.rawmsg.command_arrays`); in
+        real time, the answer to the last state computes the step it drives now, then the rest of
+        the last sample goes out."""
         cmd = self.decode("effort_commands", rawmsg.command_arrays, msg)
         if cmd is not None and self.accept("effort_commands", cmd[0]):
             self.stepper.command(*cmd)
+            if self.real_time and not (self.wait_subs and self.stepper.k == 0):
+                self.step_ahead()
+        if self.real_time and self.rest is not None:
+            self.publish_rest()
+            if self.stepper.time_left(time.monotonic()) * self.stepper.rate > 0.5:
+                self.run_deferred()
 
     def mass_changed(self, kg: float) -> None:
         self.out.payload(self.sim.truth.total_mass, self.sim.truth.total_com)
@@ -68,25 +86,69 @@ class CdprSimNode(PlantNode):
 
     def tick(self) -> None:
         """Timer: the start gate, then :meth:`SimStepper.steps_due <cablelab.plants.cdpr.stepping.
-        SimStepper.steps_due>` steps (real time: the first on time, the rest late)."""
+        SimStepper.steps_due>` states published (real time: the first on time, the rest late; the
+        first one computed ahead if its answer came), then, unless the rest of the sample waits
+        for the answer, a due deferred timer (/diagnostics or the 3D view)."""
+        self.advance()
+        if self.rest is None:
+            self.run_deferred()
+
+    def advance(self) -> None:
         if self.stepper.k == 0 and self.wait_subs:
             if self.waiting_for_subscribers(self.out.pub_js, self.stepper.last_publish, self.publish_state):
                 return
             self.publish_state()
-        self.take_polled(newest=True)      # the newest command (real time)
         for i in range(self.stepper.steps_due(time.monotonic())):
-            self.step_once(late=i > 0)
+            if self.stepper.ahead:
+                self.publish_ready()
+            else:
+                self.step_once(late=i > 0)
             if self.done:
                 return
 
     def step_once(self, late: bool = False) -> None:
+        """The step due now, with the last command (or the brakes), and its whole sample."""
         t0, now = time.perf_counter(), time.monotonic()
         if self.stepper.step(now, self.inputs.fresh("effort_commands", now), late):
-            self.publish_state()
-            self.latency.since(t0)
+            self.ready = (*self.out.state_sample(self.stepper, self.publish_pose, self.extras()), 0.0)
+            self.publish_ready(t0)
+
+    def step_ahead(self) -> None:
+        """The step the answer to the last state drives, computed now; its state waits for its
+        deadline (:meth:`publish_ready`)."""
+        t0 = time.perf_counter()
+        if self.stepper.step_ahead(time.monotonic()):
+            joints, rest = self.out.state_sample(self.stepper, self.publish_pose, self.extras())
+            self.ready = (joints, rest, time.perf_counter() - t0)
+
+    def publish_ready(self, t0: float | None = None) -> None:
+        """Publish the joint states of the step computed last (its deadline came), then the rest
+        of the sample before it if still unpublished; the rest of this one waits for the answer
+        when the step was computed ahead (the controller keeps up), else goes out now. The
+        latency is the step's work: computing it and publishing its state."""
+        t1 = time.perf_counter() if t0 is None else t0
+        joints, rest, work = self.ready
+        ahead = self.stepper.ahead
+        self.ready = None
+        self.out.pub_js.publish(joints)
+        self.stepper.published(time.monotonic())
+        self.latency.add(work + time.perf_counter() - t1)
+        if self.rest is not None:
+            self.publish_rest()
+        self.rest = rest
+        if not ahead:
+            self.publish_rest()
+
+    def publish_rest(self) -> None:
+        rest, self.rest = self.rest, None
+        self.out.rest_sample(rest)
+
+    def extras(self) -> bool:
+        return self.stepper.k % self.extras_every == 0
 
     def publish_state(self) -> None:
-        self.out.simulator_sample(self.stepper, self.publish_pose, self.stepper.k % self.extras_every == 0)
+        """The whole sample of the present sim time, now (the start and the start gate's probe)."""
+        self.out.simulator_sample(self.stepper, self.publish_pose, self.extras())
         self.stepper.published(time.monotonic())
 
 
