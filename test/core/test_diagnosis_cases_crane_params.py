@@ -7,7 +7,10 @@ effort noise with outliers, rests) through bag -> cablelab.workbench.load -> dia
   hoist accelerations, and m carries into the luff gravity torque; with m free the same record
   gives OF[luff], OF[hoist] 40 % off and the diagnosis flags them as confounded with m.
 * Base tilt as two angles (tilt_x, tilt_y) scaled by the described masses, also on a nearly
-  balanced boom (boom-side moment K ~ 0, where only the payload carries the tilt).
+  balanced boom (boom-side moment K ~ 0, where only the payload's swing carries the tilt: on the
+  30 s record the quoted standard errors are 7-9 % of the angles, so that case is held to 8 %
+  and to the 3-stderr coverage). The model is exact in the angles (the vertical gravity's
+  cos|tilt| included), so no torque-sensor offset is added beside the tilt.
 Quoted standard errors must cover the truth (|error| < 3 stderr per parameter).
 """
 import os
@@ -74,6 +77,6 @@ def test_crane_base_tilt_angles(tmp_path, seed):
         - tr["counterbalance_distance"] * tr["counterbalance_mass"]
     assert (abs(K) > 0.5) if seed == 1 else (abs(K) < 0.05)     # seed 6: a nearly balanced boom
     out = _run(case, tmp_path)
-    _assert_params(out, case, rel=0.02 if seed == 1 else 0.06)
+    _assert_params(out, case, rel=0.02 if seed == 1 else 0.08)
     tilt = np.hypot(*[case.true_params["base_tilt"][k] for k in ("tilt_x", "tilt_y")])
     assert np.radians(1.0) < tilt < np.radians(4.5)

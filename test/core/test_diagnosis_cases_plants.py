@@ -120,7 +120,7 @@ def test_suspended_hidden_pose_offset_significant(tmp_path):
 
 
 # time delay: the measured efforts / tensions lag the motion by tau (interpolated in the generator)
-def _assert_delay(out, case):
+def _assert_delay(out, case, se_share=0.1):
     first = out["ranking"][0]
     assert first["effect"] == "time_delay" and first["significant"], out["ranking"][:2]
     assert [g["added"] for g in out["greedy"][1:]] == ["time_delay"]
@@ -128,13 +128,15 @@ def _assert_delay(out, case):
     true = case.true_params["time_delay"]["tau"]
     assert abs(tau - true) < 0.15 * true, (tau, true)
     # a finite, honest uncertainty: positive, small against tau, and the error within 5 stderr
-    assert 0.0 < se < 0.1 * true and abs(tau - true) < 5 * se + 1e-4, (tau, se, true)
+    assert 0.0 < se < se_share * true and abs(tau - true) < 5 * se + 1e-4, (tau, se, true)
 
 
 def test_crane_hidden_time_delay_found_with_tau_and_its_stderr(tmp_path):
     case = _case(cases_crane, 2, "one", duration=30.0)
     assert case.hidden == ("time_delay",) and case.fs == 100.0
-    _assert_delay(_diagnose(cases_crane, case, tmp_path), case)
+    # the crane's parallel filter (efforts and columns at 3 Hz) leaves one independent residual
+    # sample per 1 / (2 x 3 Hz) for the standard errors: on this 30 s record 11 % of tau
+    _assert_delay(_diagnose(cases_crane, case, tmp_path), case, se_share=0.15)
 
 
 def test_cdpr_hidden_time_delay_found_with_tau_and_its_stderr(tmp_path):

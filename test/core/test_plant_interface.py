@@ -143,10 +143,14 @@ def test_cdpr_command_line_options_come_from_its_package():
     declared = dict(cli_options(get_plant("cdpr").options_type))
     assert declared["tensions"].flag == "--tensions" and declared["tensions"].choices == TENSION_SOURCES
     assert declared["pose"].flag == "--pose" and declared["pose"].verbs == ("estimate",)
+    from cablelab.plants.crane.options import CRANE_FILTERS
+
+    crane = dict(cli_options(get_plant("crane").options_type))
+    assert set(crane) == {"crane_filter"} and crane["crane_filter"].choices == CRANE_FILTERS
     for name in PLANTS:
-        if name != "cdpr":
+        if name not in ("cdpr", "crane"):
             assert cli_options(get_plant(name).options_type) == []
-    assert set(plant_cli_options("compare")) == {"--tensions"}
+    assert set(plant_cli_options("compare")) == {"--tensions", "--crane-filter"}
     assert set(plant_cli_options("estimate")) == {"--tensions", "--pose"}
     assert plant_cli_options("estimate")["--pose"][2] == ["cdpr"]
     p = argparse.ArgumentParser()

@@ -35,6 +35,10 @@ class Model:
             regressor): ``"raise"`` refuses with the unidentifiable directions named; ``"hold"``
             holds them at their description value (or the effect's neutral value) and says so
             (:func:`cablelab.fit.identify`, ``Identification.extra["held"]``).
+        at: parameter values by name at which the effects' higher-order output terms
+            (:attr:`~cablelab.effects.base.Effect.higher_order`) are evaluated when the values
+            given to :meth:`evaluate` do not name them: the current estimate of an iterated fit
+            (empty: the parameters' nominal values, where those terms vanish).
     """
 
     plant: str
@@ -42,6 +46,7 @@ class Model:
     fixed: Mapping[str, float] = field(default_factory=dict)
     effect_objects: tuple[Effect, ...] = field(init=False, repr=False, compare=False)
     unexcited: str = "raise"
+    at: Mapping[str, float] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         if self.unexcited not in ("raise", "hold"):
@@ -57,12 +62,24 @@ class Model:
 
     def with_effect(self, effect: "str | Effect") -> "Model":
         """The model with one more effect (an id or an :class:`Effect`)."""
-        return Model(self.plant, self.effect_objects + (effect,), self.fixed, unexcited=self.unexcited)
+        return Model(self.plant, self.effect_objects + (effect,), self.fixed, unexcited=self.unexcited,
+                     at=self.at)
 
     def with_effects(self, effects, fixed: Mapping[str, float] | None = None) -> "Model":
         """The same plant and policy with other effects (and known parameters)."""
         return Model(self.plant, tuple(effects), dict(self.fixed if fixed is None else fixed),
-                     unexcited=self.unexcited)
+                     unexcited=self.unexcited, at=self.at)
+
+    def evaluated_at(self, values: Mapping[str, float]) -> "Model":
+        """The same model with its higher-order output terms evaluated at ``values``
+        (:attr:`at`)."""
+        return Model(self.plant, self.effect_objects, self.fixed, unexcited=self.unexcited,
+                     at=dict(values))
+
+    @property
+    def higher_order(self) -> bool:
+        """Whether an effect of the model has an output term beyond its columns."""
+        return any(e.higher_order is not None for e in self.effect_objects)
 
     def nonlinear_params(self) -> list[Param]:
         return [p for e in self.effect_objects for p in e.nonlinear if p.name not in self.fixed]
@@ -77,13 +94,19 @@ class Model:
         return ds
 
     def regressor(self, ds: Dataset) -> tuple[np.ndarray, list[Param], np.ndarray]:
-        """Free regressor and the known part.
+        """Free regressor and the known part (the effects' higher-order output terms at
+        :attr:`at` and the fixed parameters: :meth:`evaluate` takes other values).
 
         Returns:
             ``(Phi, params, y_known)``: Phi (N, C, p) for the free linear parameters, their
-            :class:`Param` list, and (N, C) the contribution of the fixed parameters; filtered
-            by the dataset's parallel filter when it declares one (``ds.parallel_hz``).
+            :class:`Param` list, and (N, C) the contribution of the fixed parameters and of the
+            effects' higher-order terms; filtered by the dataset's parallel filter when it
+            declares one (``ds.parallel_hz``).
         """
+        return self._regressor(ds, None)
+
+    def _regressor(self, ds: Dataset, values: Mapping[str, float] | None
+                   ) -> tuple[np.ndarray, list[Param], np.ndarray]:
         blocks, cols = [], []
         for e in self.effect_objects:
             blk = e.block(ds)
@@ -109,6 +132,10 @@ class Model:
             phi_known, phi = phi[:, :, known], phi[:, :, free]
         # (every column free: phi, built above, is returned as it is, not copied again)
         nominal = ds.signals.get(KNOWN_OUTPUT)
+        higher = self._higher_order(ds, values)
+        if higher is not None:
+            nominal = higher if nominal is None else \
+                np.asarray(nominal, dtype=float).reshape(ds.n, ds.n_channels) + higher
         if nominal is not None:
             # the plant's own parameter-free prediction (e.g. MuJoCo's inverse dynamics of the
             # given model), filtered like the columns; a copy (the dataset's signal stays its own)
@@ -126,11 +153,21 @@ class Model:
         return phi, [cols[i] for i in free], y_known
 
     def evaluate(self, ds: Dataset, values: Mapping[str, float]) -> "Evaluation":
-        """The model on a dataset at given nonlinear parameter values: the transformed dataset
-        and its regressor, built once (what a fit solves and predicts with)."""
+        """The model on a dataset at given nonlinear parameter values (and linear ones, for the
+        effects' higher-order output terms): the transformed dataset and its regressor, built
+        once (what a fit solves and predicts with)."""
         ds2 = self.apply_nonlinear(ds, values)
-        phi, cols, y_known = self.regressor(ds2)
+        phi, cols, y_known = self._regressor(ds2, values) if self.higher_order else self.regressor(ds2)
         return Evaluation(ds2, phi, cols, y_known)
+
+    def _higher_order(self, ds: Dataset, values: Mapping[str, float] | None) -> np.ndarray | None:
+        """(N, C) sum of the effects' higher-order output terms at ``values`` over :attr:`at`
+        and the fixed parameters (None when no effect has one)."""
+        fns = [e.higher_order for e in self.effect_objects if e.higher_order is not None]
+        if not fns:
+            return None
+        vals = {**self.at, **self.fixed, **dict(values or {})}
+        return sum(np.asarray(fn(ds, vals), dtype=float).reshape(ds.n, ds.n_channels) for fn in fns)
 
     def predict(self, ds: Dataset, params: Mapping[str, float]) -> tuple[np.ndarray, np.ndarray]:
         """Model output (N, C) and the valid mask for given parameter values (by name)."""

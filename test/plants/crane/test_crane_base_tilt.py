@@ -13,7 +13,8 @@ from cablelab.dataset import Dataset
 from cablelab.plants.crane import kinematics as kin
 from cablelab.plants.crane import plant as C
 from cablelab.plants.crane.effects import BASE_TILT, tilt_masses
-from cablelab.plants.crane.model import CraneParams, gravity_vector
+from cablelab.plants.crane.model import CraneParams, gravity_vector, regressor
+from cablelab.model import Model
 from cablelab.plants.crane.mjcf import build_mjcf
 from cablelab.plants.crane.sim import CraneTruth, gravity_in_base, set_state
 
@@ -111,12 +112,30 @@ def test_free_run_truth_takes_the_fitted_angles():
     np.testing.assert_allclose(truth.base_tilt, tilt, atol=1e-12)
 
 
-@pytest.mark.parametrize("tilt,alpha,beta", [((-0.04, 0.03), 0.0, 0.5), ((0.05, 0.046), 1.1, 0.2)])
+def _model_at_rest(q: np.ndarray, tilt_x: float, tilt_y: float) -> np.ndarray:
+    """(N, 3) efforts the crane model with ``base_tilt`` predicts at rest: every parameter at the
+    description's value and the angles (Model.predict: the columns and the effect's higher-order
+    term alike)."""
+    z = np.zeros_like(q)
+    ds = Dataset(plant="crane", t=np.arange(len(q), dtype=float), y=np.zeros((len(q), 3)),
+                 channels=("slew", "luff", "hoist"), units=("N m", "N m", "N"),
+                 signals={"q": q, "Y": regressor(q, z, z, P.gravity), "l_c": P.counterbalance_distance},
+                 description=DESC)
+    known = {"I_tot": P.slew_inertia, "I_b": P.luff_inertia, "m": P.payload_mass, "m_b": P.boom_mass,
+             "m_c": P.counterbalance_mass, "l_c": P.counterbalance_distance}
+    model = Model("crane", C.baseline(DESC) + ("base_tilt",), known)
+    y, _ = model.predict(ds, {"tilt_x": tilt_x, "tilt_y": tilt_y})
+    return y
+
+
+@pytest.mark.parametrize("tilt,alpha,beta", [((-0.04, 0.03), 0.0, 0.5), ((0.05, 0.046), 1.1, 0.2),
+                                             ((0.035, 0.0), -2.3, 0.9)])
 def test_tilt_also_shortens_the_vertical_gravity(tilt, alpha, beta):
-    """base_tilt is first order in the angles: the tilted MuJoCo crane at rest holds exactly the
-    untilted model with the vertical gravity g_z = g cos|tilt| plus the effect, so the first-order
-    model over-predicts the hoist force by m g (1 - cos|tilt|) ~ m g |tilt|^2 / 2 (0.1-0.3 % of the
-    weight at 2-4 degrees): a constant a torque-sensor offset can take up."""
+    """The tilted MuJoCo crane at rest holds exactly the untilted model with the vertical gravity
+    g_z = g cos|tilt| plus the first-order columns: the columns alone over-predict the hoist force
+    by m g (1 - cos|tilt|) ~ m g |tilt|^2 / 2 (0.1-0.3 % of the weight at 2-4 degrees, a constant
+    a torque-sensor offset would take up), and the effect's higher-order term restores it: the
+    model with base_tilt predicts the held efforts to round-off."""
     d = 0.6
     truth, sw, b_all = _held_at_rest(tilt, alpha, beta, d)
     b = b_all[[0, 1, 4]]                        # slew, luff, hoist dofs
@@ -129,3 +148,5 @@ def test_tilt_also_shortens_the_vertical_gravity(tilt, alpha, beta):
     shortfall = P.payload_mass * (P.gravity - abs(g[2]))
     assert abs(first_order[2] - b[2]) == pytest.approx(shortfall, rel=0.05)
     assert shortfall > 0.4 * P.payload_mass * P.gravity * np.hypot(*tilt) ** 2
+    np.testing.assert_allclose(_model_at_rest(q, tx, ty)[0], b, rtol=0,
+                               atol=1e-9 * P.payload_mass * P.gravity)

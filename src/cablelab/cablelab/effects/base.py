@@ -59,6 +59,7 @@ class Physical:
 
 RegressorFn = Callable[[Dataset], np.ndarray]
 TransformFn = Callable[[Dataset, Mapping[str, float]], Dataset]
+HigherOrderFn = Callable[[Dataset, Mapping[str, float]], np.ndarray]
 
 
 @dataclass(frozen=True)
@@ -92,6 +93,13 @@ class Effect:
             are the physical ones.
         requires: a capability the plant must declare (:attr:`cablelab.registry.Plant.
             capabilities`, e.g. ``"joint_actuators"``); ``None`` = no requirement.
+        higher_order: optional ``fn(ds, values) -> (N, C)``: the part of the effect's output
+            that is not linear in its own linear parameters, at the parameter values given by
+            name (those missing: their ``Param.nominal``), small next to the columns' part
+            (e.g. the second-order shortening of the vertical gravity by a base tilt whose
+            columns are first order in the angles). The model adds it to its known part at
+            the current estimate and :func:`cablelab.fit.identify` refits until the estimate
+            settles, so the columns stay linear and the output is exact.
     """
 
     id: str
@@ -108,6 +116,7 @@ class Effect:
     derived: Callable | None = None
     described: Callable | None = None
     physical: Callable | None = None
+    higher_order: HigherOrderFn | None = None
 
     def applies_to(self, plant: str, capabilities=frozenset()) -> bool:
         """Whether the effect applies to ``plant`` with these capabilities."""

@@ -29,6 +29,10 @@ OUTER_GRID = 11
 #: reduces it and the optimiser would otherwise raise its damping through its whole range, one
 #: evaluation per step (about 140 evaluations that all return the start)
 OUTER_STALL = 24
+#: refits of a model whose effects have higher-order output terms (:func:`identify`): at most
+#: this many, until no parameter moves by more than HIGHER_ORDER_TOL of its standard error
+HIGHER_ORDER_STEPS = 8
+HIGHER_ORDER_TOL = 1e-3
 
 
 @dataclass
@@ -207,11 +211,33 @@ def identify(model: Model, ds: Dataset, *, on_deficient: str | None = None,
         CablelabError: too few samples, rank-deficient regressor (names the directions).
     """
     policy = on_deficient or model.unexcited
-    if policy == "hold":
-        return _identify_holding(model, ds, outer_grid=outer_grid, start=start,
-                                 channel_scale=channel_scale)
-    return _identify_once(model, ds, on_deficient=policy, outer_grid=outer_grid, start=start,
-                          channel_scale=channel_scale)
+
+    def fit(m, start, channel_scale):
+        if policy == "hold":
+            return _identify_holding(m, ds, outer_grid=outer_grid, start=start,
+                                     channel_scale=channel_scale)
+        return _identify_once(m, ds, on_deficient=policy, outer_grid=outer_grid, start=start,
+                              channel_scale=channel_scale)
+
+    r = fit(model, start, channel_scale)
+    if not model.higher_order or r.linear.base:
+        return r
+    # effects with output terms beyond their columns (Effect.higher_order): those terms at the
+    # current estimate join the known part and the fit is repeated until the estimate settles
+    # (a fixed point: the terms are small next to the columns', so each step shrinks the change
+    # by about their relative size), with the first fit's channel weights
+    nl = [p.name for p in model.nonlinear_params()]
+    for step in range(1, HIGHER_ORDER_STEPS + 1):
+        prev = r
+        r = fit(model.evaluated_at(prev.params), {k: prev.params[k] for k in nl} or start,
+                prev.linear.channel_scale if channel_scale is None else channel_scale)
+        r.model = model
+        r.extra["higher_order_steps"] = step
+        change = max((abs(r.params[k] - prev.params[k]) / r.stderr[k]
+                      for k in r.params if r.stderr.get(k, 0.0) > 0), default=0.0)
+        if change < HIGHER_ORDER_TOL:
+            break
+    return r
 
 
 def held_value(model: Model, ds: Dataset, name: str) -> float:

@@ -19,15 +19,24 @@ from ...dataset import STANDARD_GRAVITY, Dataset
 from ...plant_interface import DatasetOptions
 from .dynamics_generated import regressor
 from .model import JOINTS
+from .options import CraneOptions
 from .swing import estimate_swing
 
 from .topics import JOINT_STATE, JOINT_STATES, PAYLOAD_POSE, POSE, TIP_POSE
 SWING_NAMES = ("theta1", "theta2", "rope_length")
-#: default low-pass cut-off of the crane's positions, Hz (when --cutoff is not given). The payload
-#: swings at sqrt(g / d) / (2 pi) ~ 0.6-1 Hz and the excitation stays below ~0.5 Hz, while
-#: motion-capture noise is differentiated twice for the swing accelerations: the generic fs / 10
-#: (10 Hz at 100 Hz) lets 1 mm of noise become metres per second squared (002 sec. 5.1.3 chose
-#: its filters case by case; this is the case for the crane).
+#: default low-pass cut-off of the crane's identification equations, Hz (when --cutoff is not
+#: given). The payload swings at sqrt(g / d) / (2 pi) ~ 0.6-1 Hz and the excitation stays below
+#: ~0.5 Hz, while motion-capture noise is differentiated twice for the swing accelerations: the
+#: generic fs / 10 (10 Hz at 100 Hz) lets 1 mm of noise become metres per second squared (002 sec.
+#: 5.1.3 chose its filters case by case; this is the case for the crane). By default the positions
+#: are filtered at it and differentiated; the plant option ``crane_filter="parallel"``
+#: (:mod:`.options`) takes the derivatives at fs / 10 and low-passes the efforts and every
+#: regressor column at this cut-off alike (:mod:`cablelab.parallel_filter`). Filtering the
+#: positions alone attenuates the swing's 1.5-3 Hz content (twice the swing frequency, in the
+#: centripetal and Coriolis terms) in the regressor but not in the efforts: a model error of 2-5 %
+#: of the torques that moved 0.2 % of the payload mass into the hoist and luff offsets (2-3 % of
+#: them) on designed runs; the parallel filter in turn made the counterbalance and delay estimates
+#: of the plain and delay benchmark cases worse, so it is not the default.
 CRANE_CUTOFF_HZ = 3.0
 
 __all__ = ["check_bag", "check_measurements", "dataset", "dataset_from_arrays"]
@@ -50,12 +59,20 @@ def dataset_from_arrays(t, q_joints, effort, t_mocap, tip, payload, description,
         effort: (N, 3) [slew N m, luff N m, hoist N].
         t_mocap, tip, payload: (M,), (M, 3), (M, 3) motion capture (NaN rows = dropouts).
         description: :class:`~cablelab.description.Description` with a ``crane`` section.
-        options: the conditioning (defaults when None).
+        options: the conditioning and the crane's own options (:class:`.options.CraneOptions`:
+            ``crane_filter``); defaults when None.
     """
     opts = (options or DatasetOptions()).conditioning
-    if opts.cutoff_hz is None:
-        opts = dataclasses.replace(opts, cutoff_hz=CRANE_CUTOFF_HZ)
     t = np.asarray(t, dtype=float)
+    parallel = None
+    if opts.cutoff_hz is None:
+        fs = 1.0 / float(np.median(np.diff(t[np.isfinite(t)]))) if np.isfinite(t).sum() > 1 else 0.0
+        mode = (options or DatasetOptions()).plant_options(CraneOptions).crane_filter
+        if mode == "parallel" and fs / 10.0 > CRANE_CUTOFF_HZ:   # derivatives at fs / 10, both
+            # sides of the fit at CRANE_CUTOFF_HZ
+            opts, parallel = dataclasses.replace(opts, cutoff_hz=fs / 10.0, effort_cutoff_hz=None), CRANE_CUTOFF_HZ
+        else:
+            opts = dataclasses.replace(opts, cutoff_hz=CRANE_CUTOFF_HZ)
     q_joints = np.asarray(q_joints, dtype=float).reshape(-1, 3)
     ok = np.isfinite(t) & np.isfinite(q_joints[:, 0])
     sw, rep = estimate_swing(t_mocap, tip, payload, t[ok], q_joints[ok, 0], source=source)
@@ -80,12 +97,24 @@ def dataset_from_arrays(t, q_joints, effort, t_mocap, tip, payload, description,
     )
     # drives that stop (issue 10): samples in the zero-speed zone of slew, luff or hoist are not
     # fitted, as for the axis (cablelab.velocity): there the smooth friction band holds any
-    # effort and the sign of a filtered, quantized encoder velocity is noise
+    # effort and the sign of a filtered, quantized encoder velocity is noise. The zones come from
+    # the drives' speeds in the efforts' band; they are applied before the parallel filter is
+    # declared, so without exclude_zero_speed's rest guard: the crane's three drives seldom all
+    # move at once, and guarding every stop of any drive by half a filter period left 16 % of a
+    # 30 s chirp record (468 of 2900 samples)
     from ...velocity import exclude_zero_speed, position_quantum, speed_resolution
 
     ok_q = q_joints[ok]
-    floor = np.array([speed_resolution(position_quantum(ok_q[:, j]), c["cutoff_hz"]) for j in range(3)])
-    return exclude_zero_speed(ds, floor=floor)
+    floor = np.array([speed_resolution(position_quantum(ok_q[:, j]), parallel or c["cutoff_hz"]) for j in range(3)])
+    if parallel:
+        from ...parallel_filter import edge_mask, parallel_filter
+
+        ds = ds.replace(signals={**ds.signals, "rest_velocity": parallel_filter(qd[:, :3], ds.t, parallel)})
+    ds = exclude_zero_speed(ds, floor=floor)
+    if parallel:
+        ds = ds.replace(y=parallel_filter(ds.y, ds.t, parallel), parallel_hz=parallel,
+                        valid=ds.valid & edge_mask(ds.t, parallel))
+    return ds
 
 
 def dataset(bag, description, options: DatasetOptions) -> Dataset:

@@ -22,7 +22,12 @@ parameters:
   tilt is two angles, not four free loads, because the payload's load ``m g_x`` alone is barely
   excited (swing angles of a few degrees) and as a free parameter it carried 10-20 % standard
   errors on the diagnosis benchmark (bench/cases_crane.py). At rest it is the slew torque offset
-  002 measured (-0.2 N m). The vertical-gravity change is second order.
+  002 measured (-0.2 N m). The columns are first order in the angles; the tilt also shortens the
+  vertical gravity to g cos|tilt| (:func:`tilt_vertical_shortening`, a constant m g |tilt|^2 / 2
+  on the hoist that a torque-sensor offset would otherwise take up), the effect's higher-order
+  term, which the fit evaluates at its current angles and iterates
+  (:attr:`~cablelab.effects.base.Effect.higher_order`): the output is exact in the angles
+  (tested against the tilted MuJoCo crane at rest).
 """
 from __future__ import annotations
 
@@ -136,8 +141,8 @@ def tilt_angle_columns(q: np.ndarray, first_moment: float, payload_mass: float,
     about world x, y): g_x = g tilt_y, g_y = -g tilt_x in :func:`tilt_columns` weighted by K and m.
     First order in the angles: the tilt also shortens the vertical gravity to g cos|tilt|, which
     these columns leave out (a constant m g |tilt|^2 / 2 on the hoist, 0.1-0.3 % of the weight at
-    2-4 degrees; tested against the tilted MuJoCo crane). A fit whose residual is clean enough
-    (efforts and columns parallel-filtered) sees it as a significant hoist offset."""
+    2-4 degrees) and :func:`tilt_vertical_shortening` adds; without it a fit whose residual is
+    clean enough (efforts and columns parallel-filtered) sees a significant hoist offset."""
     c = tilt_columns(q)
     gx = first_moment * c[:, :, 0] + payload_mass * c[:, :, 2]     # per unit g_x
     gy = first_moment * c[:, :, 1] + payload_mass * c[:, :, 3]     # per unit g_y
@@ -147,6 +152,31 @@ def tilt_angle_columns(q: np.ndarray, first_moment: float, payload_mass: float,
 def _tilt(ds: Dataset) -> np.ndarray:
     K, m, g = tilt_masses(ds.description)
     return tilt_angle_columns(ds.require_signal("q"), K, m, g)
+
+
+def tilt_vertical_shortening(q: np.ndarray, tilt_x: float, tilt_y: float, params) -> np.ndarray:
+    """(N, 3) slew, luff, hoist change of the vertical-gravity efforts on a base tilted by
+    (tilt_x, tilt_y): gravity along the slew axis is g_z = g sqrt(1 - tilt_x^2 - tilt_y^2)
+    = g cos|tilt| (exactly, with tilt_x = -g_y / g and tilt_y = g_x / g), so the vertical
+    gravity vector G(q) of :class:`CraneParams` ``params`` scales by cos|tilt|: ``(cos|tilt|
+    - 1) G(q)``, about -|tilt|^2 / 2 G(q) (the slew row is 0: vertical gravity loads no slew
+    torque)."""
+    from .model import gravity_vector
+
+    cos_tilt = np.sqrt(max(0.0, 1.0 - float(tilt_x) ** 2 - float(tilt_y) ** 2))
+    return (cos_tilt - 1.0) * gravity_vector(q, params)[:, :3]
+
+
+def _tilt_higher_order(ds: Dataset, values: Mapping[str, float]) -> np.ndarray:
+    from .model import CraneParams
+
+    tx, ty = float(values.get("tilt_x", 0.0)), float(values.get("tilt_y", 0.0))
+    q = ds.require_signal("q")
+    if tx == 0.0 and ty == 0.0:
+        return np.zeros((q.shape[0], 3))
+    desc = ds.description
+    return tilt_vertical_shortening(q, tx, ty, CraneParams.from_description(desc)
+                                    if desc is not None else CraneParams())
 
 
 BASE_TILT = register(Effect(
@@ -161,4 +191,5 @@ BASE_TILT = register(Effect(
     signature="slew torque offset at rest that changes with alpha like cos/sin(alpha)",
     reference="002 sec. 6.5 (-0.2 N m at rest); K, m: the described masses",
     regressor=_tilt,
+    higher_order=_tilt_higher_order,
 ))

@@ -18,6 +18,7 @@ from .topics import JOINT_STATE, JOINT_STATES, PAYLOAD_POSE, POSE, TIP_POSE
 from .description import parse_section
 from .estimate import estimate_bag
 from .freerun import fit_free_run, free_run_compare
+from .options import CraneOptions
 
 
 def baseline(description) -> tuple[str, ...]:
@@ -49,6 +50,7 @@ PLANT = Plant(
     capabilities=frozenset({"joint_actuators"}),
     estimate=estimate_bag,
     check_bag=check_bag,
+    options_type=CraneOptions,
     channels=JOINTS,
     markers=lazy_hook(f"{__package__}.markers", "bag_markers"),
     topic_names=lambda desc: {JOINT_STATES: list(JOINTS), **{t: ["theta1", "theta2", "rope_length"] for t in
