@@ -25,7 +25,7 @@ from __future__ import annotations
 import numpy as np
 
 from cases_cdpr import LIMITS, delay_visibility, draw_case, tabulated, write_bag
-from cases_common import PlantCase
+from cases_common import PlantCase, draw_slow_sines
 
 #: what the designed run must separate: the delay and the accelerated mass (a delay shifts the
 #: wrench of the accelerated platform like a phase lag; on slow sines both are small)
@@ -52,29 +52,13 @@ def draw_delay_case(seed: int, kind: str | None = None) -> PlantCase:
         case.hidden = ()
         case.true_params = {}
     case.family = f"designed {kind}"
-    hz = rng.uniform(0.015, 0.035, 3)
-    amp = rng.uniform(0.3, 0.6, 3) * 0.5 * np.array([hi - lo for lo, hi in LIMITS])
-    phase = rng.uniform(0, 2 * np.pi, 3)
     tr.update(first_s=60.0, designed_s=60.0, pair=PAIR, diagnose_first=True,
-              reference=slow_sines(amp, hz, phase))
+              reference=draw_slow_sines(rng, LIMITS))
     return case
 
 
-def slow_sines(amp, hz, phase):
-    """Reference ``fn(t) -> (p, v, a)``: a sine per axis about the centre of :data:`LIMITS`."""
-    centre = np.array([0.5 * (lo + hi) for lo, hi in LIMITS])
-    w = 2 * np.pi * np.asarray(hz, float)
-    amp, phase = np.asarray(amp, float), np.asarray(phase, float)
-
-    def fn(t):
-        arg = w * np.atleast_1d(np.asarray(t, float))[:, None] + phase
-        return centre + amp * np.sin(arg), amp * w * np.cos(arg), -amp * w * w * np.sin(arg)
-
-    return fn
-
-
 #: the generator's interface for bench_diagnosis.py: cases_cdpr's simulator and bag writer
-__all__ = ["PAIR", "delay_visibility", "draw_delay_case", "slow_sines", "tabulated", "write_bag"]
+__all__ = ["PAIR", "delay_visibility", "draw_delay_case", "tabulated", "write_bag"]
 
 
 if __name__ == "__main__":      # ./run python bench/cases_cdpr_delay.py: first recordings' visibility

@@ -102,6 +102,32 @@ def moves_and_rests(rng, start, limits, duration: float, rest_fraction: float, p
     return r, float(t)
 
 
+def slow_sines(limits, amp, hz, phase):
+    """Reference ``fn(t) -> (x, xd, xdd)``: a sine per axis (or drive) about the centre of
+    ``limits`` ((lo, hi) per axis), amplitudes ``amp``, frequencies ``hz`` (Hz), phases (rad).
+    The simulators start at the reference's first point, at rest; the speed there is small,
+    which their PD loops take up."""
+    centre = np.array([0.5 * (lo + hi) for lo, hi in limits])
+    w = 2 * np.pi * np.asarray(hz, float)
+    amp, phase = np.asarray(amp, float), np.asarray(phase, float)
+
+    def fn(t):
+        arg = w * np.atleast_1d(np.asarray(t, float))[:, None] + phase
+        return centre + amp * np.sin(arg), amp * w * np.cos(arg), -amp * w * w * np.sin(arg)
+
+    return fn
+
+
+def draw_slow_sines(rng, limits):
+    """:func:`slow_sines` drawn for a slow first recording: 0.015-0.035 Hz, amplitudes 30-60 % of
+    each axis's half range, random phases."""
+    n = len(limits)
+    hz = rng.uniform(0.015, 0.035, n)
+    amp = rng.uniform(0.3, 0.6, n) * 0.5 * np.array([hi - lo for lo, hi in limits])
+    phase = rng.uniform(0, 2 * np.pi, n)
+    return slow_sines(limits, amp, hz, phase)
+
+
 def rel_param_error(fitted: dict, true: dict) -> float:
     """|p_fit - p_true| / |p_true| over the parameter vector of one effect (Euclidean norms;
     a parameter missing from the fit counts as infinite error)."""

@@ -41,7 +41,7 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from cases_common import PlantCase, coloured_noise, moves_and_rests, quantize
+from cases_common import PlantCase, coloured_noise, draw_slow_sines, moves_and_rests, quantize
 from cablelab.plants.crane.reference import slew_only
 
 JOINT_NAMES = ("slew", "luff", "hoist")
@@ -169,27 +169,9 @@ def draw_delay_case(seed: int, kind: str | None = None) -> PlantCase:
         tr["tau"] = 0.0
         case.true_params = {}
     case.family = f"designed {kind}"
-    hz = rng.uniform(0.015, 0.035, 3)
-    amp = rng.uniform(0.3, 0.6, 3) * 0.5 * np.array([hi - lo for lo, hi in LIMITS])
-    phase = rng.uniform(0, 2 * np.pi, 3)
     tr.update(first_s=60.0, designed_s=60.0, pair=DELAY_PAIR, diagnose_first=True,
-              reference=slow_sines(amp, hz, phase))
+              reference=draw_slow_sines(rng, LIMITS))
     return case
-
-
-def slow_sines(amp, hz, phase):
-    """Reference ``fn(t) -> (q, qd, qdd)``: a sine per drive about the centre of :data:`LIMITS`
-    (the simulator starts at the reference's first point, at rest; the speed there is a few
-    cm/s, which the PD loop takes up)."""
-    centre = np.array([0.5 * (lo + hi) for lo, hi in LIMITS])
-    w = 2 * np.pi * np.asarray(hz, float)
-    amp, phase = np.asarray(amp, float), np.asarray(phase, float)
-
-    def fn(t):
-        arg = w * np.asarray(t, float)[:, None] + phase
-        return centre + amp * np.sin(arg), amp * w * np.cos(arg), -amp * w * w * np.sin(arg)
-
-    return fn
 
 
 def tabulated(t_ref, q, qd, qdd):
