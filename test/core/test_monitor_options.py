@@ -1,7 +1,7 @@
 """``model_monitor --plant P`` takes the plant's own options from the plant, not from a list in
 the monitor: the fields of the plant's options dataclass that ``cablelab compare`` offers become
-ROS parameters of the same name, default and choices (CDPR: ``tensions``), each value reaching
-the monitor's dataset; other plants have none, and ``--help`` lists what the chosen plant has.
+ROS parameters of the same name, default and choices (CDPR: ``tensions``; crane:
+``crane_filter``), each value reaching the monitor's dataset; other plants have none, and ``--help`` lists what the chosen plant has.
 
 Oracle: the plant's own dataset options (:meth:`DatasetOptions.build`, the path every verb takes)
 accept every value the monitor offers, and the monitor built in-process with ``-p`` overrides
@@ -32,7 +32,9 @@ def test_every_offered_value_is_an_option_of_the_plant_dataset():
             for value in spec.choices:
                 opts = DatasetOptions.build(get_plant(plant), {spec.name: value})
                 assert getattr(opts.plant, spec.name) == value
-    for plant in ("axis", "crane", "leg", "suspended"):
+    crane = offered["crane"]                    # the crane's equations' filter, a dataset option
+    assert [s.name for s in crane] == ["crane_filter"] and crane[0].default == "positions"
+    for plant in ("axis", "leg", "suspended"):
         assert offered[plant] == () and "tensions" not in {s.name for s in parameters_for(plant)}
 
 
