@@ -45,6 +45,10 @@ class Dataset:
         parallel_hz: cut-off (Hz) of the parallel filter (:mod:`cablelab.parallel_filter`):
             ``y`` is low-passed with it and every regressor column is filtered the same way by
             :meth:`cablelab.model.Model.regressor`; ``None`` = no parallel filter.
+        noise_map: (N, C, S) map from S independently noisy sensors to the channels
+            (``y_n = noise_map[n] @ readings_n``, e.g. a wrench from cable tensions); the fit then
+            whitens each sample with the sensors' estimated noise (:mod:`cablelab.fit.noise`).
+            ``None``: each channel is one sensor (weighted by its own noise level).
     """
 
     plant: str
@@ -63,6 +67,7 @@ class Dataset:
     description: object = None
     source: str = ""
     parallel_hz: float | None = None
+    noise_map: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         self.t = np.asarray(self.t, dtype=float)
@@ -161,6 +166,7 @@ class Dataset:
             t=self.t[idx], y=self.y[idx],
             signals={k: cut(v) for k, v in self.signals.items()},
             act_vel=cut(self.act_vel), act_map=cut(self.act_map), valid=valid,
+            noise_map=cut(self.noise_map),
             regimes={k: cut(v) for k, v in self.regimes.items()},
             inputs={k: cut(v) for k, v in self.inputs.items()},
         )

@@ -269,6 +269,7 @@ def rank_candidates(model: Model, ds: Dataset, candidates, *, folds: int = FOLDS
     # what the ambiguity check compares (diagnose/ambiguity.py): the model's columns, weighted and
     # on its valid rows, and each candidate's held-out prediction and projected columns
     from .ambiguity import find_ambiguous, project_out
+    from ..fit.linear import weigh
 
     ev_base = model.evaluate(ds, base_full.params)
     ds_base = ev_base.ds
@@ -277,7 +278,7 @@ def rank_candidates(model: Model, ds: Dataset, candidates, *, folds: int = FOLDS
     use = base_full.valid & np.isfinite(ds_base.y).all(axis=1)
 
     def weighted(phi):
-        return (phi[use] * w_ch[None, :, None]).reshape(int(use.sum()) * phi.shape[1], phi.shape[2])
+        return weigh(w_ch, phi)[use].reshape(int(use.sum()) * phi.shape[1], phi.shape[2])
 
     phi0 = weighted(ev_base.phi)
     compared = {}

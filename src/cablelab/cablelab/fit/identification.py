@@ -19,7 +19,8 @@ import scipy.linalg
 from ..errors import CablelabError
 from ..dataset import Dataset
 from ..model import Evaluation, Model
-from .linear import LinearFit, RankDeficient, solve_linear, unexcited_columns
+from .linear import LinearFit, RankDeficient, solve_linear, unexcited_columns, weigh
+from .noise import noise_whitening
 
 #: grid points per nonlinear parameter for the start of the outer search
 OUTER_GRID = 11
@@ -184,7 +185,7 @@ def _solve(ev: Evaluation, valid: np.ndarray, on_deficient: str, channel_scale="
 
 def _weighted_residual(fit: LinearFit, phi, lhs, valid) -> np.ndarray:
     """Channel-weighted residual (valid rows, others 0) of a full-rank linear fit, flattened."""
-    r = (lhs - phi @ fit.theta) * fit.channel_scale[None, :]
+    r = weigh(fit.channel_scale, lhs - phi @ fit.theta)
     return np.where(valid[:, None], r, 0.0).reshape(-1)
 
 
@@ -206,7 +207,10 @@ def identify(model: Model, ds: Dataset, *, on_deficient: str | None = None,
         channel_scale: channel weights; default (None): with several channels, noise weights
             1 / sigma_c from the residual of a first RMS-weighted fit (:func:`noise_weights`,
             feasible generalised least squares), so a channel that carries an effect is not
-            drowned by channels that do not care; one channel: unweighted.
+            drowned by channels that do not care; when the dataset has a ``noise_map`` (channels
+            that mix independent sensors), per-sample whitening with the sensors' variances
+            estimated from that residual instead (:func:`cablelab.fit.noise.noise_whitening`);
+            one channel: unweighted.
     Raises:
         CablelabError: too few samples, rank-deficient regressor (names the directions).
     """
@@ -388,7 +392,8 @@ def _identify_once(model: Model, ds: Dataset, *, on_deficient: str = "raise",
         if ds.n_channels > 1:
             first = _identify_once(model, ds, on_deficient=on_deficient, outer_grid=outer_grid,
                                    start=start, channel_scale="rms")
-            channel_scale = noise_weights(first.residual)
+            channel_scale = noise_weights(first.residual) if ds.noise_map is None \
+                else noise_whitening(first.residual, ds.noise_map)
             start = {p.name: first.params[p.name] for p in model.nonlinear_params()} or start
     nl_params = model.nonlinear_params()
     nl_values: dict[str, float] = {}
@@ -423,7 +428,7 @@ def _identify_once(model: Model, ds: Dataset, *, on_deficient: str = "raise",
     cov_all = np.zeros((0, 0)) if fit.base else np.asarray(fit.cov, dtype=float)
     if jac_nl is not None and not fit.base:
         w = fit.channel_scale
-        a = np.where(valid[:, None, None], phi * w[None, :, None], 0.0).reshape(
+        a = np.where(valid[:, None, None], weigh(w, phi), 0.0).reshape(
             phi.shape[0] * phi.shape[1], phi.shape[2])
         jac = np.concatenate([-a, jac_nl], axis=1)
         jtj = jac.T @ jac
@@ -544,20 +549,20 @@ class _OuterProblem:
                             channel_scale=channel_scale)
         self.w = fit0.channel_scale
         if self.constant:
-            a = (phi[valid] * self.w[None, :, None]).reshape(int(valid.sum()) * phi.shape[1], phi.shape[2])
+            a = weigh(self.w, phi)[valid].reshape(int(valid.sum()) * phi.shape[1], phi.shape[2])
             self.q = np.linalg.qr(a, mode="reduced")[0] if a.shape[1] else np.zeros((a.shape[0], 0))
 
     def residual(self, x) -> np.ndarray:
         values = dict(zip(self.names, np.ravel(x)))
         if self.constant:   # the regressor does not move: only the transformed measurement
             ds2 = self.model.apply_nonlinear(self.ds, values)
-            b = ((ds2.y - self.y_known)[self.valid] * self.w[None, :]).reshape(-1)
+            b = weigh(self.w, ds2.y - self.y_known)[self.valid].reshape(-1)
             return b - self.q @ (self.q.T @ b)
         ev = self.model.evaluate(self.ds, values)
-        b = (ev.lhs[self.valid] * self.w[None, :]).reshape(-1)
+        b = weigh(self.w, ev.lhs)[self.valid].reshape(-1)
         if ev.phi.shape[2] == 0:       # a model of known parts only (a delay alone)
             return b
-        a = (ev.phi[self.valid] * self.w[None, :, None]).reshape(-1, ev.phi.shape[2])
+        a = weigh(self.w, ev.phi)[self.valid].reshape(-1, ev.phi.shape[2])
         # normal equations on scaled columns: cheap for the few parameters of an outer search
         sc = np.linalg.norm(a, axis=0)
         sc = np.where(sc > 0, sc, 1.0)

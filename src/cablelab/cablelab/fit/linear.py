@@ -2,7 +2,8 @@
 
 ``solve_linear(phi, y, params)`` solves ``y = phi @ theta`` over N samples and C channels with:
 
-* channel weighting (each channel divided by its RMS so torques and forces weigh alike),
+* channel weighting (each channel divided by its RMS so torques and forces weigh alike), or a
+  per-sample whitening of the channels (generalised least squares, :mod:`.noise`),
 * column scaling, SVD rank and condition number on the scaled regressor (for a well-conditioned
   regressor from the small ``p x p`` Gram matrix of the scaled columns, see :func:`_solve_gram`;
   otherwise, and for every rank decision near the threshold, from the SVD of the tall regressor),
@@ -52,7 +53,8 @@ class LinearFit:
         unidentifiable: named null-space directions (empty when full rank).
         base: for a regrouped fit, the base-parameter definitions (``"M + 0.5 Fc"``).
         active_bounds: names of parameters held at a bound by bounded LS.
-        channel_scale: (C,) weights applied to the channels.
+        channel_scale: (C,) weights applied to the channels, or (N, C, C) per-sample whitening
+            matrices (:func:`weigh`).
     """
 
     names: tuple[str, ...]
@@ -99,6 +101,15 @@ def _combo(names: Sequence[str], vec: np.ndarray, tol: float = 0.05) -> str:
     return text
 
 
+def weigh(w: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """``x`` (N, C) or (N, C, p) with channel weights ``w`` applied: (C,) scales each channel,
+    (N, C, C) multiplies each sample's channels by its matrix (``w[n] @ x[n]``, a whitening)."""
+    w = np.asarray(w, dtype=float)
+    if w.ndim == 3:
+        return np.einsum("ncd,nd...->nc...", w, x)
+    return x * (w[None, :, None] if x.ndim == 3 else w[None, :])
+
+
 def _as_channels(phi, y):
     """``phi`` as (N, C, p) and ``y`` as (N, C) float arrays (one channel when given 2-D / 1-D)."""
     phi = np.asarray(phi, dtype=float)
@@ -117,8 +128,9 @@ def solve_linear(phi: np.ndarray, y: np.ndarray, params: Sequence[Param], *,
         y: (N, C) (or (N,)) left-hand side (known contributions already subtracted).
         params: the p :class:`Param` (names, units, bounds).
         valid: (N,) mask of usable samples (non-finite rows are dropped too).
-        channel_scale: ``"rms"`` (divide each channel by its RMS), None (no weighting) or (C,)
-            weights.
+        channel_scale: ``"rms"`` (divide each channel by its RMS), None (no weighting), (C,)
+            weights, or (N, C, C) per-sample whitening matrices (generalised least squares with a
+            channel covariance that changes with the sample, :mod:`.noise`).
         bounded: enforce the parameters' box bounds with bounded LS.
         rank_tol: relative singular-value threshold for the rank.
         on_deficient: ``"raise"`` -> CablelabError naming the unidentifiable directions;
@@ -142,10 +154,12 @@ def solve_linear(phi: np.ndarray, y: np.ndarray, params: Sequence[Param], *,
     elif channel_scale is None:
         w = np.ones(n_c)
     else:
-        w = np.asarray(channel_scale, dtype=float).reshape(n_c)
+        w = np.asarray(channel_scale, dtype=float)
+        w = w.reshape(n_s, n_c, n_c) if w.ndim == 3 else w.reshape(n_c)
     # (no free parameter, e.g. every one fixed: no columns, the residual is y itself)
-    a = (phi[mask] * w[None, :, None]).reshape(int(mask.sum()) * n_c, p)
-    b = (y[mask] * w[None, :]).reshape(-1)
+    wm = w[mask] if w.ndim == 3 else w
+    a = weigh(wm, phi[mask]).reshape(int(mask.sum()) * n_c, p)
+    b = weigh(wm, y[mask]).reshape(-1)
     n = a.shape[0]
     if n <= p:
         raise CablelabError(f"too few valid samples for the fit: {n} equations for {p} parameters "

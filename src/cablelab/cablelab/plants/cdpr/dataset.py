@@ -227,6 +227,9 @@ def dataset_from_arrays(arr: CdprArrays, description, source: str = "data",
            "pulley_S": S, "act_scale": act_scale, "velocity": arr.velocity[sl]}
     channels, units = CHANNELS, UNITS
     act_map = W_model * act_scale[None, None, :]
+    # the wrench channels mix the cables' independent sensors (dynamometers or motor torques,
+    # whose noise differs from cable to cable): the fit whitens each sample with W diag(v) W^T
+    noise_map = W
     if arr.source == "both":
         mask = balance_mask(qd)
         bal = torque_balance(arr)[sl] * mask
@@ -237,13 +240,14 @@ def dataset_from_arrays(arr: CdprArrays, description, source: str = "data",
         # the workbench still leaves samples with a winch at rest out (as for the dynamometers
         # alone): at static poses the sheave radius and the mass act alike on the wrench
         sig.update(balance_mask=mask)
+        noise_map = None      # (the balance channels are weighted each by its own noise level)
     return Dataset(
         plant="cdpr", t=arr.t[sl], y=y, channels=channels, units=units, signals=sig,
         actuators=tuple(f"winch_{i}" for i in range(1, n + 1)), act_vel=qd,
         act_map=act_map, act_units=((unit, "rad"),) * n,
         regimes={k2: v[sl] for k2, v in _regimes(arr).items()},
         inputs={"vertical acceleration": arr.acc[sl, 2], "speed": np.linalg.norm(arr.velocity[sl], axis=1)},
-        description=description, source=source)
+        description=description, source=source, noise_map=noise_map)
 
 
 def _balance_map(mask: np.ndarray, act_scale: np.ndarray) -> np.ndarray:
