@@ -70,7 +70,7 @@ def sensor_variances(residual: np.ndarray, noise_map: np.ndarray) -> np.ndarray:
         cim = np.linalg.solve(cov, m)                               # C^-1 M   (N, C, S)
         u = np.einsum("nck,nc->nk", cim, r)                          # m_k^T C^-1 r
         q = np.einsum("nck,ncl->nkl", m, cim)                        # m_k^T C^-1 m_l
-        score = 0.5 * ((u ** 2).sum(axis=0) - np.einsum("nkk->k", q).sum(axis=0))
+        score = 0.5 * ((u ** 2).sum(axis=0) - np.einsum("nkk->k", q))
         fisher = 0.5 * (q ** 2).sum(axis=0)
         step = np.linalg.lstsq(fisher, score, rcond=None)[0]
         # scoring in the log variances (every variance stays positive), step halved until the
