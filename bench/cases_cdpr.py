@@ -392,11 +392,12 @@ def _visibility_table(first_seed: int = 3000, n: int = 60) -> None:
 
 
 def predicted_offset_error(case: PlantCase, t, p, a) -> float:
-    """|error| / |b| of the dynamometer offsets that the covariance of a channel-weighted least
-    squares fit predicts for the platform motion ``p``, ``a`` (N, 3) sampled at ``t`` (this
-    generator's structure matrix and noise: independent per-cable sigmas mapped through W, the
-    AR(1) noise's low-frequency variance (1 + ar) / (1 - ar) times the white one), with the
-    parameters of the fitted model: b (8), m, mx, my, m_a and its three first moments."""
+    """|error| / |b| of the dynamometer offsets that the covariance of the fit predicts for the
+    platform motion ``p``, ``a`` (N, 3) sampled at ``t``: generalised least squares with each
+    sample whitened by its wrench noise ``W diag(sigma^2) W^T`` (as ``identify`` does with the
+    dataset's noise map; this generator's structure matrix and per-cable sigmas), the AR(1)
+    noise's low-frequency variance (1 + ar) / (1 - ar) times the white one, and the parameters of
+    the fitted model: b (8), m, mx, my, m_a and its three first moments."""
     tr = case.truth
     W = structure_matrix(cable_directions(p, tr["r_p"])[0])              # (N, 6, 8)
     X = np.zeros((len(t), 6, 15))
@@ -408,10 +409,7 @@ def predicted_offset_error(case: PlantCase, t, p, a) -> float:
         X[:, 3:, 12 + k] = np.cross(np.eye(3)[k], a)
     sig = tr["noise_rel"] * mean_tension(tr["m"])
     C = np.einsum("nij,j,nkj->nik", W, sig ** 2, W) * (1 + tr["ar"]) / (1 - tr["ar"])
-    sc = np.sqrt(np.einsum("nii->i", C) / len(t))                          # channel weights 1 / sigma_c
-    Xw = X / sc[None, :, None]
-    Ai = np.linalg.inv(np.einsum("nip,niq->pq", Xw, Xw))
-    cov = Ai @ np.einsum("nip,nij,njq->pq", Xw, C / np.outer(sc, sc)[None], Xw) @ Ai
+    cov = np.linalg.inv(np.einsum("nip,nij,njq->pq", X, np.linalg.inv(C), X))
     return float(np.sqrt(np.trace(cov[:8, :8])) / np.linalg.norm(tr["b"]))
 
 
