@@ -11,6 +11,7 @@ import sys
 
 import numpy as np
 import pytest
+import scipy.signal
 
 from cablelab.description import parse_description, read_yaml
 from cablelab.fit import identify
@@ -48,10 +49,12 @@ def _dataset(desc, t, p, v, a, readings):
     return dataset_from_arrays(arr, desc)
 
 
-@pytest.fixture(scope="module")
-def draws():
+@pytest.fixture(scope="module", params=[0.0, 0.7], ids=["white", "ar0.7"])
+def draws(request):
     """Fitted offsets (whitened and per-channel weighted) and the stated covariance over
-    independent noise draws, with hidden offsets and without (a control)."""
+    independent noise draws, with hidden offsets and without (a control); white or AR(1) cable
+    noise (the dynamometers' coloured noise of the benchmark cases)."""
+    ar = request.param
     desc = parse_description(read_yaml(cases_cdpr._description(M, 0.0)))
     t, p, v, a, ten = _truth()
     sig = NOISE_REL * cases_cdpr.mean_tension(M)
@@ -62,7 +65,7 @@ def draws():
     names = [f"b[winch_{i}]" for i in range(1, 9)]
     for k in range(16):
         r = np.random.default_rng(100 + k)
-        noise = r.normal(size=ten.shape) * sig
+        noise = scipy.signal.lfilter([1.0], [1.0, -ar], r.normal(size=ten.shape), axis=0) * np.sqrt(1 - ar ** 2) * sig
         for offsets, key in ((b, "z2"), (np.zeros(8), "z2_control")):
             ds = _dataset(desc, t, p, v, a, ten + offsets + noise)
             fit = identify(model, ds)
@@ -86,9 +89,10 @@ def test_whitened_offsets_beat_channel_weights(draws):
 
 def test_stated_covariance_describes_the_spread(draws):
     """Mean of the squared Mahalanobis error of the eight offsets ~ 8 (chi^2_8) over the draws:
-    the covariance neither hides the error nor (by much: the standard errors carry the residual's
-    AR(1) inflation, which white noise keeps near 1) overstates it; the control without offsets
-    likewise, so its offsets stay within their noise."""
+    the covariance neither hides the error nor overstates it, with white noise and with AR(1)
+    noise (whose slow-band variance, (1 + a) / (1 - a) times the white one, the standard errors
+    carry through the residual's AR(1) inflation); the control without offsets likewise, so its
+    offsets stay within their noise."""
     for key in ("z2", "z2_control"):
         z2 = np.array(draws[key])
         assert 8 * 0.5 < z2.mean() < 8 * 1.5, (key, z2)
