@@ -24,6 +24,10 @@ VAR_ITERATIONS = 50
 VAR_TOL = 1e-6
 #: a sensor variance is kept at least this fraction of the largest (every C_n positive definite)
 VAR_FLOOR = 1e-6
+#: rows of the residual the variances are estimated from (evenly spread over the record; a few
+#: thousand determine a handful of variances to a few per cent, enough for weights, and keep
+#: the scoring cheap next to the fit itself)
+VAR_SAMPLES = 4000
 #: the moment estimate that starts the scoring, floored at this fraction of the largest (a
 #: negative or zero moment estimate would start it on the boundary)
 START_FLOOR = 1e-3
@@ -34,7 +38,9 @@ def _rows(residual: np.ndarray, noise_map: np.ndarray):
     m = np.asarray(noise_map, dtype=float)
     if m.ndim != 3 or m.shape[:2] != r.shape:
         raise ValueError(f"noise map of shape {m.shape} for a residual of shape {r.shape}")
-    ok = np.isfinite(r).all(axis=1) & np.isfinite(m.reshape(m.shape[0], -1)).all(axis=1)
+    ok = np.flatnonzero(np.isfinite(r).all(axis=1) & np.isfinite(m.reshape(m.shape[0], -1)).all(axis=1))
+    if ok.size > VAR_SAMPLES:
+        ok = ok[np.linspace(0, ok.size - 1, VAR_SAMPLES).round().astype(int)]
     return r[ok], m[ok]
 
 
@@ -42,7 +48,8 @@ def sensor_variances(residual: np.ndarray, noise_map: np.ndarray) -> np.ndarray:
     """(S,) maximum-likelihood noise variances of the S independent sensors behind the channels.
 
     Args:
-        residual: (N, C) residual of a fit (rows with NaN are left out).
+        residual: (N, C) residual of a fit (rows with NaN are left out; at most
+            :data:`VAR_SAMPLES` rows, evenly spread, are used).
         noise_map: (N, C, S) the channels' map of the sensor readings, ``y_n = M_n s_n``.
     Returns:
         the variances (units of the sensors squared); a sensor the residual cannot see (its
@@ -53,23 +60,23 @@ def sensor_variances(residual: np.ndarray, noise_map: np.ndarray) -> np.ndarray:
     if r.shape[0] < s + 1:
         return np.ones(s)
     # moment start: E[(m_k . r)^2] = sum_l v_l (m_k . m_l)^2
-    g = np.einsum("nck,ncl->nkl", m, m)
-    h = np.einsum("nck,nc->nk", m, r) ** 2
+    mt = np.swapaxes(m, 1, 2)
+    g = mt @ m
+    h = (mt @ r[..., None])[..., 0] ** 2
     v = np.linalg.lstsq((g ** 2).sum(axis=0), h.sum(axis=0), rcond=None)[0]
     top = max(float(np.max(v)), float(np.mean(r ** 2)), 1e-300)
     v = np.maximum(v, START_FLOOR * top)
 
     def loglik(v):
-        lower = np.linalg.cholesky(np.einsum("nck,k,ndk->ncd", m, v, m))
+        lower = np.linalg.cholesky((m * v) @ mt)
         z = np.linalg.solve(lower, r[..., None])[..., 0]
         return -np.log(np.einsum("ncc->nc", lower)).sum() - 0.5 * float(np.sum(z * z))
 
     best = loglik(v)
     for _ in range(VAR_ITERATIONS):
-        cov = np.einsum("nck,k,ndk->ncd", m, v, m)
-        cim = np.linalg.solve(cov, m)                               # C^-1 M   (N, C, S)
-        u = np.einsum("nck,nc->nk", cim, r)                          # m_k^T C^-1 r
-        q = np.einsum("nck,ncl->nkl", m, cim)                        # m_k^T C^-1 m_l
+        cim = np.linalg.solve((m * v) @ mt, m)                       # C^-1 M   (N, C, S)
+        u = (np.swapaxes(cim, 1, 2) @ r[..., None])[..., 0]          # m_k^T C^-1 r
+        q = mt @ cim                                                 # m_k^T C^-1 m_l
         score = 0.5 * ((u ** 2).sum(axis=0) - np.einsum("nkk->k", q))
         fisher = 0.5 * (q ** 2).sum(axis=0)
         step = np.linalg.lstsq(fisher, score, rcond=None)[0]
@@ -97,7 +104,8 @@ def whitening(noise_map: np.ndarray, variances: np.ndarray) -> np.ndarray:
     (a channel no sensor reaches, or a non-finite map) gets its channels' mean whitening."""
     m = np.asarray(noise_map, dtype=float)
     n, c, _ = m.shape
-    cov = np.einsum("nck,k,ndk->ncd", np.nan_to_num(m), np.asarray(variances, float), np.nan_to_num(m))
+    m = np.nan_to_num(m)
+    cov = (m * np.asarray(variances, float)) @ np.swapaxes(m, 1, 2)
     scale = np.trace(cov, axis1=1, axis2=2) / c
     ref = float(np.median(scale[scale > 0])) if np.any(scale > 0) else 1.0
     # a relative floor keeps every covariance positive definite (a channel without noise of its
