@@ -3,9 +3,9 @@
  *
  * Python plans the law's reference terms ahead (LiveController.plan and planned_terms: per stamp
  * the PD part pd = kp q_d + kd q_d', the feedforward torques of the live estimate and the
- * friction compensation) and puts them here as rows keyed by stamp. A thread with its own rcl
- * context and node waits on the joint states (keep-last 1), takes the newest, finds the row of its
- * stamp and publishes what LiveController.planned_law gives, with the same operations in the same
+ * friction compensation) and puts them here as rows keyed by stamp. A thread waits on the joint
+ * states (a keep-last-1 subscription of the node's own rcl node, so one DDS participant per
+ * process), takes the newest, finds the row of its stamp and publishes what LiveController.planned_law gives, with the same operations in the same
  * order (so the same doubles):
  *     tau = pd - kp q;  tau -= kd q';  tau += ff;  tau = max(tau, floor);  tau += friction;
  *     tau = min(max(tau, -max_torque), max_torque)
@@ -58,16 +58,21 @@ typedef struct {
   int handoff_ready, h_nq, h_nqd;
   double h_t, h_wall, h_q[CP_HANDOFF], h_qd[CP_HANDOFF];
   /* counters (Python reads them for /diagnostics) */
-  long commanded, handed_off, waited, publish_failed;
+  long commanded, handed_off, waited, publish_failed, taken, wakes;
   double last_commanded_t, last_commanded_wall;
   double lat[CP_LAT];
   long nlat;
-  /* the thread */
+  /* the thread and its rcl entities (on the caller's node) */
   pthread_t thread;
   int running;
   volatile int stop;
-  char state_topic[256], command_topic[256], label[64], error[256];
-  int cmd_depth, domain_id;
+  char label[64], error[256];
+  rcl_node_t *node;
+  rcl_subscription_t sub;
+  rcl_publisher_t pub;
+  rcl_wait_set_t ws;
+  sensor_msgs__msg__JointState js;
+  std_msgs__msg__Float64MultiArray cmd;
 } cp_t;
 
 static double now_s(void) {
@@ -86,7 +91,11 @@ cp_t *cp_create(int n, int has_ff, double kp, double kd, double floor_, double m
   h->max_torque = max_torque; h->row_wait = row_wait;
   h->last_commanded_t = NAN; h->last_commanded_wall = NAN;
   pthread_mutex_init(&h->mu, NULL);
-  pthread_cond_init(&h->rows_put, NULL);
+  pthread_condattr_t ca;
+  pthread_condattr_init(&ca);
+  pthread_condattr_setclock(&ca, CLOCK_MONOTONIC);
+  pthread_cond_init(&h->rows_put, &ca);
+  pthread_condattr_destroy(&ca);
   return h;
 }
 
@@ -181,12 +190,13 @@ int cp_handoff(cp_t *h, double *t, double *wall, double *q, int *nq, double *qd,
   return ready;
 }
 
-/* out[0..6]: commanded, handed off, waited for a row, publish failures, running (1/0, -1 failed),
- * stamp and wall time of the last command */
+/* out[0..8]: commanded, handed off, waited for a row, publish failures, running (1/0, -1 failed),
+ * stamp and wall time of the last command, states taken, wake-ups of the thread */
 void cp_stats(cp_t *h, double *out) {
   pthread_mutex_lock(&h->mu);
   out[0] = h->commanded; out[1] = h->handed_off; out[2] = h->waited; out[3] = h->publish_failed;
   out[4] = h->running; out[5] = h->last_commanded_t; out[6] = h->last_commanded_wall;
+  out[7] = h->taken; out[8] = h->wakes;
   pthread_mutex_unlock(&h->mu);
 }
 
@@ -217,66 +227,35 @@ static rmw_qos_profile_t qos(size_t depth, int transient_local) {
     if ((x) != RCL_RET_OK) {                                                 \
       snprintf(h->error, sizeof h->error, "%s: %s", what, rcl_get_error_string().str); \
       rcl_reset_error();                                                     \
-      goto done;                                                             \
+      goto fail;                                                             \
     }                                                                        \
   } while (0)
 
 static void *run(void *arg) {
   cp_t *h = arg;
-  rcl_allocator_t alloc = rcl_get_default_allocator();
-  rcl_init_options_t io = rcl_get_zero_initialized_init_options();
-  rcl_context_t ctx = rcl_get_zero_initialized_context();
-  rcl_node_t node = rcl_get_zero_initialized_node();
-  rcl_subscription_t sub = rcl_get_zero_initialized_subscription();
-  rcl_publisher_t pub = rcl_get_zero_initialized_publisher();
-  rcl_wait_set_t ws = rcl_get_zero_initialized_wait_set();
-  sensor_msgs__msg__JointState js;
-  std_msgs__msg__Float64MultiArray cmd;
-  sensor_msgs__msg__JointState__init(&js);
-  std_msgs__msg__Float64MultiArray__init(&cmd);
-  int n = h->n;
-  std_msgs__msg__MultiArrayDimension__Sequence__init(&cmd.layout.dim, 1);
-  cmd.layout.dim.data[0].size = n;
-  cmd.layout.dim.data[0].stride = n;
-  rosidl_runtime_c__double__Sequence__init(&cmd.data, n);
-
-  TRY(rcl_init_options_init(&io, alloc), "rcl_init_options_init");
-  if (h->domain_id >= 0) TRY(rcl_init_options_set_domain_id(&io, (size_t)h->domain_id), "rcl_init_options_set_domain_id");
-  TRY(rcl_init(0, NULL, &io, &ctx), "rcl_init");
-  rcl_node_options_t no = rcl_node_get_default_options();
-  no.use_global_arguments = false;
-  no.enable_rosout = false;
-  TRY(rcl_node_init(&node, "pd_feedforward_path", "", &ctx, &no), "rcl_node_init");
-  rcl_subscription_options_t so = rcl_subscription_get_default_options();
-  so.qos = qos(1, 0);
-  TRY(rcl_subscription_init(&sub, &node, ROSIDL_GET_MSG_TYPE_SUPPORT(sensor_msgs, msg, JointState),
-                            h->state_topic, &so), "subscribing to the joint states");
-  rcl_publisher_options_t po = rcl_publisher_get_default_options();
-  po.qos = qos(h->cmd_depth, 1);
-  TRY(rcl_publisher_init(&pub, &node, ROSIDL_GET_MSG_TYPE_SUPPORT(std_msgs, msg, Float64MultiArray),
-                         h->command_topic, &po), "advertising the commands");
-  TRY(rcl_wait_set_init(&ws, 1, 0, 0, 0, 0, 0, &ctx, alloc), "rcl_wait_set_init");
-  pthread_mutex_lock(&h->mu);
-  h->running = 1;
-  pthread_mutex_unlock(&h->mu);
-
   double tau[CP_MAXN];
   char label[128];
   while (!h->stop) {
-    if (rcl_wait_set_clear(&ws) != RCL_RET_OK || rcl_wait_set_add_subscription(&ws, &sub, NULL) != RCL_RET_OK) break;
-    rcl_ret_t rc = rcl_wait(&ws, RCL_MS_TO_NS(50));
+    if (rcl_wait_set_clear(&h->ws) != RCL_RET_OK || rcl_wait_set_add_subscription(&h->ws, &h->sub, NULL) != RCL_RET_OK) {
+      rcl_reset_error();
+      break;
+    }
+    rcl_ret_t rc = rcl_wait(&h->ws, RCL_MS_TO_NS(50));
+    h->wakes++;
     if (rc == RCL_RET_TIMEOUT) continue;
     if (rc != RCL_RET_OK) { rcl_reset_error(); continue; }
     rmw_message_info_t info;
     int got = 0;
-    while (rcl_take(&sub, &js, &info, NULL) == RCL_RET_OK) got = 1;
+    while (rcl_take(&h->sub, &h->js, &info, NULL) == RCL_RET_OK) got = 1;
     if (!got) continue;
     double wall = now_s();
-    double t = js.header.stamp.sec + js.header.stamp.nanosec * 1e-9;
-    const double *q = js.position.data, *qd = js.velocity.data;
-    int nq = (int)js.position.size, nqd = (int)js.velocity.size;
+    const sensor_msgs__msg__JointState *js = &h->js;
+    double t = js->header.stamp.sec + js->header.stamp.nanosec * 1e-9;
+    const double *q = js->position.data, *qd = js->velocity.data;
+    int nq = (int)js->position.size, nqd = (int)js->velocity.size;
     int res = CP_BAD_STATE;
     pthread_mutex_lock(&h->mu);
+    h->taken++;
     if (good_state(h, t, q, nq, qd, nqd)) {
       res = law_locked(h, t, q, qd, tau);
       if (res == CP_NO_ROW && t > newest_row_t(h) + STAMP_TOL && h->row_wait > 0) {
@@ -287,7 +266,7 @@ static void *run(void *arg) {
           double left = until - now_s();
           if (left <= 0) break;
           struct timespec abs_;
-          clock_gettime(CLOCK_REALTIME, &abs_);
+          clock_gettime(CLOCK_MONOTONIC, &abs_);
           double s = abs_.tv_sec + 1e-9 * abs_.tv_nsec + left;
           abs_.tv_sec = (time_t)s;
           abs_.tv_nsec = (long)((s - (double)abs_.tv_sec) * 1e9);
@@ -305,10 +284,10 @@ static void *run(void *arg) {
     }
     pthread_mutex_unlock(&h->mu);
     if (res != CP_OK) continue;
-    memcpy(cmd.data.data, tau, sizeof(double) * n);
+    memcpy(h->cmd.data.data, tau, sizeof(double) * h->n);
     snprintf(label, sizeof label, "%s stamp=%.9f", h->label, t);
-    rosidl_runtime_c__String__assign(&cmd.layout.dim.data[0].label, label);
-    int ok = rcl_publish(&pub, &cmd, NULL) == RCL_RET_OK;
+    rosidl_runtime_c__String__assign(&h->cmd.layout.dim.data[0].label, label);
+    int ok = rcl_publish(&h->pub, &h->cmd, NULL) == RCL_RET_OK;
     if (!ok) rcl_reset_error();
     double done_at = now_s();
     pthread_mutex_lock(&h->mu);
@@ -322,58 +301,61 @@ static void *run(void *arg) {
     }
     pthread_mutex_unlock(&h->mu);
   }
-done:
-  pthread_mutex_lock(&h->mu);
-  if (h->running != 1) h->running = -1;
-  else h->running = 0;
-  pthread_mutex_unlock(&h->mu);
-  (void)!rcl_wait_set_fini(&ws);
-  (void)!rcl_subscription_fini(&sub, &node);
-  (void)!rcl_publisher_fini(&pub, &node);
-  (void)!rcl_node_fini(&node);
-  if (rcl_context_is_valid(&ctx)) (void)!rcl_shutdown(&ctx);
-  (void)!rcl_context_fini(&ctx);
-  (void)!rcl_init_options_fini(&io);
-  rcl_reset_error();
-  sensor_msgs__msg__JointState__fini(&js);
-  std_msgs__msg__Float64MultiArray__fini(&cmd);
   return NULL;
 }
 
-/* Start the thread: its own rcl context and node on ROS domain domain_id (negative: the
- * environment's ROS_DOMAIN_ID), the joint states of state_topic, commands on command_topic
- * (reliable, transient local, keep-last cmd_depth) labelled "<label> stamp=<t>". Returns 0, or -1
- * (cp_error says why) when the thread could not start or rcl failed within 10 s. */
-int cp_start(cp_t *h, const char *state_topic, const char *command_topic, int cmd_depth, const char *label,
-             int domain_id) {
+static void entities_fini(cp_t *h) {
+  if (!h->node) return;
+  (void)!rcl_wait_set_fini(&h->ws);
+  (void)!rcl_subscription_fini(&h->sub, h->node);
+  (void)!rcl_publisher_fini(&h->pub, h->node);
+  rcl_reset_error();
+  sensor_msgs__msg__JointState__fini(&h->js);
+  std_msgs__msg__Float64MultiArray__fini(&h->cmd);
+  h->node = NULL;
+}
+
+/* Start the thread on the caller's rcl node and context (rclpy's: Node.handle.pointer,
+ * Context.handle.pointer; one DDS participant for the process): a subscription to the joint
+ * states of state_topic (reliable, keep-last 1) and a publisher of the commands on command_topic
+ * (reliable, transient local, keep-last cmd_depth) labelled "<label> stamp=<t>", made here in the
+ * calling thread; the thread only waits, takes and publishes. Returns 0, or -1 (cp_error says
+ * why). cp_stop (or cp_destroy) before the node is destroyed. */
+int cp_start(cp_t *h, void *node, void *context, const char *state_topic, const char *command_topic, int cmd_depth,
+             const char *label) {
   if (h->thread) return 0;
-  snprintf(h->state_topic, sizeof h->state_topic, "%s", state_topic);
-  snprintf(h->command_topic, sizeof h->command_topic, "%s", command_topic);
   snprintf(h->label, sizeof h->label, "%s", label);
-  h->cmd_depth = cmd_depth;
-  h->domain_id = domain_id;
+  h->node = node;
+  h->sub = rcl_get_zero_initialized_subscription();
+  h->pub = rcl_get_zero_initialized_publisher();
+  h->ws = rcl_get_zero_initialized_wait_set();
+  sensor_msgs__msg__JointState__init(&h->js);
+  std_msgs__msg__Float64MultiArray__init(&h->cmd);
+  std_msgs__msg__MultiArrayDimension__Sequence__init(&h->cmd.layout.dim, 1);
+  h->cmd.layout.dim.data[0].size = h->n;
+  h->cmd.layout.dim.data[0].stride = h->n;
+  rosidl_runtime_c__double__Sequence__init(&h->cmd.data, h->n);
+  rcl_subscription_options_t so = rcl_subscription_get_default_options();
+  so.qos = qos(1, 0);
+  TRY(rcl_subscription_init(&h->sub, h->node, ROSIDL_GET_MSG_TYPE_SUPPORT(sensor_msgs, msg, JointState),
+                            state_topic, &so), "subscribing to the joint states");
+  rcl_publisher_options_t po = rcl_publisher_get_default_options();
+  po.qos = qos(cmd_depth, 1);
+  TRY(rcl_publisher_init(&h->pub, h->node, ROSIDL_GET_MSG_TYPE_SUPPORT(std_msgs, msg, Float64MultiArray),
+                         command_topic, &po), "advertising the commands");
+  TRY(rcl_wait_set_init(&h->ws, 1, 0, 0, 0, 0, 0, (rcl_context_t *)context, rcl_get_default_allocator()),
+      "rcl_wait_set_init");
   h->stop = 0;
   if (pthread_create(&h->thread, NULL, run, h) != 0) {
     snprintf(h->error, sizeof h->error, "pthread_create failed");
     h->thread = 0;
-    return -1;
+    goto fail;
   }
-  double t0 = now_s();
-  for (;;) {
-    pthread_mutex_lock(&h->mu);
-    int r = h->running;
-    pthread_mutex_unlock(&h->mu);
-    if (r == 1) return 0;
-    if (r == -1 || now_s() - t0 > 10.0) {
-      h->stop = 1;
-      pthread_join(h->thread, NULL);
-      h->thread = 0;
-      if (!h->error[0]) snprintf(h->error, sizeof h->error, "rcl did not start within 10 s");
-      return -1;
-    }
-    struct timespec ts = {0, 1000000};
-    nanosleep(&ts, NULL);
-  }
+  h->running = 1;
+  return 0;
+fail:
+  entities_fini(h);
+  return -1;
 }
 
 void cp_stop(cp_t *h) {
@@ -384,6 +366,8 @@ void cp_stop(cp_t *h) {
   pthread_mutex_unlock(&h->mu);
   pthread_join(h->thread, NULL);
   h->thread = 0;
+  h->running = 0;
+  entities_fini(h);
 }
 
 void cp_destroy(cp_t *h) {

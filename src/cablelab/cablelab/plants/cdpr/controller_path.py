@@ -5,7 +5,7 @@ Python plans the reference terms of each stamp (:meth:`LiveController.plan
 <cablelab.plants.cdpr.live.LiveController.plan>`) and the feedforward of the present estimate
 (:meth:`~cablelab.plants.cdpr.live.LiveController.planned_terms`) as soon as the reference comes,
 and puts them in the library as rows keyed by stamp; a new estimate re-plans the rows not used
-yet. A C thread (its own rcl context and node on the same domain) takes each joint state,
+yet. A C thread (subscribing and publishing through the node's own rcl node) takes each joint state,
 finds the row of its stamp and publishes :meth:`~cablelab.plants.cdpr.live.LiveController.
 planned_law`'s torques, the same doubles, without Python. A state it cannot answer (bad values,
 no row of its stamp) is handed to Python (:meth:`ControllerPath.handoff`), whose checks and law
@@ -43,7 +43,8 @@ def _bind(lib) -> None:
     lib.cp_handoff.argtypes = [P, _D, _D, _D, ctypes.POINTER(I), _D, ctypes.POINTER(I), I]
     lib.cp_stats.restype, lib.cp_stats.argtypes = None, [P, _D]
     lib.cp_latencies.restype, lib.cp_latencies.argtypes = I, [P, _D, I]
-    lib.cp_start.restype, lib.cp_start.argtypes = I, [P, ctypes.c_char_p, ctypes.c_char_p, I, ctypes.c_char_p, I]
+    lib.cp_start.restype = I
+    lib.cp_start.argtypes = [P, P, P, ctypes.c_char_p, ctypes.c_char_p, I, ctypes.c_char_p]
     lib.cp_stop.restype, lib.cp_stop.argtypes = None, [P]
     lib.cp_error.restype, lib.cp_error.argtypes = ctypes.c_char_p, [P]
     lib._cablelab_bound = True
@@ -76,7 +77,7 @@ class ControllerPath:
             raise ValueError(f"controller_path: cannot hold {self.n} winches")
         self.recent: deque = deque()       # (plan, rows) put lately: re-planned by a new estimate
         self.keep = keep
-        self._stats = np.zeros(7)
+        self._stats = np.zeros(9)
         self._lat = np.zeros(4096)
         self._q, self._qd = np.zeros(MAX_HANDOFF), np.zeros(MAX_HANDOFF)
         self._t, self._wall = np.zeros(1), np.zeros(1)
@@ -129,10 +130,12 @@ class ControllerPath:
         return rc, (out if rc == OK else None)
 
     # ------------------------------------------------------------------ the thread
-    def start(self, state_topic: str, command_topic: str, depth: int, label: str, domain_id: int) -> str | None:
-        """Start the thread answering ``state_topic`` on ``command_topic``; None, or why not."""
-        rc = self.lib.cp_start(self.h, state_topic.encode(), command_topic.encode(), int(depth), label.encode(),
-                               int(domain_id))
+    def start(self, node, state_topic: str, command_topic: str, depth: int, label: str) -> str | None:
+        """Start the thread answering ``state_topic`` on ``command_topic`` (keep-last ``depth``,
+        labels ``'<label> stamp=<t>'``) through the rcl node of the rclpy ``node`` (:meth:`close`
+        before it is destroyed); None, or why not."""
+        rc = self.lib.cp_start(self.h, node.handle.pointer, node.context.handle.pointer, state_topic.encode(),
+                               command_topic.encode(), int(depth), label.encode())
         return None if rc == 0 else (self.lib.cp_error(self.h) or b"").decode() or "failed"
 
     def handoff(self):
@@ -148,11 +151,13 @@ class ControllerPath:
     def stats(self) -> dict:
         """Counts of the thread: ``commanded``, ``handed_off``, ``waited`` (for a row),
         ``publish_failed``, ``running`` (1, 0 stopped, -1 failed), ``last_stamp`` and
-        ``last_wall`` of the last command (NaN before)."""
+        ``last_wall`` of the last command (NaN before), ``taken`` (states), ``wakes`` (of the
+        thread)."""
         self.lib.cp_stats(self.h, _ptr(self._stats))
         s = self._stats
         return {"commanded": int(s[0]), "handed_off": int(s[1]), "waited": int(s[2]), "publish_failed": int(s[3]),
-                "running": int(s[4]), "last_stamp": float(s[5]), "last_wall": float(s[6])}
+                "running": int(s[4]), "last_stamp": float(s[5]), "last_wall": float(s[6]), "taken": int(s[7]),
+                "wakes": int(s[8])}
 
     def latencies(self) -> np.ndarray:
         """Take -> published times (s) of the commands since the last call."""

@@ -68,12 +68,14 @@ class CdprController(PlantNode):
         # wakes the node). The states keep-last 1: after a busy moment the newest state is
         # answered, not a backlog whose commands the simulator would only count as stale
         q = stream_qos(1000)
-        # (with the compiled path, the C thread takes the states: the reference and the estimate
-        # wake this node, which plans the rows ahead)
-        wake = self._native is not None
-        self.subscribe(MultiDOFJointTrajectory, topics.REFERENCE, self.on_reference, q, raw=True, polled=not wake)
+        # (with the compiled path, the C thread takes the states, and each reference wakes this
+        # node, which plans its row at once: the simulator streams it only two periods ahead;
+        # the estimate waits queued for the timer)
+        self._unplanned = []
+        self.subscribe(MultiDOFJointTrajectory, topics.REFERENCE, self.on_reference, q, raw=True,
+                       polled=self._native is None)
         self.subscribe(InertiaStamped, topics.PAYLOAD_ESTIMATE, self.on_estimate, q,
-                       polled=not (wake or self.stream.awaits_estimate))
+                       polled=not self.stream.awaits_estimate)
         if self._native is None:
             self.create_subscription(JointState, topics.JOINT_STATES, self.on_state, stream_qos(1), raw=True)
         self.player = self.play_reference(v.reference_bag, topics.REFERENCE, ("x", "y", "z"), platform=True)
@@ -105,8 +107,7 @@ class CdprController(PlantNode):
         if self.controller is None or not hasattr(self, "timer"):
             return          # (again once both the description and the placement are here)
         path = ControllerPath(self._native, self.controller, row_wait=self.v.sync_wait)
-        problem = path.start(topics.JOINT_STATES, topics.EFFORT_COMMANDS, PUBLISHER_DEPTH, self._cmd.label,
-                             self.context.get_domain_id())
+        problem = path.start(self, topics.JOINT_STATES, topics.EFFORT_COMMANDS, PUBLISHER_DEPTH, self._cmd.label)
         if problem is None:
             self.path = path
             self.get_logger().info("compiled path: the joint states are answered by cablelab/csrc/controller_path.c")
@@ -116,14 +117,19 @@ class CdprController(PlantNode):
         self.get_logger().warning(f"{self.path_problem}: the Python path answers the joint states")
         self.create_subscription(JointState, topics.JOINT_STATES, self.on_state, stream_qos(1), raw=True)
 
-    def _plan(self, t: float, position, quat_wxyz, velocity, acceleration) -> None:
-        """The row of the reference of stamp ``t`` for the compiled path (a level platform: a
-        tilted reference is left to the Python path, whose prepare handles it)."""
-        if abs(quat_wxyz[0]) != 1.0 or quat_wxyz[1:].any():
+    def _plan(self) -> None:
+        """The rows of the references taken since the last call, planned in one block and put in
+        the compiled path (a level platform: a tilted reference is left to the Python path,
+        whose prepare handles it)."""
+        refs, self._unplanned = self._unplanned, []
+        refs = [r for r in refs if abs(r[2][0]) == 1.0 and not r[2][1:].any()]
+        if not refs:
             return
-        v = None if velocity is None else np.asarray(velocity, float)[None]
-        a = None if acceleration is None else np.asarray(acceleration, float)[None]
-        self.path.put(self.controller.plan(np.array([t]), np.asarray(position, float)[None], v, a))
+
+        def rows(k):
+            return np.array([np.full(3, np.nan) if r[k] is None else r[k] for r in refs], float)
+
+        self.path.put(self.controller.plan(np.array([r[0] for r in refs]), rows(1), rows(3), rows(4)))
 
     def on_reference(self, msg: MultiDOFJointTrajectory) -> None:
         """A reference sample (MultiDOFJointTrajectory or its serialised bytes)."""
@@ -132,7 +138,8 @@ class CdprController(PlantNode):
             quat = xyzw_to_wxyz(r["quaternion"])
             self.stream.reference(r["t"], r["position"], quat, r["linear_velocity"], r["linear_acceleration"])
             if self.path is not None:
-                self._plan(r["t"], r["position"], quat, r["linear_velocity"], r["linear_acceleration"])
+                self._unplanned.append((r["t"], r["position"], quat, r["linear_velocity"], r["linear_acceleration"]))
+                self._plan()
             self.command(self.stream.ready())
 
     def on_estimate(self, msg: InertiaStamped) -> None:
@@ -172,6 +179,8 @@ class CdprController(PlantNode):
         commanded once they came or it waited long enough; while states flow, their own callback
         takes the queued inputs and the timer only runs a due /diagnostics."""
         if self.path is not None:
+            self.take_polled()
+            self._plan()
             self._from_path()
         now = time.monotonic()
         if self.stream.pending is not None or (self.path is None and now - self._state_wall > 0.01):
@@ -217,7 +226,9 @@ class CdprController(PlantNode):
                                                 self.sent + path)
         if self.path is not None:
             values.update({"compiled path": "on", "commands from the compiled path": str(path),
-                           "states handed to Python": str(self._path_seen["handed_off"])})
+                           "states handed to Python": str(self._path_seen["handed_off"]),
+                           "states waiting for their row": str(self._path_seen["waited"]),
+                           "compiled path states taken / wake-ups": f"{self._path_seen['taken']} / {self._path_seen['wakes']}"})
         else:
             values["compiled path"] = "off" + (f" ({self.path_problem})" if self.path_problem else "")
         return level, msg, values
