@@ -211,3 +211,65 @@ def test_node_thread_answers_states_over_dds_and_reports_bad_ones(ros_context):
     finally:
         ctl.destroy_node()
         peer.destroy_node()
+
+
+@pytest.mark.parametrize("compiled", [True, False])
+def test_three_processes_answer_the_simulator_and_survive_the_estimator(launcher, compiled):
+    """cable_sim_node (real time) + payload_estimator + pd_feedforward as processes, with the
+    compiled path and without (the Python path, the oracle): the simulator gets its commands, the
+    feedforward takes the live mass; the estimator killed, the controller keeps commanding with
+    the nominal mass and says so on /diagnostics (WARN), and exits cleanly."""
+    if compiled:
+        _lib()
+    from diagnostic_msgs.msg import DiagnosticArray
+
+    launcher.node("estimator", "payload_estimator", "cdpr", {"poll_period": 0.01})
+    launcher.node("controller", "pd_feedforward", "cdpr", {"compiled_path": compiled, "estimate_timeout": 1.0})
+    probe = launcher.probe()
+    seen = {}
+
+    def on_diag(msg):
+        for s in msg.status:
+            seen[s.name] = (int.from_bytes(s.level, "little") if isinstance(s.level, bytes) else int(s.level),
+                            s.message, {kv.key: kv.value for kv in s.values}, time.monotonic())
+    probe.node.create_subscription(DiagnosticArray, "/diagnostics", on_diag, 50)
+
+    def diag(name):
+        return seen.get(name, (None, "", {}, 0.0))
+
+    def spin_until(cond, timeout, what):
+        end = time.monotonic() + timeout
+        while time.monotonic() < end:
+            for p in ("controller", "sim"):
+                if p in launcher.procs:
+                    assert launcher.procs[p].alive(), launcher.procs[p].log()[-2000:]
+            probe.executor.spin_once(timeout_sec=0.05)
+            if cond():
+                return
+        raise AssertionError(f"timeout after {timeout} s waiting for {what}; pd_feedforward: "
+                             f"{diag('pd_feedforward')}; sim: {diag('cable_sim_node')}")
+
+    spin_until(lambda: "pd_feedforward" in seen and "payload_estimator" in seen, 120, "the nodes' diagnostics")
+    launcher.node("sim", "cable_sim_node", "cdpr", {"rate": 250.0, "real_time": True, "payload_mass": 249.0,
+                                                    "duration": 600.0, "settle": 1.0})
+
+    def ctl():
+        return diag("pd_feedforward")[2]
+
+    spin_until(lambda: int(diag("cable_sim_node")[2].get("effort_commands received", "0")) > 250
+               and ctl().get("feedforward mass kg", "-") not in ("-",), 120, "commands and estimates")
+    assert ctl()["compiled path"] == ("on" if compiled else "off")
+    if compiled:
+        spin_until(lambda: int(ctl().get("commands from the compiled path", "0")) > 200, 60, "compiled commands")
+    mass = float(ctl()["feedforward mass kg"])
+    assert 500.0 < mass < 700.0, mass       # 366 kg platform + 249 kg payload
+    launcher.kill("estimator")
+    killed = time.monotonic()
+    spin_until(lambda: diag("pd_feedforward")[0] == 1 and "nominal mass" in diag("pd_feedforward")[1]
+               and diag("pd_feedforward")[3] > killed, 60, "a WARN about the stale estimate")
+    before = int(ctl()["commands"])
+    spin_until(lambda: int(ctl()["commands"]) > before + 250, 60, "more commands after the estimator died")
+    if compiled:
+        assert int(ctl()["commands from the compiled path"]) > before - int(ctl()["states handed to Python"])
+    codes = launcher.stop_all()
+    assert codes["controller"] == 0, launcher.procs["controller"].log()[-2000:]
