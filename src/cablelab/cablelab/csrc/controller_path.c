@@ -68,6 +68,7 @@ typedef struct {
   volatile int stop;
   char label[64], error[256];
   rcl_node_t *node;
+  rcl_context_t *context;
   rcl_subscription_t sub;
   rcl_publisher_t pub;
   rcl_wait_set_t ws;
@@ -243,7 +244,13 @@ static void *run(void *arg) {
     rcl_ret_t rc = rcl_wait(&h->ws, RCL_MS_TO_NS(50));
     h->wakes++;
     if (rc == RCL_RET_TIMEOUT) continue;
-    if (rc != RCL_RET_OK) { rcl_reset_error(); continue; }
+    if (rc != RCL_RET_OK) {
+      rcl_reset_error();
+      if (!rcl_context_is_valid(h->context)) break; /* rclpy shut down: nothing more will come */
+      struct timespec ts = {0, 1000000};
+      nanosleep(&ts, NULL);
+      continue;
+    }
     rmw_message_info_t info;
     int got = 0;
     while (rcl_take(&h->sub, &h->js, &info, NULL) == RCL_RET_OK) got = 1;
@@ -326,6 +333,7 @@ int cp_start(cp_t *h, void *node, void *context, const char *state_topic, const 
   if (h->thread) return 0;
   snprintf(h->label, sizeof h->label, "%s", label);
   h->node = node;
+  h->context = context;
   h->sub = rcl_get_zero_initialized_subscription();
   h->pub = rcl_get_zero_initialized_publisher();
   h->ws = rcl_get_zero_initialized_wait_set();

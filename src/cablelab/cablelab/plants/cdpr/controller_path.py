@@ -28,7 +28,7 @@ LIBRARY = "controller_path"
 MAX_HANDOFF = 256          # values of a handed-off state read back (the library keeps as many)
 OK, NO_ROW, BAD_STATE = 0, 1, 2
 
-_D = ctypes.POINTER(ctypes.c_double)
+_D = ctypes.c_void_p       # float64 arrays, passed by address (ndarray.ctypes.data)
 
 
 def _bind(lib) -> None:
@@ -50,8 +50,8 @@ def _bind(lib) -> None:
     lib._cablelab_bound = True
 
 
-def _ptr(a: np.ndarray):
-    return a.ctypes.data_as(_D)
+def _ptr(a: np.ndarray) -> int:
+    return a.ctypes.data
 
 
 class ControllerPath:
@@ -76,7 +76,7 @@ class ControllerPath:
         if not self.h:
             raise ValueError(f"controller_path: cannot hold {self.n} winches")
         self.recent: deque = deque()       # (plan, rows) put lately: re-planned by a new estimate
-        self.keep = keep
+        self.keep, self._kept = keep, 0
         self._stats = np.zeros(9)
         self._lat = np.zeros(4096)
         self._q, self._qd = np.zeros(MAX_HANDOFF), np.zeros(MAX_HANDOFF)
@@ -105,8 +105,9 @@ class ControllerPath:
         kept = self.lib.cp_put_rows(self.h, len(t), _ptr(t), _ptr(pd), None if ff is None else _ptr(ff), _ptr(fric))
         if remember:
             self.recent.append((plan, idx))
-        while sum(len(r) for _, r in self.recent) > self.keep and len(self.recent) > 1:
-            self.recent.popleft()
+            self._kept += len(idx)
+            while self._kept > self.keep and len(self.recent) > 1:
+                self._kept -= len(self.recent.popleft()[1])
         return kept
 
     def replan(self) -> int:

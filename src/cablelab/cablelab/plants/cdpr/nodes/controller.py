@@ -55,6 +55,7 @@ class CdprController(PlantNode):
             self._native = native.load("controller_path")
             if self._native is None:
                 self.path_problem = f"compiled path unavailable ({native.unavailable_reason('controller_path')})"
+                self.get_logger().info(f"{self.path_problem}: the Python path answers the joint states")
         self.sent = 0
         self._cmd = CommandTemplate("winch")     # pre-serialised commands naming their state's stamp
         self.inputs.add("joint_states", timeout=v.state_timeout)
