@@ -59,7 +59,7 @@ typedef struct {
   double h_t, h_wall, h_q[CP_HANDOFF], h_qd[CP_HANDOFF];
   /* counters (Python reads them for /diagnostics) */
   long commanded, handed_off, waited, publish_failed, taken, wakes;
-  double last_commanded_t, last_commanded_wall;
+  double last_commanded_t, last_commanded_wall, last_taken_t;
   double lat[CP_LAT];
   long nlat;
   /* the thread and its rcl entities (on the caller's node) */
@@ -90,7 +90,7 @@ cp_t *cp_create(int n, int has_ff, double kp, double kd, double floor_, double m
   if (!h->rows) { free(h); return NULL; }
   h->n = n; h->has_ff = has_ff; h->kp = kp; h->kd = kd; h->floor_ = floor_;
   h->max_torque = max_torque; h->row_wait = row_wait;
-  h->last_commanded_t = NAN; h->last_commanded_wall = NAN;
+  h->last_commanded_t = NAN; h->last_commanded_wall = NAN; h->last_taken_t = NAN;
   pthread_mutex_init(&h->mu, NULL);
   pthread_condattr_t ca;
   pthread_condattr_init(&ca);
@@ -191,13 +191,14 @@ int cp_handoff(cp_t *h, double *t, double *wall, double *q, int *nq, double *qd,
   return ready;
 }
 
-/* out[0..8]: commanded, handed off, waited for a row, publish failures, running (1/0, -1 failed),
- * stamp and wall time of the last command, states taken, wake-ups of the thread */
+/* out[0..9]: commanded, handed off, waited for a row, publish failures, running (1/0, -1 failed),
+ * stamp and wall time of the last command, states taken, wake-ups of the thread, stamp of the
+ * last state taken */
 void cp_stats(cp_t *h, double *out) {
   pthread_mutex_lock(&h->mu);
   out[0] = h->commanded; out[1] = h->handed_off; out[2] = h->waited; out[3] = h->publish_failed;
   out[4] = h->running; out[5] = h->last_commanded_t; out[6] = h->last_commanded_wall;
-  out[7] = h->taken; out[8] = h->wakes;
+  out[7] = h->taken; out[8] = h->wakes; out[9] = h->last_taken_t;
   pthread_mutex_unlock(&h->mu);
 }
 
@@ -263,6 +264,7 @@ static void *run(void *arg) {
     int res = CP_BAD_STATE;
     pthread_mutex_lock(&h->mu);
     h->taken++;
+    if (isfinite(t)) h->last_taken_t = t;
     if (good_state(h, t, q, nq, qd, nqd)) {
       res = law_locked(h, t, q, qd, tau);
       if (res == CP_NO_ROW && t > newest_row_t(h) + STAMP_TOL && h->row_wait > 0) {

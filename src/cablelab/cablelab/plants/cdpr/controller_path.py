@@ -77,7 +77,7 @@ class ControllerPath:
             raise ValueError(f"controller_path: cannot hold {self.n} winches")
         self.recent: deque = deque()       # (plan, rows) put lately: re-planned by a new estimate
         self.keep, self._kept = keep, 0
-        self._stats = np.zeros(9)
+        self._stats = np.zeros(10)
         self._lat = np.zeros(4096)
         self._q, self._qd = np.zeros(MAX_HANDOFF), np.zeros(MAX_HANDOFF)
         self._t, self._wall = np.zeros(1), np.zeros(1)
@@ -153,12 +153,12 @@ class ControllerPath:
         """Counts of the thread: ``commanded``, ``handed_off``, ``waited`` (for a row),
         ``publish_failed``, ``running`` (1, 0 stopped, -1 failed), ``last_stamp`` and
         ``last_wall`` of the last command (NaN before), ``taken`` (states), ``wakes`` (of the
-        thread)."""
+        thread), ``last_taken`` (stamp of the last state taken, NaN before)."""
         self.lib.cp_stats(self.h, _ptr(self._stats))
         s = self._stats
         return {"commanded": int(s[0]), "handed_off": int(s[1]), "waited": int(s[2]), "publish_failed": int(s[3]),
                 "running": int(s[4]), "last_stamp": float(s[5]), "last_wall": float(s[6]), "taken": int(s[7]),
-                "wakes": int(s[8])}
+                "wakes": int(s[8]), "last_taken": float(s[9])}
 
     def latencies(self) -> np.ndarray:
         """Take -> published times (s) of the commands since the last call."""

@@ -42,6 +42,11 @@ from ....rotations import xyzw_to_wxyz
 from .parameters import CONTROLLER as PARAMETERS
 
 
+#: the compiled path's rows are planned once the oldest unplanned reference is less than this many
+#: reference periods ahead of the newest joint state
+PLAN_MARGIN = 4
+
+
 class CdprController(PlantNode):
     def __init__(self):
         super().__init__("pd_feedforward", start_parameter_services=False)  # smaller wait set
@@ -118,10 +123,20 @@ class CdprController(PlantNode):
         self.get_logger().warning(f"{self.path_problem}: the Python path answers the joint states")
         self.create_subscription(JointState, topics.JOINT_STATES, self.on_state, stream_qos(1), raw=True)
 
-    def _plan(self) -> None:
+    def _plan(self, when_due: bool = False) -> None:
         """The rows of the references taken since the last call, planned in one block and put in
         the compiled path (a level platform: a tilted reference is left to the Python path,
-        whose prepare handles it)."""
+        whose prepare handles it). ``when_due``: only once the oldest of them is less than
+        :data:`PLAN_MARGIN` reference periods ahead of the newest state the thread took (a
+        reference streamed far ahead is planned in blocks; one two periods ahead, as the
+        simulator streams it by default, at once)."""
+        if not self._unplanned:
+            return
+        if when_due and len(self._unplanned) > 1:
+            dt = self._unplanned[-1][0] - self._unplanned[-2][0]
+            newest = self.path.stats()["last_taken"]
+            if dt > 0 and math.isfinite(newest) and self._unplanned[0][0] - newest > PLAN_MARGIN * dt:
+                return
         refs, self._unplanned = self._unplanned, []
         refs = [r for r in refs if abs(r[2][0]) == 1.0 and not r[2][1:].any()]
         if not refs:
@@ -140,7 +155,7 @@ class CdprController(PlantNode):
             self.stream.reference(r["t"], r["position"], quat, r["linear_velocity"], r["linear_acceleration"])
             if self.path is not None:
                 self._unplanned.append((r["t"], r["position"], quat, r["linear_velocity"], r["linear_acceleration"]))
-                self._plan()
+                self._plan(when_due=True)
             self.command(self.stream.ready())
 
     def on_estimate(self, msg: InertiaStamped) -> None:
@@ -181,7 +196,7 @@ class CdprController(PlantNode):
         takes the queued inputs and the timer only runs a due /diagnostics."""
         if self.path is not None:
             self.take_polled()
-            self._plan()
+            self._plan(when_due=True)
             self._from_path()
         now = time.monotonic()
         if self.stream.pending is not None or (self.path is None and now - self._state_wall > 0.01):
