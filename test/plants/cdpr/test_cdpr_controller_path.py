@@ -90,12 +90,17 @@ def test_bad_states_and_missing_rows_are_not_answered_and_a_new_estimate_replans
         pos[3] = np.nan
         bad = ctl.plan(tt + 1.0, pos, tr.velocity, tr.acceleration)
         assert path.put(bad) == len(tt) - 1 and path.law(tt[3] + 1.0, q, qd)[0] == NO_ROW
+        # nor a row with a term that is not finite (planned_law would give NaN or inf there)
+        inf = ctl.plan(tt + 2.0, tr.position, tr.velocity, tr.acceleration)
+        inf.pd[2, 0], inf.friction[5, 1] = np.nan, np.inf
+        assert path.put(inf) == len(tt) - 2
+        assert path.law(tt[2] + 2.0, q, qd)[0] == NO_ROW and path.law(tt[5] + 2.0, q, qd)[0] == NO_ROW
         # a new estimate re-plans the rows not answered yet
         q = plan.pd[6] / ctl.config.gains.kp        # on the reference: no saturation
         before = path.law(tt[6], q, qd)[1]
         for c in (ctl, oracle):
             c.estimate(tt[0], 700.0, np.array([0.1, -0.05]))
-        assert path.replan() == (len(tt) - 1) + len(tt)      # nothing answered by the thread yet
+        assert path.replan() == len(tt) + (len(tt) - 1) + (len(tt) - 2)     # nothing answered yet
         after = path.law(tt[6], q, qd)[1]
         assert np.abs(after - before).max() > 1e-3
         np.testing.assert_allclose(after, oracle.planned_law(plan, 6, q.copy(), qd.copy()), rtol=1e-13, atol=1e-12)

@@ -93,12 +93,20 @@ class ControllerPath:
 
     # ------------------------------------------------------------------ rows
     def put(self, plan: ReferencePlan, rows=None, remember: bool = True) -> int:
-        """Put the valid ``rows`` (default all) of ``plan`` with the present estimate; returns
+        """Put the valid ``rows`` (default all) of ``plan`` with the present estimate (a row
+        with a term that is not finite is left out: its states go to the Python path); returns
         how many the library kept (an older stamp it no longer holds is not)."""
         idx = np.flatnonzero(plan.valid) if rows is None else np.asarray(rows)[plan.valid[rows]]
         if idx.size == 0:
             return 0
         pd, ff, fric, _ = self.controller.planned_terms(plan, idx)
+        finite = np.isfinite(pd).all(1) & np.isfinite(fric).all(1)
+        if ff is not None:
+            finite &= np.isfinite(ff).all(1)
+        if not finite.all():        # (a reference far outside the workspace: the Python path says why)
+            idx, pd, fric, ff = idx[finite], pd[finite], fric[finite], None if ff is None else ff[finite]
+            if idx.size == 0:
+                return 0
         t = np.ascontiguousarray(plan.t[idx], float)
         pd, fric = np.ascontiguousarray(pd), np.ascontiguousarray(fric)
         ff = None if ff is None else np.ascontiguousarray(ff)

@@ -145,7 +145,11 @@ class CdprController(PlantNode):
         def rows(k):
             return np.array([np.full(3, np.nan) if r[k] is None else r[k] for r in refs], float)
 
-        self.path.put(self.controller.plan(np.array([r[0] for r in refs]), rows(1), rows(3), rows(4)))
+        try:
+            plan = self.controller.plan(np.array([r[0] for r in refs]), rows(1), rows(3), rows(4))
+        except (np.linalg.LinAlgError, ValueError, FloatingPointError):
+            return          # (no rows: the Python path prepares those stamps and says why)
+        self.path.put(plan)
 
     def on_reference(self, msg: MultiDOFJointTrajectory) -> None:
         """A reference sample (MultiDOFJointTrajectory or its serialised bytes)."""
