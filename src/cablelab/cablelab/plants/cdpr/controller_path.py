@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import atexit
 import ctypes
-from collections import deque
 
 import numpy as np
 
@@ -75,8 +74,8 @@ class ControllerPath:
                                float(row_wait))
         if not self.h:
             raise ValueError(f"controller_path: cannot hold {self.n} winches")
-        self.recent: deque = deque()       # (plan, rows) put lately: re-planned by a new estimate
-        self.keep, self._kept = keep, 0
+        self.recent: ReferencePlan | None = None     # the rows put lately: re-planned by a new estimate
+        self.keep = keep
         self._stats = np.zeros(10)
         self._lat = np.zeros(4096)
         self._q, self._qd = np.zeros(MAX_HANDOFF), np.zeros(MAX_HANDOFF)
@@ -112,21 +111,27 @@ class ControllerPath:
         ff = None if ff is None else np.ascontiguousarray(ff)
         kept = self.lib.cp_put_rows(self.h, len(t), _ptr(t), _ptr(pd), None if ff is None else _ptr(ff), _ptr(fric))
         if remember:
-            self.recent.append((plan, idx))
-            self._kept += len(idx)
-            while self._kept > self.keep and len(self.recent) > 1:
-                self._kept -= len(self.recent.popleft()[1])
+            self._remember(plan, idx)
         return kept
+
+    def _remember(self, plan: ReferencePlan, idx: np.ndarray) -> None:
+        """Keep the newest :attr:`keep` rows put, as one plan, for :meth:`replan`."""
+        r = self.recent
+        parts = [(plan.t[idx], plan.pd[idx], plan.friction[idx], None if plan.ff is None else plan.ff[idx])]
+        if r is not None:
+            parts.insert(0, (r.t, r.pd, r.friction, r.ff))
+        t, pd, fric = (np.concatenate([p[k] for p in parts])[-self.keep:] for k in range(3))
+        ff = None if plan.ff is None else np.concatenate([p[3] for p in parts])[-self.keep:]
+        self.recent = ReferencePlan(t, (None, None, None), np.ones(len(t), bool), pd, fric, ff)
 
     def replan(self) -> int:
         """Put again, with the present estimate, the remembered rows not answered yet."""
+        r = self.recent
+        if r is None:
+            return 0
         last = self.stats()["last_stamp"]
-        kept = 0
-        for plan, idx in list(self.recent):
-            todo = idx if not np.isfinite(last) else idx[plan.t[idx] > last]
-            if todo.size:
-                kept += self.put(plan, todo, remember=False)
-        return kept
+        todo = np.arange(len(r.t)) if not np.isfinite(last) else np.flatnonzero(r.t > last)
+        return self.put(r, todo, remember=False) if todo.size else 0
 
     # ------------------------------------------------------------------ the law
     def law(self, t: float, q, qdot) -> tuple[int, np.ndarray | None]:

@@ -33,7 +33,7 @@ from trajectory_msgs.msg import MultiDOFJointTrajectory
 from .. import topics
 from ..controller_path import ControllerPath
 from ..streams import CommandStream, controller_config
-from ....ros import convert
+from ....ros import convert, fastspin
 from ....ros.plant_node import PlantNode
 from ....ros.qos import PUBLISHER_DEPTH, publisher_qos, stream_qos
 from ....ros.rawmsg import CommandTemplate
@@ -45,6 +45,9 @@ from .parameters import CONTROLLER as PARAMETERS
 #: the compiled path's rows are planned once the oldest unplanned reference is less than this many
 #: reference periods ahead of the newest joint state
 PLAN_MARGIN = 4
+#: with the compiled path, a reference streamed at least this many periods ahead of the states
+#: (1000 times in a row) stops waking the node: the timer (every 2 ms) takes it and plans the block
+FAR_AHEAD = 3 * PLAN_MARGIN
 
 
 class CdprController(PlantNode):
@@ -78,8 +81,9 @@ class CdprController(PlantNode):
         # node, which plans its row at once: the simulator streams it only two periods ahead;
         # the estimate waits queued for the timer)
         self._unplanned = []
-        self.subscribe(MultiDOFJointTrajectory, topics.REFERENCE, self.on_reference, q, raw=True,
-                       polled=self._native is None)
+        self._far_ahead = 0         # references in a row streamed far ahead of the states
+        self._ref_sub = self.subscribe(MultiDOFJointTrajectory, topics.REFERENCE, self.on_reference, q, raw=True,
+                                       polled=self._native is None)
         self.subscribe(InertiaStamped, topics.PAYLOAD_ESTIMATE, self.on_estimate, q,
                        polled=not self.stream.awaits_estimate)
         if self._native is None:
@@ -135,8 +139,13 @@ class CdprController(PlantNode):
         if when_due and len(self._unplanned) > 1:
             dt = self._unplanned[-1][0] - self._unplanned[-2][0]
             newest = self.path.stats()["last_taken"]
-            if dt > 0 and math.isfinite(newest) and self._unplanned[0][0] - newest > PLAN_MARGIN * dt:
-                return
+            if dt > 0 and math.isfinite(newest):
+                ahead = (self._unplanned[-1][0] - newest) / dt
+                self._far_ahead = self._far_ahead + 1 if ahead >= FAR_AHEAD else 0
+                if self._far_ahead == 1000 and self._ref_sub not in self.polled:
+                    fastspin.poll(self, self._ref_sub)
+                if self._unplanned[0][0] - newest > PLAN_MARGIN * dt:
+                    return
         refs, self._unplanned = self._unplanned, []
         refs = [r for r in refs if abs(r[2][0]) == 1.0 and not r[2][1:].any()]
         if not refs:
