@@ -82,6 +82,7 @@ class CdprController(PlantNode):
         # the estimate waits queued for the timer)
         self._unplanned = []
         self._far_ahead = 0         # references in a row streamed far ahead of the states
+        self._ref_t, self._ref_dt = None, 0.0     # the last reference's stamp, the reference period
         self._ref_sub = self.subscribe(MultiDOFJointTrajectory, topics.REFERENCE, self.on_reference, q, raw=True,
                                        polled=self._native is None)
         self.subscribe(InertiaStamped, topics.PAYLOAD_ESTIMATE, self.on_estimate, q,
@@ -136,8 +137,8 @@ class CdprController(PlantNode):
         simulator streams it by default, at once)."""
         if not self._unplanned:
             return
-        if when_due and len(self._unplanned) > 1:
-            dt = self._unplanned[-1][0] - self._unplanned[-2][0]
+        if when_due:
+            dt = self._ref_dt
             newest = self.path.stats()["last_taken"]
             if dt > 0 and math.isfinite(newest):
                 ahead = (self._unplanned[-1][0] - newest) / dt
@@ -167,6 +168,9 @@ class CdprController(PlantNode):
             quat = xyzw_to_wxyz(r["quaternion"])
             self.stream.reference(r["t"], r["position"], quat, r["linear_velocity"], r["linear_acceleration"])
             if self.path is not None:
+                if self._ref_t is not None and r["t"] > self._ref_t:
+                    self._ref_dt = r["t"] - self._ref_t       # the reference's period
+                self._ref_t = r["t"]
                 self._unplanned.append((r["t"], r["position"], quat, r["linear_velocity"], r["linear_acceleration"]))
                 self._plan(when_due=True)
             self.command(self.stream.ready())
