@@ -10,9 +10,10 @@ estimate falls back to the nominal mass (WARN on /diagnostics). Without a refere
 bad motor state) nothing is published (the simulator's brakes hold) and /diagnostics says why.
 Matching samples by stamp: :class:`cablelab.plants.cdpr.streams.CommandStream`.
 
-Compiled path (parameter ``compiled_path``, on unless ``CABLELAB_NATIVE=0`` or no compiler): each
-reference is planned as it comes (:meth:`LiveController.plan <cablelab.plants.cdpr.live.
-LiveController.plan>`, a new estimate re-plans the rows not used) and put in
+Compiled path (parameter ``compiled_path``, on unless ``CABLELAB_NATIVE=0`` or no compiler): the
+references are planned as they come, or in blocks when they come far ahead (:meth:`LiveController.
+plan <cablelab.plants.cdpr.live.LiveController.plan>`; a new estimate re-plans the rows not used),
+and put in
 :class:`~cablelab.plants.cdpr.controller_path.ControllerPath`, whose C thread answers the joint
 states with the same law without Python; a state it cannot answer (bad, or no planned row of its
 stamp) comes back here and takes the Python path below, which checks and reports it.
@@ -77,9 +78,8 @@ class CdprController(PlantNode):
         # wakes the node). The states keep-last 1: after a busy moment the newest state is
         # answered, not a backlog whose commands the simulator would only count as stale
         q = stream_qos(1000)
-        # (with the compiled path, the C thread takes the states, and each reference wakes this
-        # node, which plans its row at once: the simulator streams it only two periods ahead;
-        # the estimate waits queued for the timer)
+        # (with the compiled path the C thread takes the states and each reference wakes this
+        # node, which plans its row when due (:meth:`_plan`); the estimate waits for the timer)
         self._unplanned = []
         self._far_ahead = 0         # references in a row streamed far ahead of the states
         self._ref_t, self._ref_dt = None, 0.0     # the last reference's stamp, the reference period
@@ -260,8 +260,7 @@ class CdprController(PlantNode):
         if self.path is not None:
             values.update({"compiled path": "on", "commands from the compiled path": str(path),
                            "states handed to Python": str(self._path_seen["handed_off"]),
-                           "states waiting for their row": str(self._path_seen["waited"]),
-                           "compiled path states taken / wake-ups": f"{self._path_seen['taken']} / {self._path_seen['wakes']}"})
+                           "states waiting for their row": str(self._path_seen["waited"])})
         else:
             values["compiled path"] = "off" + (f" ({self.path_problem})" if self.path_problem else "")
         return level, msg, values
