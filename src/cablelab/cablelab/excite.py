@@ -93,6 +93,11 @@ class Exciter:
         tune: ``fn(params) -> {field: value}``: fields of this exciter chosen by the named
             parameters (e.g. a family fast enough to show a delay, or slow and wide enough to show
             what the travel reveals); None: the same fields for every design.
+        loaded: ``fn(description, values) -> description`` whose ``motion_dataset`` synthesises
+            the measurement of the load a recording's fit found (``values``: its linear
+            parameters), for a plant whose delay column re-forms the outputs from that
+            measurement (``remeasure``; the CDPR's tensions scale with the moving mass); None:
+            the described machine's.
     """
 
     limits: Callable
@@ -106,6 +111,7 @@ class Exciter:
     start: Callable | None = None
     stacked: bool | None = None
     tune: Callable | None = None
+    loaded: Callable | None = None
 
 
 _EXCITERS: dict[str, Exciter] = {}
@@ -612,6 +618,7 @@ def design(plant_name: str, desc, params: Sequence[str], *, duration: float = 60
     fs = ex.grid * ex.base_hz * h
     t = np.arange(0.0, duration, 1.0 / fs)
     probe = ex.motion_dataset(t, *scaled_motion(np.ones(shape), t, lim, ex.base_hz, duration), desc)
+    mdesc = desc          # the description the designed motion's datasets are built with
     model, _ = model_for(plant, desc, params, probe)
     from .model import Model
 
@@ -631,6 +638,12 @@ def design(plant_name: str, desc, params: Sequence[str], *, duration: float = 60
             # the synthesised one would stay in the residual, and its change under a delay (the
             # wrench map's motion times that tension difference) is not the delay's column.
             own = Model(plant.name, tuple(model.effects), {**model.fixed, "tau": tau0})
+            if before_ds is not None and ex.loaded is not None:
+                # the measurement synthesised for the load the recording's fit found: the
+                # delay's column (the tensions' change within tau) scales with the moving mass
+                mdesc = ex.loaded(desc, linear_values(own, before_ds, vals))
+                probe = ex.motion_dataset(t, *scaled_motion(np.ones(shape), t, lim, ex.base_hz, duration),
+                                          mdesc)
             model = Linearised(model, linear_values(own, probe, vals), tau0)
         else:
             model = Linearised(model, linear_values(model, before_ds, vals, probe), tau0)
@@ -656,12 +669,12 @@ def design(plant_name: str, desc, params: Sequence[str], *, duration: float = 60
     # stacked evaluation when the plant's dataset keeps one sample per reference sample (not the
     # leg's, built per hop): checked once on two stacked motions
     stacked = ex.stacked if ex.stacked is not None else \
-        ex.motion_dataset(*_stacked_motion(np.ones((2, n)), basis, t, lim, shape), desc).n == 2 * len(t)
+        ex.motion_dataset(*_stacked_motion(np.ones((2, n)), basis, t, lim, shape), mdesc).n == 2 * len(t)
 
     def conditions(xs):
         """(log condition numbers, log information per sample of ``info`` or None) of motions xs."""
         if stacked:
-            ds = ex.motion_dataset(*_stacked_motion(xs, basis, t, lim, shape), desc)
+            ds = ex.motion_dataset(*_stacked_motion(xs, basis, t, lim, shape), mdesc)
             if isinstance(model, Linearised):
                 # the delay's column at a block's first and last sample reaches into the next
                 # block, where a motion of its own has no sample (NaN, left out): left out here
@@ -674,7 +687,7 @@ def design(plant_name: str, desc, params: Sequence[str], *, duration: float = 60
             c, per = block_terms(model, ds, len(xs), params, info, sigma)
         else:
             terms = [block_terms(model, ex.motion_dataset(
-                t, *scaled_motion(x.reshape(shape), t, lim, ex.base_hz, duration), desc), 1, params,
+                t, *scaled_motion(x.reshape(shape), t, lim, ex.base_hz, duration), mdesc), 1, params,
                 info, sigma) for x in xs]
             c = np.concatenate([a for a, _ in terms])
             per = None if info is None else np.concatenate([b for _, b in terms])
@@ -708,7 +721,7 @@ def design(plant_name: str, desc, params: Sequence[str], *, duration: float = 60
     bad = check.check(q, qd, qdd)
     if bad:   # a plant whose box does not guarantee its constraint: refuse, never write it
         raise CablelabError(f"designed reference breaks the machine's limits: {bad[0]}")
-    after_ds = ex.motion_dataset(t_out, q, qd, qdd, desc)
+    after_ds = ex.motion_dataset(t_out, q, qd, qdd, mdesc)
     after = condition(model, after_ds, params)
     before = condition(model, before_ds, params) if before_ds is not None else None
     detect = None
