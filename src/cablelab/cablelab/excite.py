@@ -373,8 +373,8 @@ def detectable_delay(model: "Linearised", ds, sigma, n_eff_per_s: float, *,
     is the smallest delay detectable.
 
     Returns:
-        ``{"tau": s, "by_gain": s, "by_test": s, "snr": (C,) s_c in 1/s}``; inf when the
-        motion does not show a delay at all.
+        ``{"tau": s, "by_gain": s, "by_test": s, "snr": (C,) s_c in 1/s, "min_gain"}``; inf
+        when the motion does not show a delay at all.
     """
     import scipy.optimize
     import scipy.stats
@@ -397,7 +397,8 @@ def detectable_delay(model: "Linearised", ds, sigma, n_eff_per_s: float, *,
     out_snr[live] = np.sqrt(np.mean(col.reshape(n, c) ** 2, axis=0)) if n else 0.0
     snr = out_snr[out_snr > 0]              # the channels the delay changes
     if snr.size == 0:
-        return {"tau": float("inf"), "by_gain": float("inf"), "by_test": float("inf"), "snr": out_snr}
+        return {"tau": float("inf"), "by_gain": float("inf"), "by_test": float("inf"), "snr": out_snr,
+                "min_gain": MIN_GAIN}
     need_gain = -2.0 * np.log(1.0 - MIN_GAIN)
     n_eff = max(n_eff_per_s * float(ds.t[-1] - ds.t[0]), 3.0)
     need_test = scipy.stats.chi2.isf(ALPHA / max(n_candidates, 1), 1) / n_eff
@@ -405,14 +406,15 @@ def detectable_delay(model: "Linearised", ds, sigma, n_eff_per_s: float, *,
     def solve(level, weight):   # the tau where weight * sum_c log(1 + tau^2 s_c^2) = level
         lo = np.sqrt(np.expm1(level / (weight * snr.size))) / snr.max()   # every channel the best
         hi = np.sqrt(np.expm1(level / weight)) / snr.max()                # the best channel alone
-        if hi <= lo * (1 + 1e-12):
-            return float(lo)
         f = lambda tau: weight * np.sum(np.log1p(tau ** 2 * snr ** 2)) - level
+        if hi <= lo * (1 + 1e-12) or f(lo) >= 0:     # equal channels: lo is the root
+            return float(lo)
         return float(scipy.optimize.brentq(f, lo, hi, xtol=1e-12 * hi, rtol=1e-10))
 
     by_gain = solve(need_gain, 1.0 / snr.size)
     by_test = solve(need_test, 1.0)
-    return {"tau": max(by_gain, by_test), "by_gain": by_gain, "by_test": by_test, "snr": out_snr}
+    return {"tau": max(by_gain, by_test), "by_gain": by_gain, "by_test": by_test, "snr": out_snr,
+            "min_gain": MIN_GAIN}
 
 
 def linear_values(model, ds, values: dict | None = None, columns_ds=None) -> dict:
@@ -508,6 +510,21 @@ def _stacked_motion(xs, basis, t, limits: Limits, shape):
     q, qd, qdd = _scale(*(np.einsum("nh,kjh->knj", m, flat) for m in basis), limits)
     t_all = (t[None, :] + span * np.arange(len(xs))[:, None]).ravel()
     return (t_all,) + tuple(m.reshape(-1, shape[0]) for m in (q, qd, qdd))
+
+
+def stacked_dataset(ex: Exciter, xs, basis, t, limits: Limits, shape, desc, edges: bool = False):
+    """The plant's dataset of the motions ``xs`` stacked by :func:`_stacked_motion`. ``edges``
+    (a design naming the delay): each block's first and last sample left out, as a motion of
+    its own has them (the delay's column there reaches beyond the motion: NaN), so every block
+    is its motion's own and the cost's differences between blocks are the motions' (kept, one
+    such row moved the CDPR's condition number from 1.076 to 1.006 on the design grid, and the
+    optimiser's forward differences stopped it at its random start)."""
+    ds = ex.motion_dataset(*_stacked_motion(xs, basis, t, limits, shape), desc)
+    if edges:
+        keep = np.ones(len(t), bool)
+        keep[[0, -1]] = False
+        ds = ds.replace(valid=np.asarray(ds.valid, bool) & np.tile(keep, len(xs)))
+    return ds
 
 
 def block_conditions(model, ds, blocks: int, params: Sequence[str]) -> np.ndarray:
@@ -674,16 +691,7 @@ def design(plant_name: str, desc, params: Sequence[str], *, duration: float = 60
     def conditions(xs):
         """(log condition numbers, log information per sample of ``info`` or None) of motions xs."""
         if stacked:
-            ds = ex.motion_dataset(*_stacked_motion(xs, basis, t, lim, shape), mdesc)
-            if isinstance(model, Linearised):
-                # the delay's column at a block's first and last sample reaches into the next
-                # block, where a motion of its own has no sample (NaN, left out): left out here
-                # too, so every block is its motion's own and the gradient's differences are
-                # the motions' (on the coarse design grid one such row moved the CDPR's
-                # condition number from 1.076 to 1.006 and the optimiser stopped at its start)
-                edge = np.ones(len(t), bool)
-                edge[[0, -1]] = False
-                ds = ds.replace(valid=np.asarray(ds.valid, bool) & np.tile(edge, len(xs)))
+            ds = stacked_dataset(ex, xs, basis, t, lim, shape, mdesc, edges=isinstance(model, Linearised))
             c, per = block_terms(model, ds, len(xs), params, info, sigma)
         else:
             terms = [block_terms(model, ex.motion_dataset(
@@ -781,5 +789,5 @@ def read_reference(path, topic: str, joints: Sequence[str]):
 
 
 __all__ = ["Design", "Exciter", "LINEARISED", "Limits", "Linearised", "block_conditions", "block_terms",
-           "condition", "design", "detectable_delay", "fourier_basis", "fourier_motion", "get_exciter", "lead_in", "linear_values",
+           "condition", "design", "detectable_delay", "stacked_dataset", "fourier_basis", "fourier_motion", "get_exciter", "lead_in", "linear_values",
            "model_for", "noise_of", "read_reference", "register_exciter", "scaled_motion", "write_reference"]
