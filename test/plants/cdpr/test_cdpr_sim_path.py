@@ -1,0 +1,85 @@
+"""The simulator node's compiled per-period path (csrc/sim_path.c) against the Python
+SimStepper, its oracle: the same command stream (commands answering each state, gaps on the
+brakes, a payload put on while running) gives the same trajectory and the same counts."""
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from cablelab.plants.cdpr.nodes.parameters import SIM
+from cablelab.plants.cdpr.sim import default_description
+from cablelab.plants.cdpr.sim_path import CompiledSimPath, library
+from cablelab.plants.cdpr.stepping import SimStepper
+from cablelab.ros.params import check_all
+
+lib = library()
+pytestmark = pytest.mark.skipif(lib is None, reason="no compiled sim_path (CABLELAB_NATIVE=0 or no compiler)")
+
+
+def steppers(**params):
+    v = SimpleNamespace(**check_all(SIM, {"rate": 1000.0, **params}))
+    desc = default_description()
+    return SimStepper.from_parameters(desc, v), SimStepper.from_parameters(desc, v)
+
+
+def command_stream(py: SimStepper, steps: int, seed: int = 1) -> np.ndarray:
+    """Torques about the hanging platform's holding torques, with two gaps (NaN: no command, the
+    brakes hold), one before the first command."""
+    c = py.sim.desc.cdpr
+    hold = (c.drum_radius / c.gear_ratio) * py.sim.truth_state()["tension"]
+    rng = np.random.default_rng(seed)
+    u = hold + np.cumsum(rng.normal(0.0, 0.05, (steps, py.sim.n)), axis=0)
+    u[:5] = np.nan
+    u[120:160] = np.nan
+    u[400:403] = np.nan
+    return u
+
+
+def run_python(py: SimStepper, commands: np.ndarray) -> np.ndarray:
+    """The Python law: row i answers the last state (or none came); qpos after each step."""
+    out = []
+    for row in commands:
+        fresh = not np.isnan(row[0])
+        if fresh:
+            py.command(row, py.sim.time)
+        py.step(0.0, fresh=fresh)
+        out.append(np.concatenate([[py.sim.time], py.sim.data.qpos, py.sim.data.qvel]))
+    return np.array(out)
+
+
+@pytest.mark.parametrize("params", [{}, {"mass_change": 122.0, "mass_change_time": 0.3}])
+def test_compiled_steps_equal_python_steps_for_the_same_commands(params):
+    py, cs = steppers(**params)
+    path = CompiledSimPath(lib, cs, command_timeout=0.2)
+    try:
+        commands = command_stream(py, 600)
+        expected = run_python(py, commands)
+        path.run_commands(commands)
+        rows = path.drain()
+        m = path.model
+        got = np.hstack([rows[:, :1], rows[:, 4:4 + m.nq + m.nv]])
+        assert len(rows) == len(commands)
+        assert np.array_equal(got[:, 0], expected[:, 0])
+        # identical arithmetic (same mj_step, same brake law, no fused multiply-adds): to round-off
+        np.testing.assert_allclose(got, expected, rtol=0, atol=1e-12)
+        assert np.ptp(expected[:, 1 + 7 * 0:4], axis=0).max() > 1e-4      # the platform moved
+        c = path.update()
+        assert (c["steps"], c["fallbacks"], c["fallbacks_running"]) == (py.k, py.fallbacks, py.fallbacks_running)
+        assert c["slack"] == py.slack_steps and c["missed"] == py.missed_steps
+        assert cs.command_age == py.command_age
+        if params:
+            assert c["mass_changed"] == 1 and py.mass_change == 0.0
+            b = m.body("platform").id
+            assert m.body_mass[b] == py.sim.model.body_mass[b] > 300.0
+            # the drained sample at which it went on makes the mirror's truth follow
+            for row in rows:
+                *_, put_on = path.mirror(row)
+                if put_on:
+                    cs.put_on_mass(model=False)
+            assert cs.sim.truth.platform_mass == py.sim.truth.platform_mass
+        # the mirror (the stepper's own MjData) now reads the last sample: the measurements follow
+        path.mirror(rows[-1])
+        np.testing.assert_allclose(cs.sim.truth_state()["tension"], py.sim.truth_state()["tension"], atol=1e-9)
+    finally:
+        path.close()
+
