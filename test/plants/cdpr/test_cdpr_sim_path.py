@@ -83,3 +83,74 @@ def test_compiled_steps_equal_python_steps_for_the_same_commands(params):
     finally:
         path.close()
 
+
+
+@pytest.fixture
+def ros_context(domain_id):
+    import rclpy
+
+    rclpy.init(domain_id=domain_id)
+    yield
+    rclpy.try_shutdown()
+
+
+def test_the_node_with_the_compiled_path_survives_bad_commands(ros_context):
+    """The simulator node in real time runs the compiled path: NaN, wrong-length and empty
+    commands over DDS are rejected and reported on its /diagnostics status (as the Python path
+    reports them), the C thread keeps stepping on the brakes, a good command answering the last
+    state is taken; the states it publishes arrive with their stamps on the grid."""
+    import time
+
+    import rclpy
+    from rclpy.executors import SingleThreadedExecutor
+    from sensor_msgs.msg import JointState
+    from std_msgs.msg import Float64MultiArray
+
+    from cablelab.plants.cdpr.nodes.sim import CdprSimNode
+    from cablelab.ros import convert
+    from cablelab.ros.qos import stream_qos
+
+    sim = CdprSimNode()
+    peer = rclpy.create_node("bad_controller")
+    states = []
+    pub = peer.create_publisher(Float64MultiArray, "/cdpr/effort_commands", stream_qos())
+    peer.create_subscription(JointState, "/cdpr/joint_states", states.append, stream_qos(1000))
+    ex = SingleThreadedExecutor()
+    ex.add_node(sim)
+    ex.add_node(peer)
+    try:
+        assert sim.path == "compiled" and sim.compiled is not None
+
+        def spin_until(cond, timeout=60.0):
+            end = time.monotonic() + timeout
+            while not cond() and time.monotonic() < end:
+                ex.spin_once(timeout_sec=0.01)
+            return cond()
+
+        assert spin_until(lambda: sim.compiled.started and pub.get_subscription_count() > 0 and len(states) > 5)
+        nan = float("nan")
+        sent = 0
+        for bad in ([nan] * 8, [1.0] * 7, []):
+            pub.publish(Float64MultiArray(data=bad))
+            sent += 1
+            # keep-last 1 on the C side: wait until each one was taken before the next
+            assert spin_until(lambda: sim.compiled.update()["rejected"] >= sent, 30.0)
+        level, msg, values = sim.status()
+        assert values["effort_commands rejected"] == "3" and "rejected messages on effort_commands" in msg
+        assert values["per-period path"] == "compiled"
+        k0 = sim.stepper.k
+        assert spin_until(lambda: sim.stepper.k > k0 + 50)      # still stepping (on the brakes)
+        assert sim.stepper.fallbacks == sim.stepper.k and sim.stepper.commands == 0
+        # a good command answering the last state it published
+        t = convert.from_stamp(states[-1].header.stamp)
+        pub.publish(convert.command_msg(np.array(states[-1].effort), t, "winch"))
+        assert spin_until(lambda: sim.compiled.update(sim.inputs)["commands"] == 1, 30.0)
+        assert sim.inputs.inputs["effort_commands"].received == 1
+        stamps = np.array([convert.from_stamp(s.header.stamp) for s in states])
+        np.testing.assert_allclose(stamps * 1000.0, np.round(stamps * 1000.0), atol=1e-6)
+        assert np.all(np.diff(stamps) >= 0)
+        assert np.isfinite(sim.sim.truth_pose()[0]).all()
+    finally:
+        ex.shutdown()
+        sim.destroy_node()
+        peer.destroy_node()

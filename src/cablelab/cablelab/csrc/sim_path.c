@@ -520,12 +520,17 @@ static rmw_qos_profile_t qos(size_t depth, int transient_local) {
 
 /* Its own rcl context and node: publishers of the joint states and the reference (reliable,
  * transient local, keep-last publisher_depth), the command subscription (reliable, volatile,
- * keep-last 1). Type supports: rclpy's own (the message classes' _TYPE_SUPPORT). 0 on success. */
-int sp_ros(SimPath *s, const char *node_name, const void *ts_js, const char *js_topic, const void *ts_ref,
-           const char *ref_topic, const void *ts_cmd, const char *cmd_topic, long publisher_depth) {
+ * keep-last 1), in ROS domain `domain_id` (the Python node's). Type supports: rclpy's own (the
+ * message classes' _TYPE_SUPPORT). 0 on success. */
+int sp_ros(SimPath *s, const char *node_name, long domain_id, const void *ts_js, const char *js_topic,
+           const void *ts_ref, const char *ref_topic, const void *ts_cmd, const char *cmd_topic, long publisher_depth) {
   rcl_allocator_t alloc = rcl_get_default_allocator();
   rcl_init_options_t io = rcl_get_zero_initialized_init_options();
   if (rcl_init_options_init(&io, alloc) != RCL_RET_OK) { set_error(s, "rcl_init_options_init"); return 1; }
+  if (domain_id >= 0 && rcl_init_options_set_domain_id(&io, (size_t)domain_id) != RCL_RET_OK) {
+    set_error(s, "rcl_init_options_set_domain_id");
+    return 1;
+  }
   rcl_ret_t rc = rcl_init(0, NULL, &io, &s->ctx);
   rcl_init_options_fini(&io);
   if (rc != RCL_RET_OK) { set_error(s, "rcl_init"); return 1; }

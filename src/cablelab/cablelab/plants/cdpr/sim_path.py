@@ -46,7 +46,7 @@ def library():
            "sp_schedule": (None, [_P, _D, _D, _I, _D, _D, _D, ctypes.c_uint64]),
            "sp_joint_template": (None, [_P, _P, ctypes.c_size_t, _L, _L, _L, _L, _L]),
            "sp_reference": (None, [_P, _P, ctypes.c_size_t, _L, _L, _L, _L, _L, _P, _L, _I]),
-           "sp_ros": (_I, [_P, _S, _P, _S, _P, _S, _P, _S, _L]), "sp_error": (_S, [_P]),
+           "sp_ros": (_I, [_P, _S, _L, _P, _S, _P, _S, _P, _S, _L]), "sp_error": (_S, [_P]),
            "sp_publish_now": (None, [_P]), "sp_start": (_I, [_P]), "sp_stop": (None, [_P]),
            "sp_running": (_I, [_P]), "sp_drain": (_L, [_P, _P, _L]), "sp_counts": (None, [_P, _P]),
            "sp_subscribers": (_I, [_P]), "sp_all_acked": (_I, [_P, _D]), "sp_free": (None, [_P]),
@@ -115,9 +115,10 @@ class CompiledSimPath:
         self.started = False
         self.counts = dict.fromkeys(COUNTS, 0)
 
-    def connect(self, outputs, js_topic: str, ref_topic: str, cmd_topic: str) -> None:
-        """Its rcl node: the joint states and reference in the layout of ``outputs``'
-        templates (:class:`~.nodes.outputs.CdprOutputs`), the commands on ``cmd_topic``.
+    def connect(self, outputs, js_topic: str, ref_topic: str, cmd_topic: str, domain_id: int) -> None:
+        """Its rcl node in ROS domain ``domain_id``: the joint states and reference in the layout
+        of ``outputs``' templates (:class:`~.nodes.outputs.CdprOutputs`), the commands on
+        ``cmd_topic``.
 
         Raises:
             ValueError: rcl refused (its error)."""
@@ -148,7 +149,7 @@ class CompiledSimPath:
                              rt.spans["header.stamp.nanosec"][0], *offs, _address(table), len(table),
                              int(round(lead)))
             ts_ref = type_support(MultiDOFJointTrajectory)
-        if lib.sp_ros(self._h, b"cable_sim_node_rt", type_support(JointState), js_topic.encode(), ts_ref,
+        if lib.sp_ros(self._h, b"cable_sim_node_rt", int(domain_id), type_support(JointState), js_topic.encode(), ts_ref,
                       ref_topic.encode(), type_support(Float64MultiArray), cmd_topic.encode(),
                       PUBLISHER_DEPTH):
             raise ValueError(lib.sp_error(self._h).decode(errors="replace"))
