@@ -78,7 +78,7 @@ struct SimPath {
   long cap, stride;
   long head, tail;
   pthread_t th;
-  int started, stop;
+  int started, stop, finished;
   char error[256];
 };
 
@@ -332,7 +332,7 @@ static void step(SimPath *s, int fresh, int late) {
   if (missed && commands) count_add(s, SP_MISSED, 1);
   for (int i = 0; i < m->ntendon; i++)
     if (d->ten_length[i] < m->tendon_range[2 * i + 1] - 1e-6) { count_add(s, SP_SLACK, 1); break; }
-  if (s->duration > 0 && d->time >= s->duration) __atomic_store_n(&s->counts[SP_DONE], 1, __ATOMIC_RELEASE);
+  if (s->duration > 0 && d->time >= s->duration) s->finished = 1;   /* (done once published) */
   s->work = now_s() - t0;
 }
 
@@ -361,6 +361,8 @@ static void publish_ready(SimPath *s, double work) {
   publish_state(s);
   s->ahead = 0;
   push_sample(s, work + now_s() - t0);
+  /* done only once its last sample is in the ring: Python reads the counts, then drains */
+  if (s->finished) __atomic_store_n(&s->counts[SP_DONE], 1, __ATOMIC_RELEASE);
 }
 
 /* SimStepper.due: the steps due at `now` (the first on time, the rest late; far behind dropped) */
@@ -381,7 +383,7 @@ static int stopping(SimPath *s) { return __atomic_load_n(&s->stop, __ATOMIC_ACQU
 
 /* A command answering the last published state drives the next step, computed now. */
 static void maybe_step_ahead(SimPath *s) {
-  if (!s->ahead && !done(s) && s->has_stamp && fabs(s->u_stamp - s->d->time) < 0.5 / s->rate) {
+  if (!s->ahead && !s->finished && s->has_stamp && fabs(s->u_stamp - s->d->time) < 0.5 / s->rate) {
     step(s, 1, 0);
     s->ahead = 1;
   }
@@ -661,5 +663,6 @@ void sp_run_commands(SimPath *s, const double *commands, long count) {
     }
     step(s, fresh, 0);
     push_sample(s, s->work);
+    if (s->finished) __atomic_store_n(&s->counts[SP_DONE], 1, __ATOMIC_RELEASE);
   }
 }

@@ -174,6 +174,8 @@ class CdprSimNode(PlantNode):
             self.run_deferred()
             return
         self.advance()
+        if self.done and self.rest is not None:
+            self.publish_rest()         # the last sample's rest: no answer is coming
         if self.rest is None:
             self.run_deferred()
 
