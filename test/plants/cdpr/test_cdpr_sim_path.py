@@ -159,10 +159,10 @@ def test_the_node_with_the_compiled_path_survives_bad_commands(ros_context):
 @pytest.mark.parametrize("path", ["compiled", "Python"])
 def test_real_time_three_process_loop_both_paths(launcher, tmp_path, path):
     """sim (real time, compiled or Python path) -> estimator -> controller -> sim, + recorder, as
-    separate processes at 100 Hz (slow enough for a busy machine): every state the C thread published and
-    every tension sample the Python side published are recorded (same stamps, on
-    the period's grid), the commands answer them, and the platform follows the reference lifted
-    from A (within 1 cm: stale commands on a loaded machine still hold it)."""
+    separate processes at 100 Hz (slow enough for a busy machine): every joint state, tension
+    sample and ground-truth pose is recorded (same stamps, on the period's grid, none lost), the
+    commands answer them, and the platform follows the reference lifted from A (within 1 cm:
+    stale commands on a loaded machine still hold it)."""
     import sys
     import time
 

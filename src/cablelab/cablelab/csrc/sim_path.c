@@ -1,10 +1,10 @@
 /* The CDPR simulator node's per-period path in C (cablelab.plants.cdpr.sim_path loads it).
  *
  * A thread of its own steps the node's MuJoCo model on absolute deadlines of 1/rate s, with the
- * newest effort command (or the winch brakes), publishes the winch joint states and the
- * reference sample due around each state through an rcl node of its own, and appends each
- * published sample (time, qpos, qvel, actuator forces, sensors, tendon lengths) to a lock-free
- * ring that the Python node drains to publish everything else off the deadline path. Its law is
+ * newest effort command (or the winch brakes), publishes the winch joint states, the cable
+ * tensions and the reference sample due around each state through an rcl node of its own, and
+ * appends each published sample (time, qpos, qvel, actuator forces, sensors, tendon lengths) to a
+ * lock-free ring that the Python node drains to publish the rest off the deadline path. Its law is
  * SimStepper's in real time, step for step: the command answering the last state computes the
  * step it drives at once and its deadline only publishes; the steps due at a deadline (at most
  * 20, the rest dropped) are counted late, stale (the command answers an older state) or braked
@@ -46,7 +46,7 @@ struct SimPath {
   double rate;
   int *reel_q, *reel_v;
   double *paid0, k, kp, kd, hold_scale;
-  double torque_noise;
+  double torque_noise, tension_noise, *bias;
   uint64_t rng[4];
   int spare_ok;
   double spare;
@@ -57,11 +57,11 @@ struct SimPath {
   const double *ref;
   long ref_rows;
   int ref_on, ref_lead, ref_started;
-  Template js, rt;
+  Template js, rt, ten;
   /* ros */
   rcl_context_t ctx;
   rcl_node_t node;
-  rcl_publisher_t pub_js, pub_ref;
+  rcl_publisher_t pub_js, pub_ref, pub_ten;
   rcl_subscription_t sub;
   rcl_wait_set_t ws;
   int ros_ok;
@@ -187,6 +187,15 @@ static void publish_state(SimPath *s) {
   put_values(&s->js, 1, v, s->n);
   put_values(&s->js, 2, e, s->n);
   publish(s, &s->pub_js, &s->js);
+  /* the dynamometers (noise, bias) and the paid-out lengths */
+  for (int i = 0; i < s->n; i++) {
+    a[i] = s->paid0[i] - s->d->qpos[s->reel_q[i]];
+    e[i] = fabs(s->d->sensordata[i]) + s->bias[i] + s->tension_noise * normal(s);
+  }
+  put_stamp(&s->ten, t);
+  put_values(&s->ten, 0, a, s->n);
+  put_values(&s->ten, 1, e, s->n);
+  publish(s, &s->pub_ten, &s->ten);
   if (s->ref_on && lead > 0) publish_reference(s, t + lead / s->rate);
 }
 
@@ -438,6 +447,7 @@ SimPath *sp_new(const mjModel *m, mjData *d, int n, int nstep, double rate, long
   s->hold = calloc(n, sizeof(double));
   s->lock_q = calloc(n, sizeof(double));
   s->cmd = calloc(n, sizeof(double));
+  s->bias = calloc(n, sizeof(double));
   s->timeout = 0.2;
   s->mass_time = -1.0;
   s->cap = ring_capacity > 16 ? ring_capacity : 16;
@@ -447,6 +457,7 @@ SimPath *sp_new(const mjModel *m, mjData *d, int n, int nstep, double rate, long
   s->node = rcl_get_zero_initialized_node();
   s->pub_js = rcl_get_zero_initialized_publisher();
   s->pub_ref = rcl_get_zero_initialized_publisher();
+  s->pub_ten = rcl_get_zero_initialized_publisher();
   s->sub = rcl_get_zero_initialized_subscription();
   s->ws = rcl_get_zero_initialized_wait_set();
   s->in = rmw_get_zero_initialized_serialized_message();
@@ -467,7 +478,9 @@ void sp_winches(SimPath *s, const int *reel_q, const int *reel_v, const double *
 }
 
 void sp_schedule(SimPath *s, double command_timeout, double duration, int mass_body, double mass,
-                 double mass_time, double torque_noise, uint64_t seed) {
+                 double mass_time, double torque_noise, double tension_noise, const double *bias, uint64_t seed) {
+  s->tension_noise = tension_noise;
+  memcpy(s->bias, bias, sizeof(double) * s->n);
   s->timeout = command_timeout;
   s->duration = duration;
   s->mass_body = mass_body;
@@ -502,6 +515,11 @@ void sp_joint_template(SimPath *s, const uint8_t *bytes, size_t len, long sec, l
   set_template(&s->js, bytes, len, sec, nsec, pos, vel, eff);
 }
 
+void sp_tension_template(SimPath *s, const uint8_t *bytes, size_t len, long sec, long nsec, long length,
+                         long tension) {
+  set_template(&s->ten, bytes, len, sec, nsec, length, tension, -1);
+}
+
 void sp_reference(SimPath *s, const uint8_t *bytes, size_t len, long sec, long nsec, long pos, long vel,
                   long acc, const double *table, long rows, int lead_steps) {
   set_template(&s->rt, bytes, len, sec, nsec, pos, vel, acc);
@@ -520,12 +538,12 @@ static rmw_qos_profile_t qos(size_t depth, int transient_local) {
   return q;
 }
 
-/* Its own rcl context and node: publishers of the joint states and the reference (reliable,
+/* Its own rcl context and node: publishers of the joint states, the tensions and the reference (reliable,
  * transient local, keep-last publisher_depth), the command subscription (reliable, volatile,
  * keep-last 1), in ROS domain `domain_id` (the Python node's). Type supports: rclpy's own (the
  * message classes' _TYPE_SUPPORT). 0 on success. */
 int sp_ros(SimPath *s, const char *node_name, long domain_id, const void *ts_js, const char *js_topic,
-           const void *ts_ref, const char *ref_topic, const void *ts_cmd, const char *cmd_topic, long publisher_depth) {
+           const char *ten_topic, const void *ts_ref, const char *ref_topic, const void *ts_cmd, const char *cmd_topic, long publisher_depth) {
   rcl_allocator_t alloc = rcl_get_default_allocator();
   rcl_init_options_t io = rcl_get_zero_initialized_init_options();
   if (rcl_init_options_init(&io, alloc) != RCL_RET_OK) { set_error(s, "rcl_init_options_init"); return 1; }
@@ -544,6 +562,10 @@ int sp_ros(SimPath *s, const char *node_name, long domain_id, const void *ts_js,
   po.qos = qos((size_t)publisher_depth, 1);
   if (rcl_publisher_init(&s->pub_js, &s->node, ts_js, js_topic, &po) != RCL_RET_OK) {
     set_error(s, js_topic);
+    return 1;
+  }
+  if (rcl_publisher_init(&s->pub_ten, &s->node, ts_js, ten_topic, &po) != RCL_RET_OK) {
+    set_error(s, ten_topic);
     return 1;
   }
   if (ts_ref && rcl_publisher_init(&s->pub_ref, &s->node, ts_ref, ref_topic, &po) != RCL_RET_OK) {
@@ -576,6 +598,7 @@ int sp_start(SimPath *s) {
   if (s->started || s->ros_ok < 3) return 1;
   __atomic_store_n(&s->stop, 0, __ATOMIC_RELEASE);
   if (pthread_create(&s->th, NULL, run, s) != 0) return 1;
+  pthread_setname_np(s->th, "sim_path");
   s->started = 1;
   return 0;
 }
@@ -619,6 +642,7 @@ int sp_all_acked(SimPath *s, double timeout) {
   if (s->ros_ok < 3) return 1;
   rcl_duration_value_t ns = (rcl_duration_value_t)(timeout * 1e9);
   int ok = rcl_publisher_wait_for_all_acked(&s->pub_js, ns) == RCL_RET_OK;
+  ok = (rcl_publisher_wait_for_all_acked(&s->pub_ten, ns) == RCL_RET_OK) && ok;
   if (s->ref_on) ok = (rcl_publisher_wait_for_all_acked(&s->pub_ref, ns) == RCL_RET_OK) && ok;
   rcutils_reset_error();
   return ok;
@@ -635,6 +659,7 @@ void sp_free(SimPath *s) {
     (void)!rcl_subscription_fini(&s->sub, &s->node);
     (void)!rcl_publisher_fini(&s->pub_js, &s->node);
     (void)!rcl_publisher_fini(&s->pub_ref, &s->node);
+    (void)!rcl_publisher_fini(&s->pub_ten, &s->node);
     (void)!rcl_node_fini(&s->node);
   }
   if (s->ros_ok >= 1) {
@@ -642,8 +667,8 @@ void sp_free(SimPath *s) {
     (void)!rcl_context_fini(&s->ctx);
   }
   rcutils_reset_error();
-  free(s->reel_q); free(s->reel_v); free(s->paid0); free(s->u); free(s->hold); free(s->lock_q); free(s->cmd);
-  free(s->ring); free(s->js.buf); free(s->rt.buf);
+  free(s->reel_q); free(s->reel_v); free(s->paid0); free(s->u); free(s->hold); free(s->lock_q); free(s->cmd); free(s->bias);
+  free(s->ring); free(s->js.buf); free(s->rt.buf); free(s->ten.buf);
   free(s);
 }
 

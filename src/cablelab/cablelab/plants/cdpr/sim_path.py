@@ -2,14 +2,14 @@
 :mod:`cablelab.native`).
 
 In real time, a C thread steps the node's MuJoCo model on absolute deadlines with the newest
-effort command (or the winch brakes), publishes the winch joint states and the reference
-through an rcl node of its own (``cable_sim_node_rt``: same topics, QoS and serialised layout as
-the Python node's), and counts late, stale, braked and dropped steps exactly as
-:class:`~.stepping.SimStepper` does. Each published sample goes into a lock-free ring; the
-Python node drains it (:meth:`CompiledSimPath.drain`), copies each sample into its own
-:class:`~.sim.CdprSim`'s MjData (a mirror: the thread steps a copy, Python never touches the
-thread's) and publishes the rest from there (tensions, /clock, pose, truth, /diagnostics, 3D
-view) off the deadline path.
+effort command (or the winch brakes), publishes the winch joint states, the cable tensions and
+the reference through an rcl node of its own (``cable_sim_node_rt``: same topics, QoS and
+serialised layout as the Python node's), and counts late, stale, braked and dropped steps
+exactly as :class:`~.stepping.SimStepper` does. Each published sample goes into a lock-free
+ring; the Python node drains it (:meth:`CompiledSimPath.drain`), copies the samples it needs into
+its own :class:`~.sim.CdprSim`'s MjData (a mirror: the thread steps a copy, Python never touches
+the thread's) and publishes the rest from there (/clock, pose, truth, /diagnostics, 3D view)
+off the deadline path.
 
 The Python path stays the oracle and the fallback: :func:`library` is None when
 ``CABLELAB_NATIVE=0`` or the library cannot be built, and lock-step runs in Python.
@@ -43,10 +43,11 @@ def library():
         return lib
     sig = {"sp_new": (_P, [_P, _P, _I, _I, _D, _L]), "sp_stride": (_L, [_P]),
            "sp_winches": (None, [_P, _P, _P, _P, _D, _D, _D, _D]),
-           "sp_schedule": (None, [_P, _D, _D, _I, _D, _D, _D, ctypes.c_uint64]),
+           "sp_schedule": (None, [_P, _D, _D, _I, _D, _D, _D, _D, _P, ctypes.c_uint64]),
+           "sp_tension_template": (None, [_P, _P, ctypes.c_size_t, _L, _L, _L, _L]),
            "sp_joint_template": (None, [_P, _P, ctypes.c_size_t, _L, _L, _L, _L, _L]),
            "sp_reference": (None, [_P, _P, ctypes.c_size_t, _L, _L, _L, _L, _L, _P, _L, _I]),
-           "sp_ros": (_I, [_P, _S, _L, _P, _S, _P, _S, _P, _S, _L]), "sp_error": (_S, [_P]),
+           "sp_ros": (_I, [_P, _S, _L, _P, _S, _S, _P, _S, _P, _S, _L]), "sp_error": (_S, [_P]),
            "sp_publish_now": (None, [_P]), "sp_start": (_I, [_P]), "sp_stop": (None, [_P]),
            "sp_running": (_I, [_P]), "sp_drain": (_L, [_P, _P, _L]), "sp_counts": (None, [_P, _P]),
            "sp_subscribers": (_I, [_P]), "sp_all_acked": (_I, [_P, _D]), "sp_free": (None, [_P]),
@@ -107,18 +108,21 @@ class CompiledSimPath:
         kp, kd = hw.brakes.gains
         lib.sp_winches(self._h, _address(rq), _address(rv), _address(paid0), float(sim.k), float(kp), float(kd),
                        float(c.drum_radius / c.gear_ratio))
+        bias = np.ascontiguousarray(sim._bias, float)
         lib.sp_schedule(self._h, float(command_timeout), float(stepper.duration),
                         int(m.body("platform").id), float(stepper.mass_change), float(stepper.mass_change_time),
-                        float(sim.truth.torque_noise), int(sim.truth.seed) & (2 ** 64 - 1))
+                        float(sim.truth.torque_noise), float(sim.truth.tension_noise), _address(bias),
+                        int(sim.truth.seed) & (2 ** 64 - 1))
         self._mass_seen = 0
         self._buf = np.empty((RING, self.stride))
         self.started = False
         self.counts = dict.fromkeys(COUNTS, 0)
 
-    def connect(self, outputs, js_topic: str, ref_topic: str, cmd_topic: str, domain_id: int) -> None:
-        """Its rcl node in ROS domain ``domain_id``: the joint states and reference in the layout
-        of ``outputs``' templates (:class:`~.nodes.outputs.CdprOutputs`), the commands on
-        ``cmd_topic``.
+    def connect(self, outputs, js_topic: str, ten_topic: str, ref_topic: str, cmd_topic: str,
+                domain_id: int) -> None:
+        """Its rcl node in ROS domain ``domain_id``: the joint states, tensions and reference in
+        the layout of ``outputs``' templates (:class:`~.nodes.outputs.CdprOutputs`), the
+        commands on ``cmd_topic``.
 
         Raises:
             ValueError: rcl refused (its error)."""
@@ -132,6 +136,10 @@ class CompiledSimPath:
         lib.sp_joint_template(self._h, bytes(js.buf), js.size, sp["header.stamp.sec"][0],
                               sp["header.stamp.nanosec"][0], sp["position"][0], sp["velocity"][0],
                               sp["effort"][0])
+        ten = outputs.t_ten
+        sp = ten.spans
+        lib.sp_tension_template(self._h, bytes(ten.buf), ten.size, sp["header.stamp.sec"][0],
+                                sp["header.stamp.nanosec"][0], sp["position"][0], sp["effort"][0])
         ts_ref = None
         if st.publish_reference:
             lead = st.reference_lead * st.rate
@@ -149,14 +157,15 @@ class CompiledSimPath:
                              rt.spans["header.stamp.nanosec"][0], *offs, _address(table), len(table),
                              int(round(lead)))
             ts_ref = type_support(MultiDOFJointTrajectory)
-        if lib.sp_ros(self._h, b"cable_sim_node_rt", int(domain_id), type_support(JointState), js_topic.encode(), ts_ref,
+        if lib.sp_ros(self._h, b"cable_sim_node_rt", int(domain_id), type_support(JointState), js_topic.encode(),
+                      ten_topic.encode(), ts_ref,
                       ref_topic.encode(), type_support(Float64MultiArray), cmd_topic.encode(),
                       PUBLISHER_DEPTH):
             raise ValueError(lib.sp_error(self._h).decode(errors="replace"))
 
     # ------------------------------------------------------------------ running
     def publish_now(self) -> None:
-        """Before :meth:`start`: the present state's joint states and reference."""
+        """Before :meth:`start`: the present state's joint states, tensions and reference."""
         self.lib.sp_publish_now(self._h)
 
     def start(self) -> None:
@@ -175,8 +184,8 @@ class CompiledSimPath:
         return int(self.lib.sp_subscribers(self._h)) if self._h else 0
 
     def all_acked(self, timeout: float = 0.0) -> bool:
-        """Whether every reliable subscriber acknowledged every joint state and reference sample
-        (waiting up to ``timeout`` s)."""
+        """Whether every reliable subscriber acknowledged every joint state, tension and reference
+        sample (waiting up to ``timeout`` s)."""
         return bool(self.lib.sp_all_acked(self._h, float(timeout))) if self._h else True
 
     def run_commands(self, commands: np.ndarray) -> None:
@@ -207,6 +216,11 @@ class CompiledSimPath:
         mass = int(row[3]) > self._mass_seen
         self._mass_seen = int(row[3])
         return float(row[0]), int(row[1]), float(row[2]), mass
+
+    @property
+    def mass_seen(self) -> int:
+        """Payload changes the mirror has seen (:meth:`mirror`)."""
+        return self._mass_seen
 
     def update(self, inputs=None) -> dict:
         """Read the C counters into the stepper's (what /diagnostics and the benchmarks report)

@@ -40,16 +40,15 @@ def fill_estimate(tpl: RawTemplate, t: float, mass: float, com) -> RawTemplate:
 class CdprOutputs:
     """Publishers and templates of ``n`` winches: joint states, cable tensions, reference, /clock,
     measured pose, ground truth (``truth``) and effort commands (``commands``); without ``state``
-    no joint states and reference publishers (another publishes them from the templates:
-    the simulator's compiled path)."""
+    no joint states, tensions and reference publishers (another publishes them from the
+    templates: the simulator's compiled path)."""
 
     def __init__(self, node, n: int, truth: bool = True, commands: bool = False, state: bool = True):
         q = publisher_qos()
         make = node.create_publisher
-        self.pub_js = self.pub_ref = None
+        self.pub_js = self.pub_ten = self.pub_ref = None
         if state:
             self.state_publishers(node)
-        self.pub_ten = make(JointState, topics.CABLE_TENSIONS, q)
         self.pub_pose = make(PoseStamped, topics.PLATFORM_POSE, q)
         self.pub_cmd = make(Float64MultiArray, topics.EFFORT_COMMANDS, q) if commands else None
         self.pub_tpose = make(PoseStamped, topics.GROUND_TRUTH_POSE, q) if truth else None
@@ -69,9 +68,10 @@ class CdprOutputs:
         self.t_tpay = RawTemplate(convert.inertia_msg(0.0, 0.0, z3))
 
     def state_publishers(self, node) -> None:
-        """The joint states and reference publishers."""
+        """The joint states, tensions and reference publishers."""
         q = publisher_qos()
         self.pub_js = node.create_publisher(JointState, topics.JOINT_STATES, q)
+        self.pub_ten = node.create_publisher(JointState, topics.CABLE_TENSIONS, q)
         self.pub_ref = node.create_publisher(MultiDOFJointTrajectory, topics.REFERENCE, q)
 
     def payload(self, mass: float, com) -> None:

@@ -16,15 +16,16 @@ deadline steps with the last command as before and publishes everything.
 
 Real time with the compiled path (:mod:`cablelab.plants.cdpr.sim_path`, used when
 :mod:`cablelab.native` can build it and ``CABLELAB_NATIVE`` is not ``0``): a C thread runs that
-law on the deadlines, takes the commands and publishes the joint states and the reference; the
-node drains its samples every few periods and publishes the rest of each from them. Lock-step runs
-in Python.
+law on the deadlines, takes the commands and publishes the joint states, the tensions and the
+reference; the node drains its samples every few periods and publishes the rest from them.
+Lock-step runs in Python.
 """
 from __future__ import annotations
 
 import atexit
 import time
 
+import numpy as np
 from std_msgs.msg import Float64MultiArray
 
 from .... import native
@@ -56,8 +57,8 @@ class CdprSimNode(PlantNode):
         self.out = CdprOutputs(self, self.sim.n, truth=True, state=self.compiled is None)
         if self.compiled is not None:
             try:
-                self.compiled.connect(self.out, topics.JOINT_STATES, topics.REFERENCE, topics.EFFORT_COMMANDS,
-                                      self.context.get_domain_id())
+                self.compiled.connect(self.out, topics.JOINT_STATES, topics.CABLE_TENSIONS, topics.REFERENCE,
+                                      topics.EFFORT_COMMANDS, self.context.get_domain_id())
                 atexit.register(self.compiled.close)     # the thread stops before the interpreter
             except ValueError as exc:
                 self.get_logger().warning(f"the Python per-period path: the compiled one could not start ({exc})")
@@ -138,12 +139,18 @@ class CdprSimNode(PlantNode):
                 self.publish_state()
             c.start()
         c.update(self.inputs)       # (before the drain: a sample the counts know of is in the ring)
-        for row in c.drain():
+        rows = c.drain()
+        for work in rows[:, 2]:
+            self.latency.add(float(work))
+        extras = rows[:, 1].astype(np.int64) % self.extras_every == 0
+        for row in rows[extras | (rows[:, 3] > c.mass_seen)]:
             t, k, work, put_on = c.mirror(row)
             if put_on:
                 self.stepper.put_on_mass(model=False)
-            self.latency.add(work)
-            self.out.rest_sample(self.rest_of(t, k % self.extras_every == 0))
+            if k % self.extras_every == 0:
+                self.out.extras(t, *self.extras_of())
+        if len(rows):
+            c.mirror(rows[-1])      # the mirror holds the last sample (3D view, /diagnostics)
 
     def on_command(self, msg: Float64MultiArray) -> None:
         """An effort command (serialised bytes, :func:`~cablelab.ros.rawmsg.command_arrays`); in
@@ -232,19 +239,18 @@ class CdprSimNode(PlantNode):
     def extras(self) -> bool:
         return self.stepper.k % self.extras_every == 0
 
-    def rest_of(self, t: float, extras: bool) -> tuple:
-        """The rest (:meth:`CdprOutputs.rest_sample <.outputs.CdprOutputs.rest_sample>`) of the
-        sample of stamp ``t`` the simulation holds now, without the reference (the compiled path
-        publishes it)."""
+    def extras_of(self) -> tuple:
+        """(measured pose or None, true pose) of the sample the simulation holds now
+        (:meth:`CdprOutputs.extras <.outputs.CdprOutputs.extras>`)."""
         ms = self.sim.measure()
-        pose = (ms["position"], ms["quat"]) if self.publish_pose else None
-        return t, ms["tension"], ms["cable_length"], [], (pose, self.sim.truth_pose()) if extras else None
+        return (ms["position"], ms["quat"]) if self.publish_pose else None, self.sim.truth_pose()
 
     def publish_state(self) -> None:
         """The whole sample of the present sim time, now (the start and the start gate's probe)."""
         if self.compiled is not None:
             self.compiled.publish_now()
-            self.out.rest_sample(self.rest_of(self.sim.time, self.extras()))
+            if self.extras():
+                self.out.extras(self.sim.time, *self.extras_of())
         else:
             self.out.simulator_sample(self.stepper, self.publish_pose, self.extras())
         self.stepper.published(time.monotonic())
