@@ -115,6 +115,8 @@ class CompiledSimPath:
                         int(sim.truth.seed) & (2 ** 64 - 1))
         self._mass_seen = 0
         self._buf = np.empty((RING, self.stride))
+        self._counts = np.zeros(len(COUNTS), np.int64)
+        self._buf_at, self._counts_at = _address(self._buf), _address(self._counts)
         self.started = False
         self.counts = dict.fromkeys(COUNTS, 0)
 
@@ -200,7 +202,7 @@ class CompiledSimPath:
         sensors, tendon lengths."""
         if not self._h:
             return self._buf[:0]
-        got = self.lib.sp_drain(self._h, _address(self._buf), len(self._buf))
+        got = self.lib.sp_drain(self._h, self._buf_at, len(self._buf))
         return self._buf[:got]
 
     def mirror(self, row: np.ndarray) -> tuple[float, int, float, bool]:
@@ -228,9 +230,8 @@ class CompiledSimPath:
         :class:`~cablelab.ros.inputs.InputMonitor`); the counters as a dict."""
         if not self._h:
             return self.counts
-        out = np.zeros(len(COUNTS), np.int64)
-        self.lib.sp_counts(self._h, _address(out))
-        c = self.counts = dict(zip(COUNTS, (int(x) for x in out)))
+        self.lib.sp_counts(self._h, self._counts_at)
+        c = self.counts = dict(zip(COUNTS, self._counts.tolist()))
         s = self.stepper
         s.k, s.commands = c["steps"], c["commands"]
         s.fallbacks, s.fallbacks_running, s.slack_steps = c["fallbacks"], c["fallbacks_running"], c["slack"]

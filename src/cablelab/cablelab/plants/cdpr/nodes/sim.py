@@ -41,7 +41,7 @@ from ..stepping import SimStepper
 from .outputs import CdprOutputs
 from .parameters import SIM as PARAMETERS
 
-DRAIN_PERIOD = 0.005    # s wall: the compiled path's samples are published this often (at most)
+DRAIN_PERIOD = 0.01     # s wall: the compiled path's samples are drained (the extras published) this often
 
 
 class CdprSimNode(PlantNode):
@@ -66,6 +66,7 @@ class CdprSimNode(PlantNode):
                 self.compiled = None
                 self.out.state_publishers(self)
         self.path = "compiled" if self.compiled is not None else "Python"
+        self.last_row = None        # compiled path: the last sample drained, not yet mirrored
         self.out.payload(self.sim.truth.total_mass, self.sim.truth.total_com)
         self.publish_description(self.description)
         if not self.real_time and v.rt_priority > 0:
@@ -83,7 +84,7 @@ class CdprSimNode(PlantNode):
                                stream_qos(1) if self.real_time else stream_qos(), raw=True)
             period = 1.0 / v.rate if self.real_time else 0.0002
         self.start_stepping(period, topics.MARKERS,
-                            lambda: sim_markers(self.description, self.sim), lambda: self.sim.time,
+                            lambda: sim_markers(self.description, self.mirrored()), lambda: self.mirrored().time,
                             v.markers_rate)
         # /diagnostics and the 3D view run after a step or an answer, never just before a deadline
         self.defer_timers(t for t in self.timers if t is not self.timer)
@@ -107,7 +108,15 @@ class CdprSimNode(PlantNode):
     def status(self):
         if self.compiled is not None:
             self.compiled.update(self.inputs)    # the C thread's counts, now
+            self.mirrored()
         return super().status()
+
+    def mirrored(self):
+        """The simulation (compiled path: its mirror brought to the last drained sample)."""
+        if self.last_row is not None:
+            self.compiled.mirror(self.last_row)
+            self.last_row = None
+        return self.sim
 
     def extend_status(self, level, msg, values):
         values["per-period path"] = self.path
@@ -149,8 +158,8 @@ class CdprSimNode(PlantNode):
                 self.stepper.put_on_mass(model=False)
             if k % self.extras_every == 0:
                 self.out.extras(t, *self.extras_of())
-        if len(rows):
-            c.mirror(rows[-1])      # the mirror holds the last sample (3D view, /diagnostics)
+        # the last sample, mirrored when the 3D view or /diagnostics read it (mirrored())
+        self.last_row = None if not len(rows) or extras[-1] else rows[-1].copy()
 
     def on_command(self, msg: Float64MultiArray) -> None:
         """An effort command (serialised bytes, :func:`~cablelab.ros.rawmsg.command_arrays`); in
