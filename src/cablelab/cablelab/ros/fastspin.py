@@ -36,7 +36,8 @@ from __future__ import annotations
 from contextlib import ExitStack
 
 __all__ = ["FastExecutor", "supports", "set_realtime_priority", "set_cpu_affinity", "set_background",
-           "set_latency_slice", "set_idle_class", "poll", "drain", "take_newest", "defer", "run_deferred"]
+           "set_latency_slice", "set_idle_class", "poll", "polled", "drain", "take_newest", "defer", "deferred",
+           "run_deferred"]
 
 
 def set_realtime_priority(priority: int) -> str:
@@ -168,20 +169,35 @@ def poll(node, subscription) -> None:
     stay queued (up to the QoS depth) until :func:`drain` takes them. With another executor the
     subscription is serviced as usual (then :func:`drain` usually finds nothing), so a node that
     polls behaves the same under both, only with more wake-ups under rclpy's."""
-    polled = getattr(node, "_polled_subscriptions", None)
-    if polled is None:
-        polled = node._polled_subscriptions = set()
-    polled.add(subscription)
+    _mark(node, "_polled_subscriptions", subscription)
 
 
 def defer(node, timer) -> None:
     """Leave ``timer`` of ``node`` out of :class:`FastExecutor`'s wait set: it runs only when the
     node calls :func:`run_deferred`. With another executor the timer runs as usual (and
     :func:`run_deferred` finds it not due)."""
-    deferred = getattr(node, "_deferred_timers", None)
-    if deferred is None:
-        deferred = node._deferred_timers = set()
-    deferred.add(timer)
+    _mark(node, "_deferred_timers", timer)
+
+
+def polled(node) -> list:
+    """The subscriptions of ``node`` marked with :func:`poll`, in the order they were marked."""
+    return getattr(node, "_polled_subscriptions", [])
+
+
+def deferred(node) -> list:
+    """The timers of ``node`` marked with :func:`defer`, in the order they were marked."""
+    return getattr(node, "_deferred_timers", [])
+
+
+def _mark(node, attr: str, entity) -> None:
+    """Add ``entity`` once to the node's ordered list ``attr`` (the one record :class:`FastExecutor`
+    and the node both read)."""
+    marked = getattr(node, attr, None)
+    if marked is None:
+        marked = []
+        setattr(node, attr, marked)
+    if entity not in marked:
+        marked.append(entity)
 
 
 def run_deferred(timers, limit: int | None = None) -> int:
@@ -192,13 +208,19 @@ def run_deferred(timers, limit: int | None = None) -> int:
     for tmr in timers:
         if limit is not None and ran >= limit:
             break
-        with tmr.handle:
-            if not tmr.handle.is_timer_ready():
-                continue
-            tmr.handle.call_timer()
-        tmr.callback()
-        ran += 1
+        ran += _call_if_due(tmr, tmr.handle)
     return ran
+
+
+def _call_if_due(timer, handle) -> bool:
+    """Call ``timer`` (rclpy Timer, ``handle`` its C handle) if it is due: its next call is
+    scheduled, then its callback runs; True if it ran."""
+    with handle:
+        if not handle.is_timer_ready():
+            return False
+        handle.call_timer()
+    timer.callback()
+    return True
 
 
 def drain(*subscriptions) -> int:
@@ -304,13 +326,12 @@ class FastExecutor:
         """(subscriptions, timers, services) of the wait set; rebuilt only when the node's
         entity lists or its polled / deferred sets changed (compared by identity: cheap)."""
         node = self.node
-        polled = getattr(node, "_polled_subscriptions", ())
-        deferred = getattr(node, "_deferred_timers", ())
-        raw = (tuple(node._subscriptions), tuple(node._timers), tuple(node._services), len(polled), len(deferred))
+        left_out = polled(node), deferred(node)
+        raw = (tuple(node._subscriptions), tuple(node._timers), tuple(node._services), *map(tuple, left_out))
         if raw != self._raw_key:
             self._raw_key = raw
-            self._filtered = (tuple(s for s in raw[0] if s not in polled),
-                              tuple(t for t in raw[1] if t not in deferred), raw[2])
+            self._filtered = (tuple(s for s in raw[0] if s not in left_out[0]),
+                              tuple(t for t in raw[1] if t not in left_out[1]), raw[2])
         return self._filtered
 
     def _rebuild(self, subs, timers, services) -> None:
@@ -355,9 +376,8 @@ class FastExecutor:
         # drain every queue, one sample per topic per round
         self.taken += _take_all([e for p, e in self._subs if p in subs_ready])
         for tmr, h, ptr in self._timers:
-            if ptr in timers_ready and h.is_timer_ready():
-                h.call_timer()
-                tmr.callback()
+            if ptr in timers_ready:
+                _call_if_due(tmr, h)
         for srv, h, ptr in self._services:
             if ptr in services_ready:
                 request, header = h.service_take_request(srv.srv_type.Request)

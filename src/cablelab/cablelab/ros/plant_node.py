@@ -19,6 +19,7 @@ from ..description import load_description
 from ..errors import CablelabError
 from . import convert
 from .diagnostics import Diagnostics
+from . import fastspin
 from .fastspin import defer, drain, poll, run_deferred, take_newest
 from .inputs import InputMonitor
 from .lockstep import ADVANCE, FREE, RESEND
@@ -51,8 +52,6 @@ class PlantNode(Node):
         self.fast = False
         self.keep_first_description = False  # True: later /plant_description messages are ignored
         self._desc_pub = None
-        self.polled = []     # subscriptions left out of the executor's wait set (subscribe(polled=True))
-        self.deferred = []   # timers left out of the executor's wait set (defer_timers)
         self._raw_readers = {}
         self.latency = Latency()  # per-sample processing time a node measures (latency.since(t0))
 
@@ -168,8 +167,23 @@ class PlantNode(Node):
         sub = self.create_subscription(kind, topic, callback, qos, raw=raw)
         if polled:
             poll(self, sub)
-            self.polled.append(sub)
         return sub
+
+    @property
+    def polled(self) -> list:
+        """The subscriptions left out of the fast executor's wait set (``subscribe(polled=True)``),
+        in subscription order; assigning a list replaces them (``[]``: none, e.g. a test that
+        calls the callbacks by hand)."""
+        return fastspin.polled(self)
+
+    @polled.setter
+    def polled(self, subscriptions) -> None:
+        self._polled_subscriptions = list(subscriptions)
+
+    @property
+    def deferred(self) -> list:
+        """The timers left out of the fast executor's wait set (:meth:`defer_timers`), in order."""
+        return fastspin.deferred(self)
 
     def take_polled(self, newest: bool = False) -> int:
         """Run the callbacks of every sample queued on the :attr:`polled` subscriptions, in order
@@ -184,9 +198,7 @@ class PlantNode(Node):
         executor's wait set (:func:`~cablelab.ros.fastspin.defer`): they run when the node calls
         :meth:`run_deferred`, at a point where they cannot delay its deadline work."""
         for tmr in timers:
-            if tmr not in self.deferred:
-                defer(self, tmr)
-                self.deferred.append(tmr)
+            defer(self, tmr)
 
     def run_deferred(self, limit: int | None = 1) -> int:
         """Run the due :attr:`deferred` timers, at most ``limit`` (None: all) per call, the rest

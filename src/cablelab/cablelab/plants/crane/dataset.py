@@ -35,8 +35,13 @@ SWING_NAMES = ("theta1", "theta2", "rope_length")
 #: positions alone attenuates the swing's 1.5-3 Hz content (twice the swing frequency, in the
 #: centripetal and Coriolis terms) in the regressor but not in the efforts: a model error of 2-5 %
 #: of the torques that moved 0.2 % of the payload mass into the hoist and luff offsets (2-3 % of
-#: them) on designed runs; the parallel filter in turn made the counterbalance and delay estimates
-#: of the plain and delay benchmark cases worse, so it is not the default.
+#: them) on designed runs. The parallel filter is not the default, though its equations are the
+#: exact ones: it changes the fit's channel noise weights (1 / residual spread). The positions
+#: filter leaves the efforts' broadband sensor noise in the residual, which sets the weights; the
+#: parallel filter removes it above the cut-off, and the slew channel's residual is then the
+#: in-band noise of the swing accelerations (motion capture differentiated twice): the slew channel,
+#: the one that tells the counterbalance's inertia from I_tot, loses half its weight or more and the
+#: counterbalance's spread over noise grows (bench/cases_crane.py --filter-noise; docs/benchmarks.md).
 CRANE_CUTOFF_HZ = 3.0
 
 __all__ = ["check_bag", "check_measurements", "dataset", "dataset_from_arrays"]
