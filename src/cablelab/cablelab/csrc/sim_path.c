@@ -5,10 +5,10 @@
  * tensions and the reference sample due around each state through an rcl node of its own, and
  * appends each published sample (time, qpos, qvel, actuator forces, sensors, tendon lengths) to a
  * lock-free ring that the Python node drains to publish the rest off the deadline path. Its law is
- * SimStepper's in real time, step for step: the command answering the last state computes the
- * step it drives at once and its deadline only publishes; the steps due at a deadline (at most
- * 20, the rest dropped) are counted late, stale (the command answers an older state) or braked
- * (no command for the command timeout) the same way. Messages go out as serialised bytes patched
+ * SimStepper's in real time, step for step: at each deadline the newest command is taken (the
+ * answer to the last state drives the step due, as SimStepper.step_ahead), and the steps due (at
+ * most 20, the rest dropped) are counted late, stale (the command answers an older state) or
+ * braked (no command for the command timeout) the same way. Messages go out as serialised bytes patched
  * in templates that Python built with rclpy (same layout, same type support); commands are taken
  * serialised and read like cablelab.ros.rawmsg.command_arrays. */
 #define _GNU_SOURCE
@@ -63,7 +63,6 @@ struct SimPath {
   rcl_node_t node;
   rcl_publisher_t pub_js, pub_ref, pub_ten;
   rcl_subscription_t sub;
-  rcl_wait_set_t ws;
   int ros_ok;
   rcl_serialized_message_t in;
   double *cmd;           /* scratch: the values of the command being read */
@@ -390,32 +389,24 @@ static long due_steps(SimPath *s, double now) {
 static int done(SimPath *s) { return __atomic_load_n(&s->counts[SP_DONE], __ATOMIC_ACQUIRE) != 0; }
 static int stopping(SimPath *s) { return __atomic_load_n(&s->stop, __ATOMIC_ACQUIRE); }
 
-/* A command answering the last published state drives the next step, computed now. */
-static void maybe_step_ahead(SimPath *s) {
+/* A command answering the last published state drives the next step (fresh, whatever the
+ * command timeout), computed now; the steps due then publish it first (SimStepper.step_ahead). */
+static void answered_step(SimPath *s) {
   if (!s->ahead && !s->finished && s->has_stamp && fabs(s->u_stamp - s->d->time) < 0.5 / s->rate) {
     step(s, 1, 0);
     s->ahead = 1;
   }
 }
 
+/* The thread: sleep to the next absolute deadline, take the newest command (keep-last 1; no wait
+ * set: polling at the deadline costs the least CPU), then the steps due (SimStepper.due). */
 static void *run(void *arg) {
   SimPath *s = arg;
-  double T = 1.0 / s->rate, margin = 2e-4;
+  double T = 1.0 / s->rate;
   s->wall0 = now_s() - (s->k_steps - s->ahead) * T;
   while (!stopping(s) && !done(s)) {
-    double deadline = s->wall0 + (s->k_steps - s->ahead + 1) * T;
-    /* until shortly before the deadline: wait for the answer (and compute its step at once) */
-    for (;;) {
-      double left = deadline - margin - now_s();
-      if (left <= 0 || stopping(s)) break;
-      if (rcl_wait_set_clear(&s->ws) != RCL_RET_OK ||
-          rcl_wait_set_add_subscription(&s->ws, &s->sub, NULL) != RCL_RET_OK) { rcutils_reset_error(); break; }
-      rcl_ret_t rc = rcl_wait(&s->ws, (int64_t)(left * 1e9));
-      if (rc == RCL_RET_OK && take_commands(s)) maybe_step_ahead(s);
-      else if (rc != RCL_RET_OK) rcutils_reset_error();
-    }
-    sleep_until(deadline);
-    if (take_commands(s)) maybe_step_ahead(s);
+    sleep_until(s->wall0 + (s->k_steps - s->ahead + 1) * T);
+    if (take_commands(s)) answered_step(s);
     double now = now_s();
     long due = due_steps(s, now);
     for (long i = 0; i < due && !stopping(s); i++) {
@@ -459,7 +450,6 @@ SimPath *sp_new(const mjModel *m, mjData *d, int n, int nstep, double rate, long
   s->pub_ref = rcl_get_zero_initialized_publisher();
   s->pub_ten = rcl_get_zero_initialized_publisher();
   s->sub = rcl_get_zero_initialized_subscription();
-  s->ws = rcl_get_zero_initialized_wait_set();
   s->in = rmw_get_zero_initialized_serialized_message();
   return s;
 }
@@ -578,10 +568,6 @@ int sp_ros(SimPath *s, const char *node_name, long domain_id, const void *ts_js,
     set_error(s, cmd_topic);
     return 1;
   }
-  if (rcl_wait_set_init(&s->ws, 1, 0, 0, 0, 0, 0, &s->ctx, alloc) != RCL_RET_OK) {
-    set_error(s, "rcl_wait_set_init");
-    return 1;
-  }
   if (rmw_serialized_message_init(&s->in, 1024, &alloc) != RMW_RET_OK) { set_error(s, "serialized message"); return 1; }
   s->ros_ok = 3;
   return 0;
@@ -652,7 +638,6 @@ void sp_free(SimPath *s) {
   if (!s) return;
   sp_stop(s);
   if (s->ros_ok >= 3) {
-    (void)!rcl_wait_set_fini(&s->ws);
     (void)!rmw_serialized_message_fini(&s->in);
   }
   if (s->ros_ok >= 2) {
