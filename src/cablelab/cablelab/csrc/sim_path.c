@@ -542,7 +542,7 @@ int sp_ros(SimPath *s, const char *node_name, long domain_id, const void *ts_js,
     return 1;
   }
   rcl_ret_t rc = rcl_init(0, NULL, &io, &s->ctx);
-  rcl_init_options_fini(&io);
+  (void)!rcl_init_options_fini(&io);
   if (rc != RCL_RET_OK) { set_error(s, "rcl_init"); return 1; }
   s->ros_ok = 1;
   rcl_node_options_t no = rcl_node_get_default_options();
