@@ -152,10 +152,11 @@ def run_designed_case(case, gen, workdir: str) -> dict:
     Adds the condition numbers before/after and the error of every true parameter (the hidden
     effect's and the payload mass) to :func:`diagnose_case`'s result."""
     from cablelab import workbench
-    from cablelab.excite import LINEARISED, Linearised, condition, design, model_for
+    from cablelab.excite import LINEARISED, Linearised, condition, design, detectable_delay, model_for, noise_of
     from cablelab.fit import identify
 
     vis = []   # the delay's visibility (first recording, designed run) when the pair names tau
+    det = []   # the smallest delay each recording shows (detectable_delay at its own noise)
 
     def pair_condition(path):   # the pair in the model the case fits (known parameters fixed)
         plant, desc, ds = workbench.load(path, None, dict(case.options))
@@ -171,6 +172,11 @@ def run_designed_case(case, gen, workdir: str) -> dict:
             ok = np.isfinite(col).all(axis=1) & np.isfinite(fit.residual).all(axis=1)
             vis.append(float(np.max(np.sqrt(np.mean((0.03 * col[ok]) ** 2, axis=0))
                                     / np.sqrt(np.mean(fit.residual[ok] ** 2, axis=0)))))
+            # the smallest delay this recording shows, at its own noise (the residual of the fit
+            # with the delay free: a delay the run shows does not count as noise)
+            noise = noise_of(model.model, ds)
+            det.append(detectable_delay(model, ds, *noise, n_candidates=len(plant.candidates(desc)))["tau"]
+                       if noise is not None else np.nan)
         return ds, desc, condition(model, ds, pair)
 
     tr = case.truth
@@ -205,6 +211,9 @@ def run_designed_case(case, gen, workdir: str) -> dict:
         r["first_top_sig"] = first_r.get("top_sig", "error")
     if vis:
         r["visibility"] = tuple(vis)
+        # (true delay, smallest detectable: first recording, excite's prediction, designed run)
+        r["detect"] = (float(tr.get("tau", 0.0)), det[0],
+                       d.detectable["tau"] if d.detectable else np.nan, det[1])
     if "error" not in r:
         r["perr"] = {h: rel_param_error(r["final"], v) for h, v in case.true_params.items()}
     return r
@@ -260,6 +269,19 @@ def summarise_designed(bench, results) -> None:
         if v.size:
             bench.row(metric="delay visibility (30 ms x column RMS / residual RMS), first / designed (median)",
                       value=f"{np.median(v[:, 0]):.3g} / {np.median(v[:, 1]):.3g}", target="")
+        dt = np.array([r["detect"] for r in ok if "detect" in r])
+        if dt.size:
+            bench.row(metric="smallest detectable delay (ms): first recording / excite's / designed run (median)",
+                      value=" / ".join(f"{1e3 * np.median(dt[:, k]):.3g}" for k in (1, 2, 3)), target="")
+            dh = np.array([r["detect"] for r in hid if "detect" in r])
+            above = [set(r["added"]) == set(r["hidden"]) for r in hid if "detect" in r and r["detect"][0] >= r["detect"][2]]
+            bench.row(metric="hidden set found where the delay >= excite's detectable delay",
+                      value=f"{_pct(mean(above))} of {len(above)}", target="")
+            bench.row(metric="hidden delays below excite's detectable delay (the design says it cannot show them)",
+                      value=f"{int(np.sum(dh[:, 0] < dh[:, 2]))} of {len(dh)}" if dh.size else "0", target="")
+            bench.row(metric="hidden delay / excite's detectable delay (min / median)",
+                      value=f"{np.min(dh[:, 0] / dh[:, 2]):.3g} / {np.median(dh[:, 0] / dh[:, 2]):.3g}"
+                      if dh.size else "nan", target="")
         bench.row(metric="design seconds median / max",
                   value=f"{np.median([r['design_s'] for r in ok]):.1f} / {np.max([r['design_s'] for r in ok]):.1f}"
                   if ok else "nan", target="< 30 s")
@@ -271,7 +293,10 @@ def summarise_designed(bench, results) -> None:
                           added="error", errors=r["error"][:60])
                 continue
             more = ({"first_sig": r["first_top_sig"]} if "first_top_sig" in r else {}) | (
-                {"visibility": f"{r['visibility'][0]:.3g} -> {r['visibility'][1]:.3g}"} if "visibility" in r else {})
+                {"visibility": f"{r['visibility'][0]:.3g} -> {r['visibility'][1]:.3g}"} if "visibility" in r else {}) | (
+                {"tau_ms": f"{1e3 * r['detect'][0]:.1f}" if r["hidden"] else "-",
+                 "detectable_ms": "{:.3g} / {:.3g} / {:.3g}".format(*(1e3 * np.array(r["detect"][1:])))}
+                if "detect" in r else {})
             bench.row(seed=r["case"].seed, case=r["case"].family, cond_first=f"{r['fit_cond'][0]:.3g}",
                       cond_designed=f"{r['fit_cond'][1]:.3g}", **more, added=",".join(r["added"]) or "none",
                       errors="; ".join(f"{k} {100 * v:.2f} %" for k, v in r["perr"].items()))

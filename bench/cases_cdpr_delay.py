@@ -19,6 +19,12 @@ and the jerk of a motion inside the design's speed and acceleration limits (0.3 
 harmonics up to 0.25 Hz) keeps that change near 1 % of the cable tension's noise at the other
 cases' levels, below what a held-out error gain can show. ``python bench/cases_cdpr_delay.py``
 prints each case's delay visibility (cases_cdpr.delay_visibility) on its first recording.
+
+The draw's 10 ms floor is above what the design says its run shows: ``excite`` reports the
+smallest delay a designed run tells from none (``excite.detectable_delay``, at the first
+recording's noise), 3.7-9.7 ms over the benchmark's 24 cases at these noise levels, and the
+first recordings' own 29-54 ms lie above every drawn delay (docs/benchmarks.md prints both per
+case).
 """
 from __future__ import annotations
 

@@ -93,6 +93,11 @@ class Exciter:
         tune: ``fn(params) -> {field: value}``: fields of this exciter chosen by the named
             parameters (e.g. a family fast enough to show a delay, or slow and wide enough to show
             what the travel reveals); None: the same fields for every design.
+        loaded: ``fn(description, values) -> description`` whose ``motion_dataset`` synthesises
+            the measurement of the load a recording's fit found (``values``: its linear
+            parameters), for a plant whose delay column re-forms the outputs from that
+            measurement (``remeasure``; the CDPR's tensions scale with the moving mass); None:
+            the described machine's.
     """
 
     limits: Callable
@@ -106,6 +111,7 @@ class Exciter:
     start: Callable | None = None
     stacked: bool | None = None
     tune: Callable | None = None
+    loaded: Callable | None = None
 
 
 _EXCITERS: dict[str, Exciter] = {}
@@ -327,6 +333,90 @@ class Linearised:
                 list(cols) + [Param("tau", "s", self.tau0, doc="delay, linearised")], y_known)
 
 
+def noise_of(model, ds) -> tuple[np.ndarray, float] | None:
+    """``(sigma (C,), n_eff per second)`` of a recording: the RMS per channel of the residual of
+    ``model``'s fit on ``ds`` (everything the model does not explain, noise and misfit) and the
+    AR(1) effective samples per second of that residual (what the diagnosis' likelihood-ratio
+    test counts, :func:`~cablelab.fit.identification.effective_samples`); None without ``ds`` or
+    when the fit fails."""
+    from .fit.identification import effective_samples, identify
+
+    if ds is None:
+        return None
+    try:
+        fit = identify(model, ds, on_deficient="hold")
+    except CablelabError:
+        return None
+    r = fit.residual[np.isfinite(fit.residual).all(axis=1)]
+    span = float(ds.t[-1] - ds.t[0]) if ds.n > 1 else 0.0
+    if r.shape[0] < 3 or span <= 0:
+        return None
+    step = int(fit.extra.get("sample_step", 1))
+    n_eff = np.mean([effective_samples(r[:, c], step) for c in range(r.shape[1])])
+    return np.sqrt(np.mean(r ** 2, axis=0)), float(n_eff / span * r.shape[0] / ds.n)
+
+
+def detectable_delay(model: "Linearised", ds, sigma, n_eff_per_s: float, *,
+                     n_candidates: int = 1) -> dict:
+    """The smallest delay the diagnosis calls significant on a recording of ``ds``'s motion with
+    noise ``sigma`` (C,) per channel (:func:`noise_of`), from the delay's column (``model``,
+    :class:`Linearised`) with the model's other columns projected out (what the fit cannot
+    attribute to them), each channel whitened by its sigma (the fit's noise weights).
+
+    A delay tau leaves ``tau c_perp`` in a channel's residual, so its held-out error falls by
+    ``sqrt(1 + tau^2 s_c^2)`` (``s_c = rms(c_perp,c) / sigma_c``): the diagnosis' practical gain
+    (:func:`~cablelab.diagnose.score.practical_gain`, the geometric mean over the channels it
+    changes) reaches ``MIN_GAIN`` when ``mean_c log(1 + tau^2 s_c^2) = -2 log(1 - MIN_GAIN)``,
+    whatever the record's length; its likelihood-ratio statistic ``sum_c n_eff log(1 + tau^2
+    s_c^2)`` (:func:`~cablelab.diagnose.score.lr_significance`) passes ``alpha / m`` at the
+    delay where it equals the chi^2(1) quantile, smaller the longer the record. The larger of the two
+    is the smallest delay detectable.
+
+    Returns:
+        ``{"tau": s, "by_gain": s, "by_test": s, "snr": (C,) s_c in 1/s, "min_gain"}``; inf
+        when the motion does not show a delay at all.
+    """
+    import scipy.optimize
+    import scipy.stats
+
+    from .diagnose.ranking import ALPHA, MIN_GAIN
+
+    phi, _, _ = model.regressor(ds)
+    ok = np.asarray(ds.valid, bool) & np.isfinite(phi).all(axis=(1, 2))
+    sigma = np.asarray(sigma, float)
+    live = sigma > 0
+    a = phi[ok][:, live] / sigma[live][None, :, None]                      # whitened (n, C, P)
+    n, c, p = a.shape
+    col, rest = a[:, :, -1].reshape(-1), a[:, :, :-1].reshape(n * c, p - 1)
+    if p > 1:
+        q, r = np.linalg.qr(rest)
+        keep = np.abs(np.diag(r)) > 1e-10 * max(np.abs(np.diag(r)).max(), 1e-300)
+        q = q[:, keep]
+        col = col - q @ (q.T @ col)
+    out_snr = np.zeros(len(sigma))
+    out_snr[live] = np.sqrt(np.mean(col.reshape(n, c) ** 2, axis=0)) if n else 0.0
+    snr = out_snr[out_snr > 0]              # the channels the delay changes
+    if snr.size == 0:
+        return {"tau": float("inf"), "by_gain": float("inf"), "by_test": float("inf"), "snr": out_snr,
+                "min_gain": MIN_GAIN}
+    need_gain = -2.0 * np.log(1.0 - MIN_GAIN)
+    n_eff = max(n_eff_per_s * float(ds.t[-1] - ds.t[0]), 3.0)
+    need_test = scipy.stats.chi2.isf(ALPHA / max(n_candidates, 1), 1) / n_eff
+
+    def solve(level, weight):   # the tau where weight * sum_c log(1 + tau^2 s_c^2) = level
+        lo = np.sqrt(np.expm1(level / (weight * snr.size))) / snr.max()   # every channel the best
+        hi = np.sqrt(np.expm1(level / weight)) / snr.max()                # the best channel alone
+        f = lambda tau: weight * np.sum(np.log1p(tau ** 2 * snr ** 2)) - level
+        if hi <= lo * (1 + 1e-12) or f(lo) >= 0:     # equal channels: lo is the root
+            return float(lo)
+        return float(scipy.optimize.brentq(f, lo, hi, xtol=1e-12 * hi, rtol=1e-10))
+
+    by_gain = solve(need_gain, 1.0 / snr.size)
+    by_test = solve(need_test, 1.0)
+    return {"tau": max(by_gain, by_test), "by_gain": by_gain, "by_test": by_test, "snr": out_snr,
+            "min_gain": MIN_GAIN}
+
+
 def linear_values(model, ds, values: dict | None = None, columns_ds=None) -> dict:
     """The linear parameters' values :class:`Linearised` evaluates the model output at: ``values``
     where given, else a fit of ``model`` on ``ds`` (the recording that confounds them; parameters
@@ -397,12 +487,17 @@ class Design:
     model: object
     seconds: float
     lead_in: float = 0.0
+    detectable: dict | None = None
 
     def to_json(self) -> dict:
-        return {"params": list(self.params), "condition_before": self.condition_before,
-                "condition_after": self.condition_after, "duration": float(self.t[-1] - self.t[0]),
-                "model": list(self.model.effects), "joints": list(self.limits.joints),
-                "seconds": self.seconds, "lead_in": self.lead_in}
+        out = {"params": list(self.params), "condition_before": self.condition_before,
+               "condition_after": self.condition_after, "duration": float(self.t[-1] - self.t[0]),
+               "model": list(self.model.effects), "joints": list(self.limits.joints),
+               "seconds": self.seconds, "lead_in": self.lead_in}
+        if self.detectable is not None:
+            out["detectable"] = {k: (v.tolist() if isinstance(v, np.ndarray) else v)
+                                 for k, v in self.detectable.items()}
+        return out
 
 
 def _stacked_motion(xs, basis, t, limits: Limits, shape):
@@ -417,11 +512,48 @@ def _stacked_motion(xs, basis, t, limits: Limits, shape):
     return (t_all,) + tuple(m.reshape(-1, shape[0]) for m in (q, qd, qdd))
 
 
+def stacked_dataset(ex: Exciter, xs, basis, t, limits: Limits, shape, desc, edges: bool = False):
+    """The plant's dataset of the motions ``xs`` stacked by :func:`_stacked_motion`. ``edges``
+    (a design naming the delay): each block's first and last sample left out, as a motion of
+    its own has them (the delay's column there reaches beyond the motion: NaN), so every block
+    is its motion's own and the cost's differences between blocks are the motions' (kept, one
+    such row moved the CDPR's condition number from 1.076 to 1.006 on the design grid, and the
+    optimiser's forward differences stopped it at its random start)."""
+    ds = ex.motion_dataset(*_stacked_motion(xs, basis, t, limits, shape), desc)
+    if edges:
+        keep = np.ones(len(t), bool)
+        keep[[0, -1]] = False
+        ds = ds.replace(valid=np.asarray(ds.valid, bool) & np.tile(keep, len(xs)))
+    return ds
+
+
 def block_conditions(model, ds, blocks: int, params: Sequence[str]) -> np.ndarray:
     """:func:`condition` of each of ``blocks`` equal consecutive time blocks of ``ds`` at once
     (what one batched regressor evaluation of :func:`_stacked_motion` gives): the same
     weighting and Schur complement, from each block's information matrix (eigenvalues below
     1e-13 of the largest count as a rank deficiency of the other parameters)."""
+    return block_terms(model, ds, blocks, params)[0]
+
+
+def _schur(g, sel, rest):
+    """Schur complement of the ``rest`` block of information matrices ``g`` (k, P, P) on ``sel``
+    (pseudo-inverse: eigenvalues below 1e-13 of the largest count as a rank deficiency)."""
+    s = g[:, sel][:, :, sel]
+    if rest:
+        grr, grs = g[:, rest][:, :, rest], g[:, rest][:, :, sel]
+        w, v = np.linalg.eigh(grr)
+        inv = np.where(w > 1e-13 * np.maximum(w[:, -1:], 1e-300), 1.0 / np.where(w > 0, w, 1.0), 0.0)
+        proj = np.einsum("kri,ki,ksi->krs", v, inv, v)
+        s = s - np.einsum("kri,krs,ksj->kij", grs, proj, grs)
+    return s
+
+
+def block_terms(model, ds, blocks: int, params: Sequence[str], info: str | None = None,
+                sigma=None) -> tuple[np.ndarray, np.ndarray | None]:
+    """:func:`block_conditions` and, for a parameter ``info``, its information per sample in
+    each block with the model's other parameters eliminated, every channel whitened by ``sigma``
+    (C,): ``1 / (n var)`` of its estimate on unit noise (what :func:`detectable_delay` turns
+    into the smallest delay a recording shows); None without ``info``."""
     phi, cols, _ = model.regressor(ds)
     names = [c.name for c in cols]
     n, c, p = phi.shape
@@ -429,6 +561,12 @@ def block_conditions(model, ds, blocks: int, params: Sequence[str]) -> np.ndarra
     ok = (np.asarray(ds.valid, bool).reshape(blocks, -1) & np.isfinite(phi).all(axis=(2, 3)))
     a = np.where(ok[:, :, None, None], phi, 0.0)
     cnt = np.maximum(ok.sum(axis=1), 1)[:, None]
+    per_sample = None
+    if info is not None:
+        aw = (a / np.asarray(sigma, float)[None, None, :, None]).reshape(blocks, -1, p)
+        i = names.index(info)
+        gi = _schur(np.einsum("kmi,kmj->kij", aw, aw), [i], [j for j in range(p) if j != i])
+        per_sample = np.maximum(gi[:, 0, 0], 0.0) / cnt[:, 0]
     rms = np.sqrt(np.sum(a ** 2, axis=(1, 3)) / (cnt * p))                   # (k, C)
     a = a / np.where(rms > 0, rms, 1.0)[:, None, :, None]
     a = a.reshape(blocks, -1, p)
@@ -438,17 +576,10 @@ def block_conditions(model, ds, blocks: int, params: Sequence[str]) -> np.ndarra
     d = np.where(d > 0, d, 1.0)
     g = g / d[:, :, None] / d[:, None, :]
     sel = [names.index(q) for q in params] if params else list(range(p))
-    rest = [i for i in range(p) if i not in sel]
-    s = g[:, sel][:, :, sel]
-    if rest:
-        grr, grs = g[:, rest][:, :, rest], g[:, rest][:, :, sel]
-        w, v = np.linalg.eigh(grr)
-        inv = np.where(w > 1e-13 * np.maximum(w[:, -1:], 1e-300), 1.0 / np.where(w > 0, w, 1.0), 0.0)
-        proj = np.einsum("kri,ki,ksi->krs", v, inv, v)
-        s = s - np.einsum("kri,krs,ksj->kij", grs, proj, grs)
+    s = _schur(g, sel, [i for i in range(p) if i not in sel])
     lam = np.linalg.eigvalsh(0.5 * (s + np.swapaxes(s, 1, 2)))[:, 0]
     out = np.where(lam > 1e-15, 1.0 / np.where(lam > 1e-15, lam, 1.0), np.inf)
-    return np.where(dead, np.inf, out)
+    return np.where(dead, np.inf, out), per_sample
 
 
 def design(plant_name: str, desc, params: Sequence[str], *, duration: float = 60.0,
@@ -504,6 +635,7 @@ def design(plant_name: str, desc, params: Sequence[str], *, duration: float = 60
     fs = ex.grid * ex.base_hz * h
     t = np.arange(0.0, duration, 1.0 / fs)
     probe = ex.motion_dataset(t, *scaled_motion(np.ones(shape), t, lim, ex.base_hz, duration), desc)
+    mdesc = desc          # the description the designed motion's datasets are built with
     model, _ = model_for(plant, desc, params, probe)
     from .model import Model
 
@@ -523,6 +655,12 @@ def design(plant_name: str, desc, params: Sequence[str], *, duration: float = 60
             # the synthesised one would stay in the residual, and its change under a delay (the
             # wrench map's motion times that tension difference) is not the delay's column.
             own = Model(plant.name, tuple(model.effects), {**model.fixed, "tau": tau0})
+            if before_ds is not None and ex.loaded is not None:
+                # the measurement synthesised for the load the recording's fit found: the
+                # delay's column (the tensions' change within tau) scales with the moving mass
+                mdesc = ex.loaded(desc, linear_values(own, before_ds, vals))
+                probe = ex.motion_dataset(t, *scaled_motion(np.ones(shape), t, lim, ex.base_hz, duration),
+                                          mdesc)
             model = Linearised(model, linear_values(own, probe, vals), tau0)
         else:
             model = Linearised(model, linear_values(model, before_ds, vals, probe), tau0)
@@ -530,25 +668,45 @@ def design(plant_name: str, desc, params: Sequence[str], *, duration: float = 60
             raise CablelabError("--params tau: the model's output is zero on a designed motion, so a "
                                 "delay has nothing to shift; give the recording (BAG) whose fit "
                                 "gives the model's parameters")
+    # a delay's detection needs its column large against the noise, not only apart from the
+    # others (the condition number is blind to the columns' size): the cost adds -log of the
+    # delay's information per sample at the recording's noise (without BAG, noise proportional
+    # to each channel's signal), i.e. log of the smallest delay the run shows
+    info, sigma, noise = None, None, None
+    if isinstance(model, Linearised):
+        info = "tau"
+        noise = noise_of(Model(plant.name, tuple(model.effects), {**model.fixed, "tau": model.tau0}),
+                         before_ds)
+        sigma = noise[0] if noise is not None else np.sqrt(np.nanmean(np.asarray(probe.y, float) ** 2, axis=0))
+        pos = sigma[sigma > 0]
+        sigma = np.where(sigma > 0, sigma, np.exp(np.mean(np.log(pos))) if pos.size else 1.0)
     n = n_j * 2 * h
     basis = fourier_basis(t, ex.base_hz, h, duration)
 
     # stacked evaluation when the plant's dataset keeps one sample per reference sample (not the
     # leg's, built per hop): checked once on two stacked motions
     stacked = ex.stacked if ex.stacked is not None else \
-        ex.motion_dataset(*_stacked_motion(np.ones((2, n)), basis, t, lim, shape), desc).n == 2 * len(t)
+        ex.motion_dataset(*_stacked_motion(np.ones((2, n)), basis, t, lim, shape), mdesc).n == 2 * len(t)
 
     def conditions(xs):
+        """(log condition numbers, log information per sample of ``info`` or None) of motions xs."""
         if stacked:
-            ds = ex.motion_dataset(*_stacked_motion(xs, basis, t, lim, shape), desc)
-            return block_conditions(model, ds, len(xs), params)
-        return np.array([condition(model, ex.motion_dataset(
-            t, *scaled_motion(x.reshape(shape), t, lim, ex.base_hz, duration), desc), params) for x in xs])
+            ds = stacked_dataset(ex, xs, basis, t, lim, shape, mdesc, edges=isinstance(model, Linearised))
+            c, per = block_terms(model, ds, len(xs), params, info, sigma)
+        else:
+            terms = [block_terms(model, ex.motion_dataset(
+                t, *scaled_motion(x.reshape(shape), t, lim, ex.base_hz, duration), mdesc), 1, params,
+                info, sigma) for x in xs]
+            c = np.concatenate([a for a, _ in terms])
+            per = None if info is None else np.concatenate([b for _, b in terms])
+        cost = np.where(np.isfinite(c), np.log(np.where(np.isfinite(c), c, 1.0)), 1e3)
+        if per is not None:
+            cost = cost + np.where(per > 0, -0.5 * np.log(np.where(per > 0, per, 1.0)), 1e3)
+        return cost
 
     def cost_grad(x):
         step = 1e-6 * np.maximum(1.0, np.abs(x))
-        c = conditions(np.vstack([x, x + np.diag(step)]))
-        logc = np.where(np.isfinite(c), np.log(np.where(np.isfinite(c), c, 1.0)), 1e3)
+        logc = conditions(np.vstack([x, x + np.diag(step)]))
         return float(logc[0]), (logc[1:] - logc[0]) / step
 
     rng = np.random.default_rng(seed)
@@ -571,10 +729,16 @@ def design(plant_name: str, desc, params: Sequence[str], *, duration: float = 60
     bad = check.check(q, qd, qdd)
     if bad:   # a plant whose box does not guarantee its constraint: refuse, never write it
         raise CablelabError(f"designed reference breaks the machine's limits: {bad[0]}")
-    after = condition(model, ex.motion_dataset(t_out, q, qd, qdd, desc), params)
+    after_ds = ex.motion_dataset(t_out, q, qd, qdd, mdesc)
+    after = condition(model, after_ds, params)
     before = condition(model, before_ds, params) if before_ds is not None else None
+    detect = None
+    if isinstance(model, Linearised):     # the smallest delay the designed run shows, at BAG's noise
+        if noise is not None:
+            detect = detectable_delay(model, after_ds, *noise, n_candidates=len(plant.candidates(desc)))
+            detect["noise"] = noise[0]
     return Design(t_out, q, qd, qdd, lim, tuple(params), before, after, model,
-                  time.monotonic() - t0, lead_s)
+                  time.monotonic() - t0, lead_s, detect)
 
 
 def write_reference(path, d: Design, exciter: Exciter, description_yaml: str | None = None,
@@ -624,6 +788,6 @@ def read_reference(path, topic: str, joints: Sequence[str]):
     return fn
 
 
-__all__ = ["Design", "Exciter", "LINEARISED", "Limits", "Linearised", "block_conditions", "condition", "design",
-           "fourier_basis", "fourier_motion", "get_exciter", "lead_in", "linear_values",
-           "model_for", "read_reference", "register_exciter", "scaled_motion", "write_reference"]
+__all__ = ["Design", "Exciter", "LINEARISED", "Limits", "Linearised", "block_conditions", "block_terms",
+           "condition", "design", "detectable_delay", "stacked_dataset", "fourier_basis", "fourier_motion", "get_exciter", "lead_in", "linear_values",
+           "model_for", "noise_of", "read_reference", "register_exciter", "scaled_motion", "write_reference"]

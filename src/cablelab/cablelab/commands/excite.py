@@ -15,7 +15,8 @@ DESCRIPTION = (
     "scaled into the machine's joint ranges, speeds and accelerations (a delay tau of time_delay "
     "is designable through its linearised column: the change of the fit's residual with tau, minus the "
     "time derivative of the model's output with the parameters fitted on BAG where the delay leaves the "
-    "outputs alone); written as a bag of the "
+    "outputs alone; the design also maximises that column against BAG's noise and reports the smallest "
+    "delay the run shows: the delay whose held-out gain reaches diagnose's threshold); written as a bag of the "
     "plant's reference topic that the plant's controller node plays "
     "(pd_feedforward --plant P --ros-args -p reference_bag:=REF).")
 
@@ -74,5 +75,13 @@ def run(args) -> int:
     print(f"wrote {args.out}: {d.t[-1]:.0f} s of {', '.join(d.limits.joints)} for "
           f"{', '.join(params)}; condition number {before_txt} -> {d.condition_after:.4g} "
           f"(model {' + '.join(d.model.effects)}, {d.seconds:.1f} s)")
+    if d.detectable is not None:
+        det = d.detectable
+        print(f"smallest delay this run shows: {1e3 * det['tau']:.3g} ms (diagnose's {100 * det['min_gain']:g} % "
+              f"held-out gain: {1e3 * det['by_gain']:.3g} ms, its likelihood-ratio test: "
+              f"{1e3 * det['by_test']:.3g} ms; at the noise of {args.bag}'s fit); a shorter delay "
+              f"is not told from none")
+    elif "tau" in params:
+        print("smallest delay this run shows: unknown without the noise; give the recording (BAG)")
     print(f"play it: pd_feedforward --plant {desc.plant} --ros-args -p reference_bag:={args.out}")
     return 0

@@ -17,6 +17,7 @@ box's centre before the Fourier series (:func:`cablelab.excite.lead_in`).
 """
 from __future__ import annotations
 
+import dataclasses
 import itertools
 
 import numpy as np
@@ -140,10 +141,21 @@ def _family(params) -> dict:
     return {"base_hz": 0.05, "harmonics": 5} if "tau" in params else {}
 
 
+def loaded(description, values):
+    """The description whose platform carries the moving mass ``values["m"]`` a recording's fit
+    found (the designed motion's feedforward tensions are that load's; unchanged without a
+    positive finite ``m``)."""
+    m = values.get("m")
+    if m is None or not np.isfinite(m) or m <= 0:
+        return description
+    return description.with_section("cdpr", dataclasses.replace(description.cdpr, platform_mass=float(m)))
+
+
 #: the CDPR's experiment design (``cablelab excite``), registered by the package. Base period
 #: 60 s, six harmonics (up to 0.1 Hz): the speed limit caps a harmonic's amplitude at v / omega,
 #: so a 20 s base period (0.95 m at 0.3 m/s) could not cross the box; the offsets' internal-force
 #: part shows through the change of W's null space, so the condition number of (offsets, m, mx,
 #: my) falls steeply with the travel
 EXCITER = Exciter(limits=excite_limits, motion_dataset=motion_dataset, reference_topic=REFERENCE,
-                  base_hz=1 / 60, harmonics=6, trajectory="pose", start=start_position, tune=_family)
+                  base_hz=1 / 60, harmonics=6, trajectory="pose", start=start_position, tune=_family,
+                  loaded=loaded)

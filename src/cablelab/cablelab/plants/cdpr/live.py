@@ -457,6 +457,39 @@ class LiveController:
             ff[:, 3] = np.einsum("tij,tj->ti", M[..., 3:], np.stack([f[:, 2], zero, -f[:, 0]], 1))
         return ReferencePlan(t, reference, valid, pd, friction, ff)
 
+    def planned_terms(self, plan: ReferencePlan, rows=slice(None)):
+        """The state-free terms of :meth:`planned_law` for ``rows`` of ``plan`` with the present
+        estimate, vectorised: ``(pd, ff, friction, fresh)`` with ``pd`` and ``friction`` the
+        plan's (N, n) rows, ``ff`` (N, n) the feedforward torques ``k max(coef . ff, t_min)``
+        (k = r/R, coef = (1, m, m c_x, m c_y) of the live estimate where it is fresh at the row's
+        stamp, of the nominal mass elsewhere; None for PD) and ``fresh`` (N,) where the estimate
+        was used. :meth:`planned_law` is then, per row and motor state,
+        ``clip(max(pd - kp q - kd q' + ff, k t_min) + friction, +-max_torque)``: the compiled
+        path (:mod:`.controller_path`) applies exactly that to the rows it is given."""
+        cfg, g = self.config, self.config.gains
+        t = np.atleast_1d(plan.t[rows])
+        pd, friction = plan.pd[rows].reshape(len(t), -1), plan.friction[rows].reshape(len(t), -1)
+        if plan.ff is None:
+            return pd, None, friction, np.ones(len(t), bool)
+        fresh = (t - self._t_est <= cfg.estimate_timeout) if self._t_est is not None else np.zeros(len(t), bool)
+        m, com = (self.mass, self.com) if self.mass is not None else (cfg.nominal_mass, np.zeros(2))
+        cx, cy = (com[0], com[1]) if cfg.use_com else (0.0, 0.0)
+        coef = np.where(fresh[:, None], [1.0, m, m * cx, m * cy], [1.0, cfg.nominal_mass, 0.0, 0.0])
+        ff = np.einsum("tj,tjn->tn", coef, plan.ff[rows].reshape(len(t), 4, -1))
+        np.maximum(ff, g.min_tension, out=ff)
+        ff *= self.desc.drum_radius / self.desc.gear_ratio
+        return pd, ff, friction, fresh
+
+    def planned_status(self, t: float) -> list:
+        """The :attr:`status` :meth:`planned_law` leaves after a valid row of stamp ``t`` and a
+        good motor state (PD; PDFF with a fresh estimate; else the nominal-mass warning)."""
+        cfg = self.config
+        if not cfg.feedforward:
+            return [(OK, "PD")]
+        if self._t_est is not None and t - self._t_est <= cfg.estimate_timeout:
+            return [(OK, "PDFF")]
+        return [_stale_mass(cfg.nominal_mass)]
+
     def planned_law(self, plan: ReferencePlan, i: int, q, qdot):
         """Torques (n,) N m for row ``i`` of ``plan`` and the measured motor state: what
         :meth:`prepare` then :meth:`law` give for that stamp, to round-off, with a few operations

@@ -9,6 +9,14 @@ or none (PD), friction compensation (eq. 15) and a minimum-tension floor. A stal
 estimate falls back to the nominal mass (WARN on /diagnostics). Without a reference (or with a
 bad motor state) nothing is published (the simulator's brakes hold) and /diagnostics says why.
 Matching samples by stamp: :class:`cablelab.plants.cdpr.streams.CommandStream`.
+
+Compiled path (parameter ``compiled_path``, on unless ``CABLELAB_NATIVE=0`` or no compiler): the
+references are planned as they come, or in blocks when they come far ahead (:meth:`LiveController.
+plan <cablelab.plants.cdpr.live.LiveController.plan>`; a new estimate re-plans the rows not used),
+and put in
+:class:`~cablelab.plants.cdpr.controller_path.ControllerPath`, whose C thread answers the joint
+states with the same law without Python; a state it cannot answer (bad, or no planned row of its
+stamp) comes back here and takes the Python path below, which checks and reports it.
 Parameters: :data:`.parameters.CONTROLLER` (``pd_feedforward --plant cdpr --help``).
 """
 from __future__ import annotations
@@ -16,19 +24,31 @@ from __future__ import annotations
 import math
 import time
 
+import numpy as np
+
 from geometry_msgs.msg import InertiaStamped
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 from trajectory_msgs.msg import MultiDOFJointTrajectory
 
 from .. import topics
+from ..controller_path import ControllerPath
 from ..streams import CommandStream, controller_config
-from ....ros import convert
+from ....ros import convert, fastspin
 from ....ros.plant_node import PlantNode
-from ....ros.qos import publisher_qos, stream_qos
+from ....ros.qos import PUBLISHER_DEPTH, publisher_qos, stream_qos
 from ....ros.rawmsg import CommandTemplate
+from .... import native
 from ....rotations import xyzw_to_wxyz
 from .parameters import CONTROLLER as PARAMETERS
+
+
+#: the compiled path's rows are planned once the oldest unplanned reference is less than this many
+#: reference periods ahead of the newest joint state
+PLAN_MARGIN = 4
+#: with the compiled path, a reference streamed at least this many periods ahead of the states
+#: (1000 times in a row) stops waking the node: the timer (every 2 ms) takes it and plans the block
+FAR_AHEAD = 3 * PLAN_MARGIN
 
 
 class CdprController(PlantNode):
@@ -36,6 +56,15 @@ class CdprController(PlantNode):
         super().__init__("pd_feedforward", start_parameter_services=False)  # smaller wait set
         v = self.v = self.declare_params(PARAMETERS)
         self.stream = CommandStream(v.feedforward, v.sync_wait, v.estimate_wait)
+        self.path = None            # the compiled path, once a description configured the law
+        self.path_problem = ""      # why there is none (when it was wanted)
+        self._path_seen = {"commanded": 0}
+        self._native = None
+        if v.compiled_path and not v.reference_bag and not self.stream.awaits_estimate:
+            self._native = native.load("controller_path")
+            if self._native is None:
+                self.path_problem = f"compiled path unavailable ({native.unavailable_reason('controller_path')})"
+                self.get_logger().info(f"{self.path_problem}: the Python path answers the joint states")
         self.sent = 0
         self._cmd = CommandTemplate("winch")     # pre-serialised commands naming their state's stamp
         self.inputs.add("joint_states", timeout=v.state_timeout)
@@ -49,14 +78,23 @@ class CdprController(PlantNode):
         # wakes the node). The states keep-last 1: after a busy moment the newest state is
         # answered, not a backlog whose commands the simulator would only count as stale
         q = stream_qos(1000)
-        self.subscribe(MultiDOFJointTrajectory, topics.REFERENCE, self.on_reference, q, raw=True, polled=True)
+        # (with the compiled path the C thread takes the states and each reference wakes this
+        # node, which plans its row when due (:meth:`_plan`); the estimate waits for the timer)
+        self._unplanned = []
+        self._far_ahead = 0         # references in a row streamed far ahead of the states
+        self._ref_t, self._ref_dt = None, 0.0     # the last reference's stamp, the reference period
+        self._ref_sub = self.subscribe(MultiDOFJointTrajectory, topics.REFERENCE, self.on_reference, q, raw=True,
+                                       polled=self._native is None)
         self.subscribe(InertiaStamped, topics.PAYLOAD_ESTIMATE, self.on_estimate, q,
                        polled=not self.stream.awaits_estimate)
-        self.create_subscription(JointState, topics.JOINT_STATES, self.on_state, stream_qos(1), raw=True)
+        if self._native is None:
+            self.create_subscription(JointState, topics.JOINT_STATES, self.on_state, stream_qos(1), raw=True)
         self.player = self.play_reference(v.reference_bag, topics.REFERENCE, ("x", "y", "z"), platform=True)
         self._state_wall = -1.0     # wall time of the last state taken
         self.timer = self.create_timer(0.002, self.on_timer)
         self.use_fast_executor()
+        if self._native is not None:
+            self._start_path()          # after the placement: its thread inherits it
         self.start_diagnostics()
         # /diagnostics runs after a command or from the timer, never between a state and its command
         self.defer_timers(t for t in self.timers if t is not self.timer)
@@ -71,18 +109,77 @@ class CdprController(PlantNode):
         if desc.cdpr is not None:
             super().set_description(desc)
             self.inputs.set_length("joint_states", len(desc.cdpr.cables))
+            if getattr(self, "_native", None) is not None and self.path is None:
+                self._start_path()
+
+    def _start_path(self) -> None:
+        """The compiled path for the configured law, its thread answering the joint states (or
+        :attr:`path_problem` says why not, and this node takes the states itself)."""
+        if self.controller is None or not hasattr(self, "timer"):
+            return          # (again once both the description and the placement are here)
+        path = ControllerPath(self._native, self.controller, row_wait=self.v.sync_wait)
+        problem = path.start(self, topics.JOINT_STATES, topics.EFFORT_COMMANDS, PUBLISHER_DEPTH, self._cmd.label)
+        if problem is None:
+            self.path = path
+            self.get_logger().info("compiled path: the joint states are answered by cablelab/csrc/controller_path.c")
+            return
+        path.close()
+        self._native, self.path_problem = None, f"compiled path failed to start ({problem})"
+        self.get_logger().warning(f"{self.path_problem}: the Python path answers the joint states")
+        self.create_subscription(JointState, topics.JOINT_STATES, self.on_state, stream_qos(1), raw=True)
+
+    def _plan(self, when_due: bool = False) -> None:
+        """The rows of the references taken since the last call, planned in one block and put in
+        the compiled path (a level platform: a tilted reference is left to the Python path,
+        whose prepare handles it). ``when_due``: only once the oldest of them is less than
+        :data:`PLAN_MARGIN` reference periods ahead of the newest state the thread took (a
+        reference streamed far ahead is planned in blocks; one two periods ahead, as the
+        simulator streams it by default, at once)."""
+        if not self._unplanned:
+            return
+        if when_due:
+            dt = self._ref_dt
+            newest = self.path.stats()["last_taken"]
+            if dt > 0 and math.isfinite(newest):
+                ahead = (self._unplanned[-1][0] - newest) / dt
+                self._far_ahead = self._far_ahead + 1 if ahead >= FAR_AHEAD else 0
+                if self._far_ahead == 1000 and self._ref_sub not in self.polled:
+                    fastspin.poll(self, self._ref_sub)
+                if self._unplanned[0][0] - newest > PLAN_MARGIN * dt:
+                    return
+        refs, self._unplanned = self._unplanned, []
+        refs = [r for r in refs if abs(r[2][0]) == 1.0 and not r[2][1:].any()]
+        if not refs:
+            return
+
+        def rows(k):
+            return np.array([np.full(3, np.nan) if r[k] is None else r[k] for r in refs], float)
+
+        try:
+            plan = self.controller.plan(np.array([r[0] for r in refs]), rows(1), rows(3), rows(4))
+        except (np.linalg.LinAlgError, ValueError, FloatingPointError):
+            return          # (no rows: the Python path prepares those stamps and says why)
+        self.path.put(plan)
 
     def on_reference(self, msg: MultiDOFJointTrajectory) -> None:
         """A reference sample (MultiDOFJointTrajectory or its serialised bytes)."""
         r = self.decode_raw("reference", MultiDOFJointTrajectory, msg)
         if r is not None and self.accept("reference", r["position"]):     # (position None when empty)
-            self.stream.reference(r["t"], r["position"], xyzw_to_wxyz(r["quaternion"]),
-                                  r["linear_velocity"], r["linear_acceleration"])
+            quat = xyzw_to_wxyz(r["quaternion"])
+            self.stream.reference(r["t"], r["position"], quat, r["linear_velocity"], r["linear_acceleration"])
+            if self.path is not None:
+                if self._ref_t is not None and r["t"] > self._ref_t:
+                    self._ref_dt = r["t"] - self._ref_t       # the reference's period
+                self._ref_t = r["t"]
+                self._unplanned.append((r["t"], r["position"], quat, r["linear_velocity"], r["linear_acceleration"]))
+                self._plan(when_due=True)
             self.command(self.stream.ready())
 
     def on_estimate(self, msg: InertiaStamped) -> None:
         t, m, com = convert.inertia_arrays(msg)
         self.stream.estimate(t, m if self.accept("payload_estimate", [m]) else None, com)
+        if self.path is not None:
+            self.path.replan()      # the rows not used yet, with the new estimate
         self.command(self.stream.ready())     # a state may have been waiting for this estimate
 
     def on_state(self, msg: JointState) -> None:
@@ -93,9 +190,13 @@ class CdprController(PlantNode):
         CommandStream.prepare_next>`), then a due /diagnostics: the state -> command path stays
         short."""
         state = self.decode_raw("joint_states", JointState, msg)
-        if state is None:
-            return
-        self._state_wall = now = time.monotonic()
+        if state is not None:
+            self.take_state(state, time.monotonic())
+
+    def take_state(self, state, now: float) -> None:
+        """A decoded motor state received at wall ``now`` (from :meth:`on_state`, or handed over
+        by the compiled path)."""
+        self._state_wall = now
         if self.player is not None and math.isfinite(state[0]):
             self.player(state[0], ())        # the designed reference of this stamp, published first
         if self.stream.needs_inputs_first(state[0]):
@@ -110,11 +211,35 @@ class CdprController(PlantNode):
         """A state still waiting for the reference (or the awaited estimate) of its stamp is
         commanded once they came or it waited long enough; while states flow, their own callback
         takes the queued inputs and the timer only runs a due /diagnostics."""
+        if self.path is not None:
+            self.take_polled()
+            self._plan(when_due=True)
+            self._from_path()
         now = time.monotonic()
-        if self.stream.pending is not None or now - self._state_wall > 0.01:
+        if self.stream.pending is not None or (self.path is None and now - self._state_wall > 0.01):
             self.take_polled()
             self.command(self.stream.ready(now))
         self.run_deferred()
+
+    def _from_path(self, handoff: bool = True) -> None:
+        """What the compiled path did since the last call: its commands counted as this node's
+        (states received, latency, the law's status at the last stamp answered) and (``handoff``)
+        the state it handed over taken here."""
+        s = self.path.stats()
+        new = s["commanded"] - self._path_seen["commanded"]
+        if new > 0:
+            st = self.inputs.inputs["joint_states"]
+            st.received += new
+            st.last_time = max(st.last_time or 0.0, s["last_wall"])
+            for x in self.path.latencies():
+                self.latency.add(float(x))
+            if self.controller is not None:
+                self.controller.status = self.controller.planned_status(s["last_stamp"])
+        self._path_seen = s
+        h = self.path.handoff() if handoff else None
+        if h is not None:
+            t, wall, q, qd = h
+            self.take_state((t, None, q, qd, None), wall)
 
     def command(self, state) -> None:
         """One command for ``state`` = (t, names, position, velocity, effort), if any."""
@@ -127,7 +252,23 @@ class CdprController(PlantNode):
             self.latency.since(t0)
 
     def extend_status(self, level, msg, values):
-        return self.stream.report(level, msg, values, "PDFF" if self.v.feedforward else "PD", self.sent)
+        if self.path is not None:
+            self._from_path(handoff=False)
+        path = self._path_seen.get("commanded", 0) if self.path is not None else 0
+        level, msg, values = self.stream.report(level, msg, values, "PDFF" if self.v.feedforward else "PD",
+                                                self.sent + path)
+        if self.path is not None:
+            values.update({"compiled path": "on", "commands from the compiled path": str(path),
+                           "states handed to Python": str(self._path_seen["handed_off"]),
+                           "states waiting for their row": str(self._path_seen["waited"])})
+        else:
+            values["compiled path"] = "off" + (f" ({self.path_problem})" if self.path_problem else "")
+        return level, msg, values
+
+    def destroy_node(self):
+        if self.path is not None:
+            self.path.close()
+        return super().destroy_node()
 
 
 def make_node() -> PlantNode:

@@ -113,4 +113,7 @@ CONTROLLER = merge((
     Param("estimate_wait", 0.0, "a state waits this long for the estimate of its stamp (0 = never: "
           "use the latest; with a lock-step simulator: one deterministic chain)", "s wall",
           ge=0.0, le=10.0),
+    Param("compiled_path", True, "answer the joint states from the compiled path (cablelab/csrc/"
+          "controller_path.c, same law: planned rows applied in C) when it builds; not with "
+          "estimate_wait > 0 or reference_bag; false, or CABLELAB_NATIVE=0: the Python path"),
 ), executor_params(True))
