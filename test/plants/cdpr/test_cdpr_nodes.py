@@ -27,8 +27,12 @@ def _capture(out: list, cls):
     return lambda m: out.append(deserialize_message(m, cls) if isinstance(m, bytes) else m)
 
 
-def test_adapters_survive_bad_input(ros_context):
+def test_adapters_survive_bad_input(ros_context, monkeypatch):
+    from cablelab import native
     from cablelab.ros import convert
+
+    monkeypatch.setenv("CABLELAB_NATIVE", "0")      # the Python simulator path, called in process
+    monkeypatch.setattr(native, "_loaded", {})
     from cablelab.plants.cdpr.nodes.sim import CdprSimNode
     from cablelab.plants.cdpr.nodes.estimator import CdprPayloadEstimator
     from cablelab.plants.cdpr.nodes.controller import CdprController

@@ -16,7 +16,7 @@ class FakeSim:
     def slack(self):
         return np.array([self.slack_now, False])
 
-    def add_mass(self, kg):
+    def add_mass(self, kg, model=True):
         self.added.append((self.time, kg))
 
 

@@ -149,17 +149,18 @@ class CdprSim:
         self._bias = np.zeros(self.n) if bias is None else np.broadcast_to(np.asarray(bias, float), (self.n,)).copy()
         self.reset(self.position)
 
-    def add_mass(self, mass: float) -> None:
+    def add_mass(self, mass: float, model: bool = True) -> None:
         """Load the platform with ``mass`` kg more at its own centre of mass (a payload put on
         while running: the inertia grows in proportion, the centre of mass stays); the truth's
-        platform mass follows."""
-        b = self.model.body("platform").id
-        m0 = float(self.model.body_mass[b])
-        m1 = m0 + float(mass)
-        if not m1 > 0:
-            raise ValueError(f"platform mass would become {m1:g} kg")
-        self.model.body_mass[b] = m1
-        self.model.body_inertia[b] *= m1 / m0
+        platform mass follows (``model`` False: only the truth, the model already has it)."""
+        if model:
+            b = self.model.body("platform").id
+            m0 = float(self.model.body_mass[b])
+            m1 = m0 + float(mass)
+            if not m1 > 0:
+                raise ValueError(f"platform mass would become {m1:g} kg")
+            self.model.body_mass[b] = m1
+            self.model.body_inertia[b] *= m1 / m0
         self.truth = replace(self.truth, platform_mass=float(self.truth.platform_mass) + float(mass))
 
     # ----------------------------------------------------------------------------- state

@@ -188,10 +188,7 @@ class SimStepper:
             self.hw.write(self.u)
         self.k += 1
         if self.mass_change and 0 <= self.mass_change_time <= self.sim.time:
-            self.sim.add_mass(self.mass_change)
-            if self.on_mass_change is not None:
-                self.on_mass_change(self.mass_change)
-            self.mass_change = 0.0
+            self.put_on_mass()
         if missed and self.commands and self.real_time:
             self.missed_steps += 1
         if self.sim.slack().any():
@@ -199,6 +196,14 @@ class SimStepper:
         if self.duration and self.sim.time >= self.duration:
             self.done = True
         return True
+
+    def put_on_mass(self, model: bool = True) -> None:
+        """The scheduled payload goes on now: the simulation gains it (``model`` False: only its
+        truth, the compiled path changed the model), then ``on_mass_change(kg)``."""
+        kg, self.mass_change = self.mass_change, 0.0
+        self.sim.add_mass(kg, model=model)
+        if self.on_mass_change is not None:
+            self.on_mass_change(kg)
 
     def published(self, now: float) -> None:
         """The state of the present sim time went out at wall time ``now``."""

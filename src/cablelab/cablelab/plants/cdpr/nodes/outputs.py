@@ -39,14 +39,17 @@ def fill_estimate(tpl: RawTemplate, t: float, mass: float, com) -> RawTemplate:
 
 class CdprOutputs:
     """Publishers and templates of ``n`` winches: joint states, cable tensions, reference, /clock,
-    measured pose, ground truth (``truth``) and effort commands (``commands``)."""
+    measured pose, ground truth (``truth``) and effort commands (``commands``); without ``state``
+    no joint states, tensions and reference publishers (another publishes them from the
+    templates: the simulator's compiled path)."""
 
-    def __init__(self, node, n: int, truth: bool = True, commands: bool = False):
+    def __init__(self, node, n: int, truth: bool = True, commands: bool = False, state: bool = True):
         q = publisher_qos()
         make = node.create_publisher
-        self.pub_js, self.pub_ten = make(JointState, topics.JOINT_STATES, q), make(JointState, topics.CABLE_TENSIONS, q)
+        self.pub_js = self.pub_ten = self.pub_ref = None
+        if state:
+            self.state_publishers(node)
         self.pub_pose = make(PoseStamped, topics.PLATFORM_POSE, q)
-        self.pub_ref = make(MultiDOFJointTrajectory, topics.REFERENCE, q)
         self.pub_cmd = make(Float64MultiArray, topics.EFFORT_COMMANDS, q) if commands else None
         self.pub_tpose = make(PoseStamped, topics.GROUND_TRUTH_POSE, q) if truth else None
         self.pub_tpay = make(InertiaStamped, topics.GROUND_TRUTH_PAYLOAD, q) if truth else None
@@ -63,6 +66,13 @@ class CdprOutputs:
         self.t_pose = RawTemplate(convert.pose_msg(0.0, z3, unit))
         self.t_tpose = RawTemplate(convert.pose_msg(0.0, z3, unit))
         self.t_tpay = RawTemplate(convert.inertia_msg(0.0, 0.0, z3))
+
+    def state_publishers(self, node) -> None:
+        """The joint states, tensions and reference publishers."""
+        q = publisher_qos()
+        self.pub_js = node.create_publisher(JointState, topics.JOINT_STATES, q)
+        self.pub_ten = node.create_publisher(JointState, topics.CABLE_TENSIONS, q)
+        self.pub_ref = node.create_publisher(MultiDOFJointTrajectory, topics.REFERENCE, q)
 
     def payload(self, mass: float, com) -> None:
         """The true moving mass (kg) and centre of mass (3,) of the ground truth."""
