@@ -33,6 +33,7 @@
 #include <sensor_msgs/msg/joint_state.h>
 #include <std_msgs/msg/float64_multi_array.h>
 #include <std_msgs/msg/multi_array_dimension.h>
+#include "rt_common.h"
 
 #define CP_MAXN 64     /* winches */
 #define CP_ROWS 1024   /* rows kept: a second of a 1 kHz reference */
@@ -75,12 +76,6 @@ typedef struct {
   sensor_msgs__msg__JointState js;
   std_msgs__msg__Float64MultiArray cmd;
 } cp_t;
-
-static double now_s(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
 
 cp_t *cp_create(int n, int has_ff, double kp, double kd, double floor_, double max_torque, double row_wait) {
   if (n <= 0 || n > CP_MAXN) return NULL;
@@ -214,15 +209,6 @@ int cp_latencies(cp_t *h, double *out, int cap) {
 }
 
 const char *cp_error(cp_t *h) { return h->error; }
-
-static rmw_qos_profile_t qos(size_t depth, int transient_local) {
-  rmw_qos_profile_t q = rmw_qos_profile_default;
-  q.history = RMW_QOS_POLICY_HISTORY_KEEP_LAST;
-  q.depth = depth;
-  q.reliability = RMW_QOS_POLICY_RELIABILITY_RELIABLE;
-  q.durability = transient_local ? RMW_QOS_POLICY_DURABILITY_TRANSIENT_LOCAL : RMW_QOS_POLICY_DURABILITY_VOLATILE;
-  return q;
-}
 
 #define TRY(x, what)                                                         \
   do {                                                                       \

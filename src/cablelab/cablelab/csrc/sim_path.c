@@ -30,6 +30,7 @@
 #include <rmw/serialized_message.h>
 
 #include "sim_path.h"
+#include "rt_common.h"
 
 #define MAX_CATCH_UP 20
 
@@ -82,19 +83,6 @@ struct SimPath {
 };
 
 /* ---------------------------------------------------------------------------------- helpers */
-static double now_s(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
-
-static void sleep_until(double t) {
-  struct timespec ts;
-  ts.tv_sec = (time_t)t;
-  ts.tv_nsec = (long)((t - (double)ts.tv_sec) * 1e9);
-  if (ts.tv_nsec >= 1000000000L) { ts.tv_sec += 1; ts.tv_nsec -= 1000000000L; }
-  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, NULL) == EINTR) {}
-}
 
 static void count_add(SimPath *s, int i, long v) { __atomic_fetch_add(&s->counts[i], v, __ATOMIC_RELAXED); }
 
@@ -517,15 +505,6 @@ void sp_reference(SimPath *s, const uint8_t *bytes, size_t len, long sec, long n
   s->ref_rows = rows;
   s->ref_lead = lead_steps;
   s->ref_on = rows > 0;
-}
-
-static rmw_qos_profile_t qos(size_t depth, int transient_local) {
-  rmw_qos_profile_t q = rmw_qos_profile_default;
-  q.history = RMW_QOS_POLICY_HISTORY_KEEP_LAST;
-  q.depth = depth;
-  q.reliability = RMW_QOS_POLICY_RELIABILITY_RELIABLE;
-  q.durability = transient_local ? RMW_QOS_POLICY_DURABILITY_TRANSIENT_LOCAL : RMW_QOS_POLICY_DURABILITY_VOLATILE;
-  return q;
 }
 
 /* Its own rcl context and node: publishers of the joint states, the tensions and the reference (reliable,
