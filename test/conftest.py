@@ -22,6 +22,16 @@ def domain_id():
 
 
 @pytest.fixture
+def ros_context(domain_id):
+    """rclpy initialised on the test's own domain, for nodes built in the test's process."""
+    import rclpy
+
+    rclpy.init(domain_id=domain_id)
+    yield
+    rclpy.try_shutdown()
+
+
+@pytest.fixture
 def launcher(tmp_path, domain_id):
     """A :class:`cablelab.ros.launch.Launcher` on a fresh domain; stops everything at the end and
     prints the process logs of a failed test."""

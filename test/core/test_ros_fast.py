@@ -8,15 +8,6 @@ import numpy as np
 import pytest
 
 
-@pytest.fixture
-def ros_context(domain_id):
-    import rclpy
-
-    rclpy.init(domain_id=domain_id)
-    yield
-    rclpy.try_shutdown()
-
-
 def test_templates_equal_rclpy_serialisation():
     from geometry_msgs.msg import InertiaStamped, PoseStamped
     from rclpy.serialization import deserialize_message, serialize_message
@@ -226,3 +217,25 @@ ev.set(); t.join()
         assert set(eval(lines["SLICES"])) == {200000}
     else:
         assert "not available" in out, out
+
+
+def test_yield_to_compiled_lowers_only_the_calling_thread():
+    """A node's Python thread steps back for its compiled thread: the caller's nice value rises,
+    the other threads of the process (here the test's main thread) keep theirs."""
+    import os
+    import threading
+
+    from cablelab.ros.fastspin import yield_to_compiled
+
+    main_nice = os.getpriority(os.PRIO_PROCESS, threading.get_native_id())
+    seen = {}
+
+    def worker():
+        seen["msg"] = yield_to_compiled(7)
+        seen["nice"] = os.getpriority(os.PRIO_PROCESS, threading.get_native_id())
+
+    t = threading.Thread(target=worker)
+    t.start()
+    t.join()
+    assert seen["nice"] == max(7, main_nice) and str(seen["nice"]) in seen["msg"]
+    assert os.getpriority(os.PRIO_PROCESS, threading.get_native_id()) == main_nice

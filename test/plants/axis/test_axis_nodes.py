@@ -200,13 +200,6 @@ def test_conversions_serialised_by_rclpy_decode_with_cablelab_codec():
 
 
 # ----------------------------------------------------------------------------- adapters with bad input
-@pytest.fixture
-def ros_context(domain_id):
-    import rclpy
-
-    rclpy.init(domain_id=domain_id)
-    yield
-    rclpy.try_shutdown()
 
 
 def test_sim_node_survives_bad_commands(ros_context):

@@ -109,13 +109,6 @@ def test_bad_states_and_missing_rows_are_not_answered_and_a_new_estimate_replans
 
 
 # ---------------------------------------------------------------------------------- DDS
-@pytest.fixture
-def ros_context(domain_id):
-    import rclpy
-
-    rclpy.init(domain_id=domain_id)
-    yield
-    rclpy.try_shutdown()
 
 
 def test_node_thread_answers_states_over_dds_and_reports_bad_ones(ros_context):

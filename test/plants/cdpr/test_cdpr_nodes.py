@@ -11,15 +11,6 @@ import pytest
 from cablelab.ros.inputs import ERROR, WARN
 
 
-@pytest.fixture
-def ros_context(domain_id):
-    import rclpy
-
-    rclpy.init(domain_id=domain_id)
-    yield
-    rclpy.try_shutdown()
-
-
 def _capture(out: list, cls):
     """A stand-in for Publisher.publish that keeps messages (bytes are deserialised as cls)."""
     from rclpy.serialization import deserialize_message

@@ -84,16 +84,6 @@ def test_compiled_steps_equal_python_steps_for_the_same_commands(params):
         path.close()
 
 
-
-@pytest.fixture
-def ros_context(domain_id):
-    import rclpy
-
-    rclpy.init(domain_id=domain_id)
-    yield
-    rclpy.try_shutdown()
-
-
 def test_the_node_with_the_compiled_path_survives_bad_commands(ros_context):
     """The simulator node in real time runs the compiled path: NaN, wrong-length and empty
     commands over DDS are rejected and reported on its /diagnostics status (as the Python path

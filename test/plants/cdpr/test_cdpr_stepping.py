@@ -130,10 +130,14 @@ def test_lock_step_waits_for_the_answer_then_times_out():
 
 
 def test_reference_stamps_lead_mass_change_and_duration():
-    s, _ = stepper(True)                          # real time: two periods ahead
+    s, _ = stepper(True)                          # real time: 50 ms = five periods ahead
     before, after = s.reference_stamps(0.0)
-    assert before == pytest.approx([0.0, 0.01]) and after == pytest.approx([0.02])
-    assert s.reference_stamps(0.01) == ([], [pytest.approx(0.03)])
+    assert before == pytest.approx([0.0, 0.01, 0.02, 0.03, 0.04]) and after == pytest.approx([0.05])
+    assert s.reference_stamps(0.01) == ([], [pytest.approx(0.06)])
+    s, _ = stepper(True, rate=20.0)               # at least two periods
+    assert s.reference_lead == pytest.approx(0.1)
+    s, _ = stepper(True, reference_lead=0.02)     # as given
+    assert s.reference_stamps(0.0) == ([0.0, pytest.approx(0.01)], [pytest.approx(0.02)])
     s, _ = stepper(False)                         # lock-step: each stamp before its state
     assert s.reference_stamps(0.5) == ([0.5], []) and s.reference_stamps(0.51) == ([0.51], [])
     s, _ = stepper(False, reference_lead=None)
@@ -165,7 +169,7 @@ def test_steps_due_and_report_name_the_slack_cables():
 def test_from_parameters_builds_the_caroca_at_rest_at_point_a():
     """The simulator node's stepper from its parameter specs' defaults: the default description's
     cables, the s-curve's start (oracle: trajectory.pick_and_place at 0) as the initial pose, the
-    reference published two periods ahead in real time, none with publish_reference false; a
+    reference published 50 ms ahead in real time, none with publish_reference false; a
     description without a cdpr section is one line naming the node."""
     from types import SimpleNamespace
 
@@ -180,7 +184,7 @@ def test_from_parameters_builds_the_caroca_at_rest_at_point_a():
     s = SimStepper.from_parameters(desc, v, "cable_sim_node")
     assert s.sim.n == len(desc.cdpr.cables) and s.rate == 200.0 and s.real_time
     np.testing.assert_allclose(s.sim.truth_pose()[0], pick_and_place(np.array([0.0])).position[0], atol=2e-3)
-    assert s.reference_lead == pytest.approx(0.01) and s.publish_reference
+    assert s.reference_lead == pytest.approx(0.05) and s.publish_reference
     quiet = SimpleNamespace(**{**vars(v), "publish_reference": False})
     assert not SimStepper.from_parameters(desc, quiet).publish_reference
     with pytest.raises(CablelabError, match=r"^cable_sim_node --plant cdpr: the description has no cdpr section$"):

@@ -10,15 +10,6 @@ import pytest
 from cablelab.ros.inputs import WARN
 
 
-@pytest.fixture
-def ros_context(domain_id):
-    import rclpy
-
-    rclpy.init(domain_id=domain_id)
-    yield
-    rclpy.try_shutdown()
-
-
 def test_adapters_survive_nan_wrong_length_stale(ros_context):
     from sensor_msgs.msg import JointState
     from std_msgs.msg import Float64MultiArray

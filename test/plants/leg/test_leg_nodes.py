@@ -10,15 +10,6 @@ import numpy as np
 import pytest
 
 
-@pytest.fixture
-def ros_context(domain_id):
-    import rclpy
-
-    rclpy.init(domain_id=domain_id)
-    yield
-    rclpy.try_shutdown()
-
-
 def _spin(nodes, seconds, until=None):
     """Spin for ``seconds`` of wall time, or, with ``until``, until it holds (checked every
     0.5 s; ``seconds`` is then the limit: a loaded machine runs the simulator slower)."""

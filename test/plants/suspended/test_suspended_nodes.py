@@ -7,15 +7,6 @@ import numpy as np
 import pytest
 
 
-@pytest.fixture
-def ros_context(domain_id):
-    import rclpy
-
-    rclpy.init(domain_id=domain_id)
-    yield
-    rclpy.try_shutdown()
-
-
 def test_estimator_node_publishes_swing_and_survives_nan(ros_context):
     import rclpy
     from rclpy.executors import SingleThreadedExecutor

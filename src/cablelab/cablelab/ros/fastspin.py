@@ -36,7 +36,7 @@ from __future__ import annotations
 from contextlib import ExitStack
 
 __all__ = ["FastExecutor", "supports", "set_realtime_priority", "set_cpu_affinity", "set_background",
-           "set_latency_slice", "set_idle_class", "poll", "polled", "drain", "take_newest", "defer", "deferred",
+           "set_latency_slice", "set_idle_class", "yield_to_compiled", "poll", "polled", "drain", "take_newest", "defer", "deferred",
            "run_deferred"]
 
 
@@ -103,6 +103,25 @@ def set_background(niceness: int) -> str:
     except OSError:
         pass
     return ", ".join(done)
+
+
+def yield_to_compiled(niceness: int = 10) -> str:
+    """Lower the CALLING thread's CPU priority by ``niceness`` (its own nice value; the process's
+    other threads keep theirs): for a node's Python thread once a compiled thread carries the
+    node's deadline path (:mod:`cablelab.native`), so that on a crowded machine the scheduler
+    gives the compiled thread and the DDS threads that feed it the CPU first, and the Python
+    thread (publishing what is off the deadline path) what is left. Call it after starting the
+    compiled thread (a thread inherits its creator's nice value). No privilege is needed.
+    Returns a one-line result for the log."""
+    import os
+    import threading
+
+    tid = threading.get_native_id()
+    try:
+        os.setpriority(os.PRIO_PROCESS, tid, max(os.getpriority(os.PRIO_PROCESS, tid), int(niceness)))
+    except (OSError, AttributeError) as exc:
+        return f"nice not available ({exc})"
+    return f"the Python thread at nice {os.getpriority(os.PRIO_PROCESS, tid)}"
 
 
 def set_idle_class() -> str:

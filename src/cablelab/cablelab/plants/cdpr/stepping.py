@@ -28,6 +28,17 @@ __all__ = ["SimStepper", "MAX_CATCH_UP"]
 MAX_CATCH_UP = 20       # steps run at once by a late real-time timer; more behind are dropped
 
 
+#: the reference's default lead in real time (s): far enough ahead that a controller plans it in
+#: blocks (off its state -> command path) instead of once per period
+DEFAULT_LEAD = 0.05
+
+
+def default_lead(rate: float) -> float:
+    """The default lead of the published reference in real time: :data:`DEFAULT_LEAD` as a whole
+    number of periods, at least two."""
+    return max(2, round(DEFAULT_LEAD * rate)) / rate
+
+
 class SimStepper:
     """The simulator node's per-step logic.
 
@@ -38,8 +49,8 @@ class SimStepper:
         real_time: step on the wall clock (False: lock-step with the controller).
         lockstep_timeout: s wall a lock-step waits for the answering command.
         reference: the published reference (:class:`~.trajectory.ReferenceTable`).
-        reference_lead: s the published reference runs ahead of the state (negative: two
-            periods in real time, 0 in lock-step); None = no reference published.
+        reference_lead: s the published reference runs ahead of the state (negative:
+            :func:`default_lead` in real time, 0 in lock-step); None = no reference published.
         duration: sim time after which :attr:`done` (0 = never).
         mass_change, mass_change_time: kg put on the platform at that sim time (negative: never);
             ``on_mass_change(kg)`` is called after it happened.
@@ -57,7 +68,7 @@ class SimStepper:
         # real time: the reference two steps ahead goes out right after the state (off the
         # state -> command critical path; the consumers look it up by stamp, and a controller
         # prepares the reference terms of the next stamp while the plant steps)
-        self.reference_lead = (2.0 / rate if real_time else 0.0) if lead < 0 else lead
+        self.reference_lead = (default_lead(rate) if real_time else 0.0) if lead < 0 else lead
         self._ref_started = False
         self.duration = duration
         self.mass_change, self.mass_change_time = mass_change, mass_change_time

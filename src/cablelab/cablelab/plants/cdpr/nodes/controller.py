@@ -121,7 +121,8 @@ class CdprController(PlantNode):
         problem = path.start(self, topics.JOINT_STATES, topics.EFFORT_COMMANDS, PUBLISHER_DEPTH, self._cmd.label)
         if problem is None:
             self.path = path
-            self.get_logger().info("compiled path: the joint states are answered by cablelab/csrc/controller_path.c")
+            self.get_logger().info("compiled path: the joint states are answered by cablelab/csrc/controller_path.c; "
+                                   + fastspin.yield_to_compiled())
             return
         path.close()
         self._native, self.path_problem = None, f"compiled path failed to start ({problem})"
@@ -133,8 +134,8 @@ class CdprController(PlantNode):
         the compiled path (a level platform: a tilted reference is left to the Python path,
         whose prepare handles it). ``when_due``: only once the oldest of them is less than
         :data:`PLAN_MARGIN` reference periods ahead of the newest state the thread took (a
-        reference streamed far ahead is planned in blocks; one two periods ahead, as the
-        simulator streams it by default, at once)."""
+        reference streamed far ahead, as the simulator streams it by default, is planned in
+        blocks; one only two periods ahead at once)."""
         if not self._unplanned:
             return
         if when_due:

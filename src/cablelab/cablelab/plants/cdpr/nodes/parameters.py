@@ -34,7 +34,7 @@ SIM = merge((
     Param("publish_reference", True, "publish /cdpr/reference, the pick-and-place s-curve of 001 "
           "sec. II-C (false: another node publishes it)"),
     Param("reference_lead", -1.0, "time the published reference runs ahead of the state (negative "
-          "= two periods in real time, 0 in lock-step)", "s", ge=-1.0, le=1.0),
+          "= 50 ms in real time (at least two periods), 0 in lock-step)", "s", ge=-1.0, le=1.0),
     Param("publish_pose", True, "publish the measured pose /cdpr/platform_pose"),
     Param("trajectory_speed", 1.0, "time scale of the s-curve (2 = twice as fast)", gt=0.0, le=100.0),
     Param("settle", 1.0, "time held at A before the trajectory starts", "s", ge=0.0, le=3600.0),

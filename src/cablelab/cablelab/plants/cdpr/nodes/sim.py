@@ -31,6 +31,7 @@ from std_msgs.msg import Float64MultiArray
 from .... import native
 from ....description import load_description
 from ....ros import rawmsg
+from ....ros.fastspin import yield_to_compiled
 from ....ros.plant_node import FINISH_ACK_TIMEOUT, PlantNode
 from ....ros.qos import stream_qos
 from .. import topics
@@ -147,6 +148,7 @@ class CdprSimNode(PlantNode):
                     return
                 self.publish_state()
             c.start()
+            self.get_logger().info(f"compiled path started: {yield_to_compiled()}")
         c.update(self.inputs)       # (before the drain: a sample the counts know of is in the ring)
         rows = c.drain()
         for work in rows[:, 2]:
