@@ -87,8 +87,12 @@ class CdprController(PlantNode):
                                        polled=self._native is None)
         self.subscribe(InertiaStamped, topics.PAYLOAD_ESTIMATE, self.on_estimate, q,
                        polled=not self.stream.awaits_estimate)
-        if self._native is None:
-            self.create_subscription(JointState, topics.JOINT_STATES, self.on_state, stream_qos(1), raw=True)
+        # the Python path's subscription from the start, also when the compiled path is wanted: the
+        # node subscribes to the states before a description configures the law (a launch that
+        # waits for this node's subscribers starts the simulator that sends the description);
+        # the compiled path's thread replaces it once it runs
+        self._state_sub = self.create_subscription(JointState, topics.JOINT_STATES, self.on_state,
+                                                   stream_qos(1), raw=True)
         self.player = self.play_reference(v.reference_bag, topics.REFERENCE, ("x", "y", "z"), platform=True)
         self._state_wall = -1.0     # wall time of the last state taken
         self.timer = self.create_timer(0.002, self.on_timer)
@@ -121,13 +125,14 @@ class CdprController(PlantNode):
         problem = path.start(self, topics.JOINT_STATES, topics.EFFORT_COMMANDS, PUBLISHER_DEPTH, self._cmd.label)
         if problem is None:
             self.path = path
+            self.destroy_subscription(self._state_sub)
+            self._state_sub = None
             self.get_logger().info("compiled path: the joint states are answered by cablelab/csrc/controller_path.c; "
                                    + fastspin.yield_to_compiled())
             return
         path.close()
         self._native, self.path_problem = None, f"compiled path failed to start ({problem})"
         self.get_logger().warning(f"{self.path_problem}: the Python path answers the joint states")
-        self.create_subscription(JointState, topics.JOINT_STATES, self.on_state, stream_qos(1), raw=True)
 
     def _plan(self, when_due: bool = False) -> None:
         """The rows of the references taken since the last call, planned in one block and put in
