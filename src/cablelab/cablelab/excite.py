@@ -379,7 +379,7 @@ def detectable_delay(model: "Linearised", ds, sigma, n_eff_per_s: float, *,
     import scipy.optimize
     import scipy.stats
 
-    from .diagnose.ranking import ALPHA, MIN_GAIN
+    from .diagnose.score import ALPHA, MIN_GAIN
 
     phi, _, _ = model.regressor(ds)
     ok = np.asarray(ds.valid, bool) & np.isfinite(phi).all(axis=(1, 2))

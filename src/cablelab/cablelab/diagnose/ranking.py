@@ -36,16 +36,14 @@ from ..dataset import Dataset
 from ..model import Model
 from .localise import derived_regimes, factorise_regimes, residual_by_regime
 from .result import Candidate, Diagnosis, Step
-from .score import channel_nrmse, heldout_error, lr_significance, practical_gain
+from .score import ALPHA, MIN_GAIN, channel_nrmse, heldout_error, lr_significance, practical_gain
 
-#: default number of folds, significance level, guard band (fraction of samples per side)
+#: default number of folds, guard band (fraction of samples per side); the significance level
+#: and the minimum held-out gain are the score's (:data:`.score.ALPHA`, :data:`.score.MIN_GAIN`)
 FOLDS = 5
-ALPHA = 0.01
 GUARD_FRACTION = 0.01
 #: minimum samples per test block
 MIN_FOLD_SAMPLES = 50
-#: minimum relative reduction of the held-out error for an effect to count as significant
-MIN_GAIN = 0.05
 
 
 def fold_indices(n: int, k: int = FOLDS, guard: int | None = None) -> list[tuple[np.ndarray, np.ndarray]]:

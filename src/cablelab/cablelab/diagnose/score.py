@@ -29,6 +29,11 @@ import scipy.stats
 
 from ..fit.identification import effective_samples
 
+#: default significance level of the likelihood-ratio test
+ALPHA = 0.01
+#: minimum relative reduction of the held-out error for an effect to count as significant
+MIN_GAIN = 0.05
+
 
 def channel_nrmse(y: np.ndarray, y_hat: np.ndarray, valid: np.ndarray | None = None) -> np.ndarray:
     """(C,) rms(y - y_hat) / rms(y) per channel over the finite, valid rows."""
