@@ -59,7 +59,8 @@ def test_first_use_is_quiet_and_logs_pip(project):
     assert BANNER not in res.stderr and BANNER not in res.stdout
     assert len(res.stderr.splitlines()) <= 2, res.stderr            # "creating ...", "ready ..."
     log = (root / ".venv" / "pip.log").read_text()
-    assert log.count(BANNER) == 3 and "pip -m pip install" in log   # all three pip calls logged
+    assert log.count(BANNER) == 4 and "pip -m pip install" in log   # all three pip calls logged,
+    assert "-m cablelab.native" in log                               # and the compiled paths' build
     assert (root / ".venv" / ".stamp").is_file()
     again = _run(root, env, "true")                                  # built: nothing printed
     assert again.returncode == 0 and again.stderr == "" and again.stdout == ""
