@@ -272,7 +272,9 @@ def test_recorder_gets_every_sample_through_the_publisher_process(launcher, tmp_
                                 "-o", bag_dir, "--quiet"])
     launcher.wait_for_subscribers(["/cdpr/joint_states", "/cdpr/effort_commands"], timeout=120,
                                   node_name="cablelab_recorder")
-    rate, duration = 500.0, 3.0
+    # 8 s: the publisher process is a new DDS participant that the recorder must discover before
+    # its samples can reach it (on a busy machine that took longer than a 3 s run once)
+    rate, duration = 500.0, 8.0
     loop = launcher.start("loop", [*_loop_argv(), "--ros-args", "-p", f"rate:={rate}", "-p", f"duration:={duration}",
                                    "-p", "warmup:=0.0"])
     assert loop.wait(600) == 0, loop.log()[-2000:]
