@@ -49,6 +49,26 @@ def launcher(tmp_path, domain_id):
 
 
 @pytest.fixture
+def diagnostics_seen(launcher):
+    """``(probe, seen)``: a probe node of ``launcher`` listening on /diagnostics; ``seen[name]`` is
+    the newest status of that name as ``(level, message, {key: value}, time.monotonic() of arrival)``
+    once the probe's executor has spun."""
+    import time
+
+    from diagnostic_msgs.msg import DiagnosticArray
+
+    probe = launcher.probe()
+    seen = {}
+
+    def on_diag(msg):
+        for st in msg.status:
+            seen[st.name] = (int.from_bytes(st.level, "little") if isinstance(st.level, bytes) else int(st.level),
+                             st.message, {kv.key: kv.value for kv in st.values}, time.monotonic())
+    probe.node.create_subscription(DiagnosticArray, "/diagnostics", on_diag, 50)
+    return probe, seen
+
+
+@pytest.fixture
 def play_designed(launcher, tmp_path):
     """``run(plant, description, params, nodes, counts, joints, ...)``: design an excitation of
     ``params`` (``cablelab.excite.design``), write it as a reference bag, record the plant over DDS

@@ -33,7 +33,6 @@ def test_loop_commands_equal_the_controller_node_on_a_recorded_stream(ros_contex
     """The loop node's commands (read -> ReferenceLaw -> write, reference terms prepared after
     each write, estimates taken between periods) equal what the ``pd_feedforward`` node answers to
     the same states, references and estimates as messages, to round-off: one law, two shells."""
-    from geometry_msgs.msg import InertiaStamped
     from std_msgs.msg import Float64MultiArray
 
     from cablelab.plants.cdpr.nodes.control_loop import CdprControlLoop
@@ -195,21 +194,7 @@ def test_hardware_seam():
     assert hw.sim.time == pytest.approx(0.1)    # one period of physics per write
 
 
-def _diag_listener(launcher):
-    from diagnostic_msgs.msg import DiagnosticArray
-
-    probe = launcher.probe()
-    seen = {}
-
-    def on_diag(msg):
-        for st in msg.status:
-            seen[st.name] = (int.from_bytes(st.level, "little") if isinstance(st.level, bytes) else int(st.level),
-                             st.message, {kv.key: kv.value for kv in st.values}, time.monotonic())
-    probe.node.create_subscription(DiagnosticArray, "/diagnostics", on_diag, 50)
-    return probe, seen
-
-
-def test_loop_survives_the_estimator_over_dds(launcher):
+def test_loop_survives_the_estimator_over_dds(launcher, diagnostics_seen):
     """control_loop + payload_estimator as processes: the loop takes the live estimate; when the
     estimator is killed it keeps running (its state stream goes on) and reports the stale
     estimate on /diagnostics as WARN within a bounded time. (Publishing through the publisher
@@ -217,7 +202,7 @@ def test_loop_survives_the_estimator_over_dds(launcher):
     launcher.node("estimator", "payload_estimator", "cdpr", {"poll_period": 0.01})
     launcher.start("loop", [*_loop_argv(), "--ros-args", "-p", "rate:=250.0", "-p", "payload_mass:=249.0",
                             "-p", "estimate_timeout:=1.0"])
-    probe, seen = _diag_listener(launcher)
+    probe, seen = diagnostics_seen
 
     def loop_alive():
         assert launcher.procs["loop"].alive(), launcher.procs["loop"].log()[-2000:]

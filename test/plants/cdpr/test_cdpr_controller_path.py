@@ -212,25 +212,16 @@ def test_node_thread_answers_states_over_dds_and_reports_bad_ones(ros_context):
 
 
 @pytest.mark.parametrize("compiled", [True, False])
-def test_three_processes_answer_the_simulator_and_survive_the_estimator(launcher, compiled):
+def test_three_processes_answer_the_simulator_and_survive_the_estimator(launcher, diagnostics_seen, compiled):
     """cable_sim_node (real time) + payload_estimator + pd_feedforward as processes, with the
     compiled path and without (the Python path, the oracle): the simulator gets its commands, the
     feedforward takes the live mass; the estimator killed, the controller keeps commanding with
     the nominal mass and says so on /diagnostics (WARN), and exits cleanly."""
     if compiled:
         _lib()
-    from diagnostic_msgs.msg import DiagnosticArray
-
     launcher.node("estimator", "payload_estimator", "cdpr", {"poll_period": 0.01})
     launcher.node("controller", "pd_feedforward", "cdpr", {"compiled_path": compiled, "estimate_timeout": 1.0})
-    probe = launcher.probe()
-    seen = {}
-
-    def on_diag(msg):
-        for s in msg.status:
-            seen[s.name] = (int.from_bytes(s.level, "little") if isinstance(s.level, bytes) else int(s.level),
-                            s.message, {kv.key: kv.value for kv in s.values}, time.monotonic())
-    probe.node.create_subscription(DiagnosticArray, "/diagnostics", on_diag, 50)
+    probe, seen = diagnostics_seen
 
     def diag(name):
         return seen.get(name, (None, "", {}, 0.0))
