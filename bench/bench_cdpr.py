@@ -122,6 +122,41 @@ def _cpu_seconds(pid: int) -> float:
     return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
+def _threads(pid: int) -> dict:
+    """{thread name: [CPU ns, run-queue wait ns, times scheduled]} of process ``pid``, summed over
+    its threads of one name (Linux /proc/PID/task/TID/schedstat; Fast DDS names its threads
+    ``dds.*``, the compiled paths theirs ``sim_path`` and ``controller_path``)."""
+    import os
+    import re
+
+    out = {}
+    for tid in os.listdir(f"/proc/{pid}/task"):
+        try:
+            comm = open(f"/proc/{pid}/task/{tid}/comm").read().strip()
+            run, wait, slices = (int(x) for x in open(f"/proc/{pid}/task/{tid}/schedstat").read().split()[:3])
+        except (OSError, ValueError):
+            continue
+        acc = out.setdefault(re.sub(r"[.-]?\d+$", "", comm), [0, 0, 0])
+        acc[0] += run
+        acc[1] += wait
+        acc[2] += slices
+    return out
+
+
+def _thread_deltas(before: dict, after: dict, steps: int) -> dict:
+    """{node: {thread: {"cpu_us", "wait_us", "runs"} per step}} between two :func:`_threads`
+    readings of each node, threads using the most CPU first."""
+    out = {}
+    for node, b in before.items():
+        rows = {}
+        for name, (run, wait, n) in after.get(node, {}).items():
+            r0, w0, n0 = b.get(name, (0, 0, 0))
+            rows[name] = {"cpu_us": (run - r0) / 1e3 / steps, "wait_us": (wait - w0) / 1e3 / steps,
+                          "runs": (n - n0) / steps}
+        out[node] = dict(sorted(rows.items(), key=lambda kv: -kv[1]["cpu_us"]))
+    return out
+
+
 def _load() -> str:
     import os
 
@@ -275,6 +310,7 @@ def run_closed_loop(launch, seconds: float, params: dict, log=print, on_started=
     load0 = _load()
     t0 = time.monotonic()
     samples = []        # (wall, sim time, commands received by the sim, {name: cpu s}, sim status)
+    threads = {}        # sim time -> {node: _threads}: at the first steady sample and every later one
     worst = dict.fromkeys(names, 0.0)
     last_stamp = None
     progress = None
@@ -298,6 +334,10 @@ def run_closed_loop(launch, seconds: float, params: dict, log=print, on_started=
         if progress is not None:
             progress.update(min(st, progress.total) - progress.n)
         if st >= 1.0:
+            try:
+                threads[st] = {name: _threads(pid) for name, pid in pids.items()}
+            except OSError:
+                pass
             for name, node in names.items():
                 v = cl.diag.get(node, {}).get("latency p99 ms")
                 if v not in (None, "?"):
@@ -324,6 +364,9 @@ def run_closed_loop(launch, seconds: float, params: dict, log=print, on_started=
            "cpu_ms": {k: 1000 * (cpu1[k] - cpu0[k]) / max(steps, 1) for k in pids},
            "p99_ms": worst, "load": (load0, _load()),
            "brakes_total": int(last.get("brake steps after the first command", "-1"))}
+    marks = sorted(threads)
+    out["threads"] = (_thread_deltas(threads[marks[0]], threads[marks[-1]], round((marks[-1] - marks[0]) * 1000))
+                      if len(marks) > 1 else {})
     out["missed_cycles"] = delta("missed steps") + out["dropped"]   # each step counted once
 
     def ages(d):

@@ -143,6 +143,8 @@ def run_floor(exe: Path, mjb: Path, state: Path, seconds: float, listener: bool,
         time.sleep(1.0)
         procs["sim"] = launch.start("sim", placed("sim", [str(exe), "sim", str(mjb), str(state),
                                                           str(seconds + 1.0), "1000"]))
+        threads = _sample_threads({"sim": procs["sim"].popen.pid, "controller": procs["ctrl"].popen.pid},
+                                  2.0, seconds - 1.0)
         assert procs["sim"].wait(seconds + 120) == 0, procs["sim"].log()[-2000:]
         assert procs["ctrl"].wait(30) == 0, procs["ctrl"].log()[-2000:]
         launch.stop_all()
@@ -155,7 +157,23 @@ def run_floor(exe: Path, mjb: Path, state: Path, seconds: float, listener: bool,
             "missed_cycles": sim["missed_cycles"], "late": sim["late"], "stale": sim["stale"],
             "dropped": sim["dropped"], "p99_ms": {"sim": sim["p99_ms"], "controller": ctrl["p99_ms"]},
             "cpu_per_step_ms": {"sim": sim["cpu_per_step_ms"], "controller": ctrl["cpu_per_answer_ms"]},
-            "listener": listener, "pinned": pin, "rt_priority": rt > 0}
+            "listener": listener, "pinned": pin, "rt_priority": rt > 0, "threads": threads}
+
+
+def _sample_threads(pids: dict, first: float, last: float) -> dict:
+    """Per-thread CPU, run-queue wait and runs per 1 ms step of each process in ``pids``
+    (bench_cdpr's /proc readings) between ``first`` and ``last`` s from now ({} if a process
+    ended before)."""
+    from bench_cdpr import _thread_deltas, _threads
+
+    try:
+        time.sleep(first)
+        before = {k: _threads(p) for k, p in pids.items()}
+        time.sleep(last - first)
+        after = {k: _threads(p) for k, p in pids.items()}
+    except OSError:
+        return {}
+    return _thread_deltas(before, after, round((last - first) * 1000))
 
 
 def run_timer(exe: Path, seconds: float, pin: bool, rt: int, rate: float = 1000.0) -> dict:

@@ -39,7 +39,8 @@ SCHED_FIFO alike).
                       "publisher", "publisher_cpu_per_cycle_ms" (its publisher process),
                       "samples_lost", "rt_priority", "placement"},
      "three_process": {"rate_hz": 1000, "seconds", "realtime_factor", "missed_cycles",
-                       "p99_ms": {"sim", "estimator", "controller"}, "rt_priority": false, ...},
+                       "p99_ms": {"sim", "estimator", "controller"}, "rt_priority": false,
+                       "threads": {node: {thread name: {"cpu_us", "wait_us", "runs"} per step}}, ...},
      "rate_sweep": [{"rate_hz", "bare_timer_missed", "control_loop_missed", "p99_ms",
                      "realtime_factor", "seconds"}, ...]}
 
@@ -48,6 +49,8 @@ Run it on a quiet machine: ``./run python bench/bench_realtime.py --seconds 60 -
 py-spy and prints each one's share of samples by innermost function (where the time goes);
 ``--publication-mode asynchronous`` runs the nodes with Fast DDS asynchronous publishing.
 Placement without privileges: ``--idle-estimator`` (the estimator in the SCHED_IDLE class),
+``--idle-python`` (the three-process simulator's and controller's Python threads in it once their
+compiled threads run; node parameter ``python_idle``),
 ``--pin`` (that, plus simulator and estimator on CPU 0, controller on CPU 1), ``--node-params
 JSON`` (any node parameters, e.g. ``'{"sim": {"sched_slice": 0.0001}}'``); the JSON's
 ``placement`` says what was used; ``--loop-params JSON`` the control loop's (e.g. ``'{"loop":
@@ -170,6 +173,13 @@ def control_loop(seconds: float, log, rate: float = 1000.0, pin: bool = False, e
             "rt_priority": int(placement.get("loop", {}).get("rt_priority", 0)) > 0, "placement": placement or None}
 
 
+def _thread_rows(prefix: str, threads: dict) -> list:
+    """Table rows of bench_cdpr's per-thread readings (threads under 1 us CPU per step left out)."""
+    return [dict(case=f"{prefix}{node} thread {name}: CPU / run-queue wait per step, runs per step",
+                 value=f"{v['cpu_us']:.1f} / {v['wait_us']:.1f} us, {v['runs']:.2f}", unit="", target="")
+            for node, rows in threads.items() for name, v in rows.items() if v["cpu_us"] >= 1.0]
+
+
 def _fmt(x, digits: int = 4) -> str:
     return "-" if x is None else f"{x:.{digits}f}"
 
@@ -184,6 +194,9 @@ def main(argv=None) -> int:
                                    "controller on CPU 1 (needs >= 2 CPUs)")
     bench.parser.add_argument("--idle-estimator", action="store_true",
                               help="run the estimator in the SCHED_IDLE class (no privilege; no CPU placement)")
+    bench.parser.add_argument("--idle-python", action="store_true",
+                              help="the three-process simulator's and controller's Python threads in SCHED_IDLE "
+                                   "once their compiled paths run (node parameter python_idle; otherwise nice 10)")
     bench.parser.add_argument("--node-params", default=None, metavar="JSON",
                               help='extra node parameters, e.g. \'{"sim": {"sched_slice": 0.0001}}\'')
     bench.parser.add_argument("--skip-offline", action="store_true", help="closed loop only")
@@ -251,6 +264,8 @@ def main(argv=None) -> int:
         if args.transports:
             env["FASTDDS_BUILTIN_TRANSPORTS"] = args.transports
         extra = json.loads(args.node_params) if args.node_params else {}
+        for name in ("sim", "controller") if args.idle_python else ():
+            extra.setdefault(name, {}).setdefault("python_idle", True)
         for name in ("sim", "controller") if rt else ():
             extra.setdefault(name, {}).setdefault("rt_priority", rt)
         r = closed_loop(args.seconds, bench.log, env, args.py_spy, args.pin, extra or None, args.idle_estimator)
@@ -258,7 +273,7 @@ def main(argv=None) -> int:
                               "realtime_factor": r["realtime_factor"], "missed_cycles": r["missed_cycles"],
                               "p99_ms": r["p99_ms"], "rt_priority": r["rt_priority"],
                               "command_age_steps": r["command_age"], "placement": r["placement"],
-                              "cpu_ms": r["cpu_ms"]}
+                              "cpu_ms": r["cpu_ms"], "threads": r.get("threads", {})}
     if args.json:
         print(json.dumps(out))
         return 0
@@ -283,6 +298,7 @@ def main(argv=None) -> int:
                           unit=f"of {int(round(f['bare_timer']['seconds'] * 1000))}", target=""),
                      dict(case="floor: C rcl simulator/controller pair 1 kHz", value=f["c_rcl_pair_missed"],
                           unit=f"of {int(round(f['c_rcl_pair']['seconds'] * 1000))}", target="")]
+            rows += _thread_rows("C pair ", f["c_rcl_pair"].get("threads", {}))
     if "control_loop" in out:
         c = out["control_loop"]
         bare = out.get("floor", {}).get("bare_timer_missed")
@@ -301,6 +317,8 @@ def main(argv=None) -> int:
         c = out["three_process"]
         where = ("sim + estimator (SCHED_IDLE) on CPU 0, controller on CPU 1" if args.pin else
                  "estimator SCHED_IDLE, no CPU placement" if args.idle_estimator else "no CPU placement")
+        if args.idle_python:
+            where += ", simulator's and controller's Python threads SCHED_IDLE"
         if args.node_params:
             where += f", node parameters {args.node_params}"
         prio = "SCHED_FIFO (node parameter rt_priority)" if c["rt_priority"] else "no RT priority"
@@ -319,6 +337,7 @@ def main(argv=None) -> int:
         rows.append(dict(case="CPU per step sim / estimator / controller",
                          value=" / ".join(f"{v:.3f}" for v in r["cpu_ms"].values()), unit="ms", target=""))
         rows.append(dict(case="load average before / after", value=" / ".join(r["load"]), unit="", target=""))
+        rows += _thread_rows("", c["threads"])
     print(table(rows))
     if out.get("rate_sweep"):
         print()

@@ -239,3 +239,25 @@ def test_yield_to_compiled_lowers_only_the_calling_thread():
     t.join()
     assert seen["nice"] == max(7, main_nice) and str(seen["nice"]) in seen["msg"]
     assert os.getpriority(os.PRIO_PROCESS, threading.get_native_id()) == main_nice
+
+
+def test_yield_to_compiled_idle_puts_only_the_calling_thread_in_sched_idle():
+    """``idle=True`` (node parameter ``python_idle``): the caller goes to SCHED_IDLE, the process's
+    other threads stay in their class."""
+    import os
+    import threading
+
+    from cablelab.ros.fastspin import yield_to_compiled
+
+    main_policy = os.sched_getscheduler(threading.get_native_id())
+    seen = {}
+
+    def worker():
+        seen["msg"] = yield_to_compiled(idle=True)
+        seen["policy"] = os.sched_getscheduler(threading.get_native_id())
+
+    t = threading.Thread(target=worker)
+    t.start()
+    t.join()
+    assert seen["policy"] == os.SCHED_IDLE and "SCHED_IDLE" in seen["msg"]
+    assert main_policy != os.SCHED_IDLE and os.sched_getscheduler(threading.get_native_id()) == main_policy

@@ -347,6 +347,7 @@ int cp_start(cp_t *h, void *node, void *context, const char *state_topic, const 
     h->thread = 0;
     goto fail;
   }
+  pthread_setname_np(h->thread, "controller_path");
   h->running = 1;
   return 0;
 fail:

@@ -105,18 +105,26 @@ def set_background(niceness: int) -> str:
     return ", ".join(done)
 
 
-def yield_to_compiled(niceness: int = 10) -> str:
+def yield_to_compiled(niceness: int = 10, idle: bool = False) -> str:
     """Lower the CALLING thread's CPU priority by ``niceness`` (its own nice value; the process's
     other threads keep theirs): for a node's Python thread once a compiled thread carries the
     node's deadline path (:mod:`cablelab.native`), so that on a crowded machine the scheduler
     gives the compiled thread and the DDS threads that feed it the CPU first, and the Python
     thread (publishing what is off the deadline path) what is left. Call it after starting the
-    compiled thread (a thread inherits its creator's nice value). No privilege is needed.
-    Returns a one-line result for the log."""
+    compiled thread (a thread inherits its creator's nice value). ``idle``: the SCHED_IDLE class
+    instead (preempted at once by any ordinary thread, so it never delays the compiled one, but
+    starved on a machine busy with other work: for an otherwise idle machine). No privilege is
+    needed. Returns a one-line result for the log."""
     import os
     import threading
 
     tid = threading.get_native_id()
+    if idle:
+        try:
+            os.sched_setscheduler(tid, os.SCHED_IDLE, os.sched_param(0))
+            return "the Python thread in SCHED_IDLE"
+        except (OSError, AttributeError) as exc:
+            return f"SCHED_IDLE not available ({exc})"
     try:
         os.setpriority(os.PRIO_PROCESS, tid, max(os.getpriority(os.PRIO_PROCESS, tid), int(niceness)))
     except (OSError, AttributeError) as exc:

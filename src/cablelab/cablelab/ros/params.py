@@ -284,6 +284,8 @@ def executor_params(fast_default: bool = True) -> tuple:
         Param("sched_idle", False, "run in the SCHED_IDLE class: only on otherwise idle CPU"),
         Param("sched_slice", 0.0, "EEVDF time slice for a node on the critical path (0 = the "
               "kernel's default)", "s", ge=0.0, le=0.1),
+        Param("python_idle", False, "once a compiled per-period path runs: the node's Python thread "
+              "in SCHED_IDLE instead of nice 10 (for an otherwise idle machine: other work starves it)"),
     )
 
 

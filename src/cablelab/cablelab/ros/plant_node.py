@@ -106,7 +106,8 @@ class PlantNode(Node):
         the critical path), ``sched_idle`` (run in the SCHED_IDLE class: only on otherwise idle
         CPU, preempted at once, :func:`~cablelab.ros.fastspin.set_idle_class`) and ``sched_slice``
         (s, 0 = the kernel's default: a short EEVDF time slice for a node on the critical path,
-        :func:`~cablelab.ros.fastspin.set_latency_slice`). Their specs:
+        :func:`~cablelab.ros.fastspin.set_latency_slice`); ``python_idle`` is kept for
+        :func:`~cablelab.ros.fastspin.yield_to_compiled`. Their specs:
         :func:`~cablelab.ros.params.executor_params`."""
         from .fastspin import (set_background, set_cpu_affinity, set_idle_class, set_latency_slice,
                                set_realtime_priority)
@@ -114,6 +115,7 @@ class PlantNode(Node):
 
         v = self.declare_params(executor_params(default))
         self.fast = bool(v.fast_executor)
+        self.python_idle = bool(v.python_idle)      # (read by a node that starts a compiled path)
         cpus = [int(c) for c in v.cpu_affinity if int(c) >= 0]
         if cpus:
             self.get_logger().info(f"cpu_affinity: {set_cpu_affinity(cpus)}")

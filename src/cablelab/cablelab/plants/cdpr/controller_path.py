@@ -115,11 +115,14 @@ class ControllerPath:
         return kept
 
     def _remember(self, plan: ReferencePlan, idx: np.ndarray) -> None:
-        """Keep the newest :attr:`keep` rows put, as one plan, for :meth:`replan`."""
+        """Keep the newest :attr:`keep` rows put and not answered yet, as one plan, for
+        :meth:`replan`."""
         r = self.recent
         parts = [(plan.t[idx], plan.pd[idx], plan.friction[idx], None if plan.ff is None else plan.ff[idx])]
         if r is not None:
-            parts.insert(0, (r.t, r.pd, r.friction, r.ff))
+            last = self.stats()["last_stamp"]
+            todo = slice(None) if not np.isfinite(last) else r.t > last
+            parts.insert(0, (r.t[todo], r.pd[todo], r.friction[todo], None if r.ff is None else r.ff[todo]))
         t, pd, fric = (np.concatenate([p[k] for p in parts])[-self.keep:] for k in range(3))
         ff = None if plan.ff is None else np.concatenate([p[3] for p in parts])[-self.keep:]
         self.recent = ReferencePlan(t, (None, None, None), np.ones(len(t), bool), pd, fric, ff)

@@ -47,8 +47,14 @@ from .parameters import CONTROLLER as PARAMETERS
 #: reference periods ahead of the newest joint state
 PLAN_MARGIN = 4
 #: with the compiled path, a reference streamed at least this many periods ahead of the states
-#: (1000 times in a row) stops waking the node: the timer (every 2 ms) takes it and plans the block
+#: (1000 times in a row) stops waking the node: the timer takes the references queued since its
+#: last run and plans them at once (the rows wait in the library; a new estimate re-plans them)
 FAR_AHEAD = 3 * PLAN_MARGIN
+#: s: the timer's period while states flow (it also waits for late references on the Python path)
+TIMER_PERIOD = 0.002
+#: s: the longest timer period once references come far ahead (a third of their lead, at least
+#: :data:`TIMER_PERIOD`): the node's Python thread then wakes ~100 times a second, not 500
+BLOCK_PERIOD = 0.01
 
 
 class CdprController(PlantNode):
@@ -82,6 +88,7 @@ class CdprController(PlantNode):
         # node, which plans its row when due (:meth:`_plan`); the estimate waits for the timer)
         self._unplanned = []
         self._far_ahead = 0         # references in a row streamed far ahead of the states
+        self._in_blocks = False     # references taken by the timer, each block planned at once
         self._ref_t, self._ref_dt = None, 0.0     # the last reference's stamp, the reference period
         self._ref_sub = self.subscribe(MultiDOFJointTrajectory, topics.REFERENCE, self.on_reference, q, raw=True,
                                        polled=self._native is None)
@@ -95,7 +102,7 @@ class CdprController(PlantNode):
                                                    stream_qos(1), raw=True)
         self.player = self.play_reference(v.reference_bag, topics.REFERENCE, ("x", "y", "z"), platform=True)
         self._state_wall = -1.0     # wall time of the last state taken
-        self.timer = self.create_timer(0.002, self.on_timer)
+        self.timer = self.create_timer(TIMER_PERIOD, self.on_timer)
         self.use_fast_executor()
         if self._native is not None:
             self._start_path()          # after the placement: its thread inherits it
@@ -121,14 +128,14 @@ class CdprController(PlantNode):
         :attr:`path_problem` says why not, and this node takes the states itself)."""
         if self.controller is None or not hasattr(self, "timer"):
             return          # (again once both the description and the placement are here)
-        path = ControllerPath(self._native, self.controller, row_wait=self.v.sync_wait)
+        path = ControllerPath(self._native, self.controller, row_wait=self.v.sync_wait, keep=1024)
         problem = path.start(self, topics.JOINT_STATES, topics.EFFORT_COMMANDS, PUBLISHER_DEPTH, self._cmd.label)
         if problem is None:
             self.path = path
             self.destroy_subscription(self._state_sub)
             self._state_sub = None
             self.get_logger().info("compiled path: the joint states are answered by cablelab/csrc/controller_path.c; "
-                                   + fastspin.yield_to_compiled())
+                                   + fastspin.yield_to_compiled(idle=self.python_idle))
             return
         path.close()
         self._native, self.path_problem = None, f"compiled path failed to start ({problem})"
@@ -143,15 +150,15 @@ class CdprController(PlantNode):
         blocks; one only two periods ahead at once)."""
         if not self._unplanned:
             return
-        if when_due:
+        if when_due and not self._in_blocks:
             dt = self._ref_dt
             newest = self.path.stats()["last_taken"]
             if dt > 0 and math.isfinite(newest):
                 ahead = (self._unplanned[-1][0] - newest) / dt
                 self._far_ahead = self._far_ahead + 1 if ahead >= FAR_AHEAD else 0
-                if self._far_ahead == 1000 and self._ref_sub not in self.polled:
-                    fastspin.poll(self, self._ref_sub)
-                if self._unplanned[0][0] - newest > PLAN_MARGIN * dt:
+                if self._far_ahead == 1000:
+                    self._plan_in_blocks(ahead * dt)
+                elif self._unplanned[0][0] - newest > PLAN_MARGIN * dt:
                     return
         refs, self._unplanned = self._unplanned, []
         refs = [r for r in refs if abs(r[2][0]) == 1.0 and not r[2][1:].any()]
@@ -167,6 +174,18 @@ class CdprController(PlantNode):
             return          # (no rows: the Python path prepares those stamps and says why)
         self.path.put(plan)
 
+    def _plan_in_blocks(self, lead: float) -> None:
+        """References come ``lead`` s ahead of the states: from now on the timer takes them (they
+        no longer wake the node), every third of the lead (at most :data:`BLOCK_PERIOD`), and
+        plans each block at once."""
+        self._in_blocks = True
+        if self._ref_sub not in self.polled:
+            fastspin.poll(self, self._ref_sub)
+        period = min(BLOCK_PERIOD, max(TIMER_PERIOD, lead / 3.0))
+        self.destroy_timer(self.timer)
+        self.timer = self.create_timer(period, self.on_timer)
+        self.get_logger().info(f"references {1000 * lead:.0f} ms ahead: planned in blocks every {1000 * period:.0f} ms")
+
     def on_reference(self, msg: MultiDOFJointTrajectory) -> None:
         """A reference sample (MultiDOFJointTrajectory or its serialised bytes)."""
         r = self.decode_raw("reference", MultiDOFJointTrajectory, msg)
@@ -178,7 +197,8 @@ class CdprController(PlantNode):
                     self._ref_dt = r["t"] - self._ref_t       # the reference's period
                 self._ref_t = r["t"]
                 self._unplanned.append((r["t"], r["position"], quat, r["linear_velocity"], r["linear_acceleration"]))
-                self._plan(when_due=True)
+                if not self._in_blocks:         # (in blocks: the timer plans what it took)
+                    self._plan(when_due=True)
             self.command(self.stream.ready())
 
     def on_estimate(self, msg: InertiaStamped) -> None:

@@ -148,7 +148,7 @@ class CdprSimNode(PlantNode):
                     return
                 self.publish_state()
             c.start()
-            self.get_logger().info(f"compiled path started: {yield_to_compiled()}")
+            self.get_logger().info(f"compiled path started: {yield_to_compiled(idle=self.python_idle)}")
         c.update(self.inputs)       # (before the drain: a sample the counts know of is in the ring)
         rows = c.drain()
         for work in rows[:, 2]:
