@@ -342,7 +342,8 @@ def run_closed_loop(launch, seconds: float, params: dict, log=print, on_started=
                 v = cl.diag.get(node, {}).get("latency p99 ms")
                 if v not in (None, "?"):
                     worst[name] = max(worst[name], float(v))
-        samples.append((time.monotonic(), st, int(d.get("effort_commands received", 0)), cpu, dict(d)))
+        samples.append((time.monotonic(), st, int(d.get("effort_commands received", 0)), cpu, dict(d),
+                        dict(cl.diag.get("pd_feedforward", {}))))
     if progress is not None:
         progress.close()
     cl.close()
@@ -351,7 +352,7 @@ def run_closed_loop(launch, seconds: float, params: dict, log=print, on_started=
     if len(steady) < 2:
         log("  closed loop: not enough /diagnostics samples from the simulator")
         return None
-    (w0, s0, c0, cpu0, first), (w1, s1, c1, cpu1, last) = steady[0], steady[-1]
+    (w0, s0, c0, cpu0, first, ctl0), (w1, s1, c1, cpu1, last, ctl1) = steady[0], steady[-1]
     steps = round((s1 - s0) * 1000)
 
     def delta(key):
@@ -368,6 +369,8 @@ def run_closed_loop(launch, seconds: float, params: dict, log=print, on_started=
     out["threads"] = (_thread_deltas(threads[marks[0]], threads[marks[-1]], round((marks[-1] - marks[0]) * 1000))
                       if len(marks) > 1 else {})
     out["missed_cycles"] = delta("missed steps") + out["dropped"]   # each step counted once
+    slow = "command publishes over 0.2 ms"      # (the controller's compiled path)
+    out["slow_publishes"] = int(ctl1[slow]) - int(ctl0[slow]) if slow in ctl0 and slow in ctl1 else None
 
     def ages(d):
         return [int(x) for x in d.get("command age 1/2/3+ periods", "0/0/0").split("/")]

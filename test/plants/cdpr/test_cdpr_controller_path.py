@@ -185,6 +185,10 @@ def test_node_thread_answers_states_over_dds_and_reports_bad_ones(ros_context):
         assert stats["commanded"] == len(sent) and stats["handed_off"] == 0
         level, msg, values = ctl.status()
         assert level >= 1 and "nominal mass" in msg and values["compiled path"] == "on"
+        lat = np.array(ctl.latency.samples)     # the path's take -> published times: each includes its publish
+        assert len(lat) == len(sent) and 0.0 < stats["publish_max_ms"] <= 1000.0 * lat.max()
+        assert stats["publish_slow"] <= int((lat > 2e-4).sum())    # a slow publish is a slow answer
+        assert values["command publishes over 0.2 ms"] == str(stats["publish_slow"])
         assert values["commands"] == str(len(sent)) and values["joint_states received"] == str(len(sent))
 
         # bad states: not answered by C, handed over, rejected and reported by the Python path

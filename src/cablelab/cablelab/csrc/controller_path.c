@@ -40,6 +40,7 @@
 #define CP_HANDOFF 256 /* values of a handed-off state kept (longer ones: the length is kept) */
 #define CP_LAT 4096    /* latency samples kept until Python takes them */
 #define STAMP_TOL 1e-9
+#define SLOW_PUBLISH 2e-4 /* s: a command publish longer than this is counted (a fifth of a 1 kHz period) */
 
 enum { CP_OK = 0, CP_NO_ROW = 1, CP_BAD_STATE = 2 };
 
@@ -60,6 +61,8 @@ typedef struct {
   double h_t, h_wall, h_q[CP_HANDOFF], h_qd[CP_HANDOFF];
   /* counters (Python reads them for /diagnostics) */
   long commanded, handed_off, waited, publish_failed, taken, wakes;
+  long publish_slow;    /* rcl_publish calls that took longer than SLOW_PUBLISH */
+  double publish_max;   /* s, the longest rcl_publish */
   double last_commanded_t, last_commanded_wall, last_taken_t;
   double lat[CP_LAT];
   long nlat;
@@ -194,6 +197,7 @@ void cp_stats(cp_t *h, double *out) {
   out[0] = h->commanded; out[1] = h->handed_off; out[2] = h->waited; out[3] = h->publish_failed;
   out[4] = h->running; out[5] = h->last_commanded_t; out[6] = h->last_commanded_wall;
   out[7] = h->taken; out[8] = h->wakes; out[9] = h->last_taken_t;
+  out[10] = h->publish_slow; out[11] = h->publish_max;
   pthread_mutex_unlock(&h->mu);
 }
 
@@ -282,10 +286,13 @@ static void *run(void *arg) {
     memcpy(h->cmd.data.data, tau, sizeof(double) * h->n);
     snprintf(label, sizeof label, "%s stamp=%.9f", h->label, t);
     rosidl_runtime_c__String__assign(&h->cmd.layout.dim.data[0].label, label);
+    double sent_at = now_s();
     int ok = rcl_publish(&h->pub, &h->cmd, NULL) == RCL_RET_OK;
     if (!ok) rcl_reset_error();
     double done_at = now_s();
     pthread_mutex_lock(&h->mu);
+    if (done_at - sent_at > SLOW_PUBLISH) h->publish_slow++;
+    if (done_at - sent_at > h->publish_max) h->publish_max = done_at - sent_at;
     if (ok) {
       h->commanded++;
       h->last_commanded_t = t;

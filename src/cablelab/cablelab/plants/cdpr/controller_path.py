@@ -76,7 +76,7 @@ class ControllerPath:
             raise ValueError(f"controller_path: cannot hold {self.n} winches")
         self.recent: ReferencePlan | None = None     # the rows put lately: re-planned by a new estimate
         self.keep = keep
-        self._stats = np.zeros(10)
+        self._stats = np.zeros(12)
         self._lat = np.zeros(4096)
         self._q, self._qd = np.zeros(MAX_HANDOFF), np.zeros(MAX_HANDOFF)
         self._t, self._wall = np.zeros(1), np.zeros(1)
@@ -169,12 +169,15 @@ class ControllerPath:
         """Counts of the thread: ``commanded``, ``handed_off``, ``waited`` (for a row),
         ``publish_failed``, ``running`` (1, 0 stopped, -1 failed), ``last_stamp`` and
         ``last_wall`` of the last command (NaN before), ``taken`` (states), ``wakes`` (of the
-        thread), ``last_taken`` (stamp of the last state taken, NaN before)."""
+        thread), ``last_taken`` (stamp of the last state taken, NaN before), ``publish_slow``
+        (command publishes that took over 0.2 ms: the thread held up inside DDS),
+        ``publish_max_ms`` (the longest)."""
         self.lib.cp_stats(self.h, _ptr(self._stats))
         s = self._stats
         return {"commanded": int(s[0]), "handed_off": int(s[1]), "waited": int(s[2]), "publish_failed": int(s[3]),
                 "running": int(s[4]), "last_stamp": float(s[5]), "last_wall": float(s[6]), "taken": int(s[7]),
-                "wakes": int(s[8]), "last_taken": float(s[9])}
+                "wakes": int(s[8]), "last_taken": float(s[9]), "publish_slow": int(s[10]),
+                "publish_max_ms": 1000.0 * float(s[11])}
 
     def latencies(self) -> np.ndarray:
         """Take -> published times (s) of the commands since the last call."""

@@ -286,7 +286,9 @@ class CdprController(PlantNode):
         if self.path is not None:
             values.update({"compiled path": "on", "commands from the compiled path": str(path),
                            "states handed to Python": str(self._path_seen["handed_off"]),
-                           "states waiting for their row": str(self._path_seen["waited"])})
+                           "states waiting for their row": str(self._path_seen["waited"]),
+                           "command publishes over 0.2 ms": str(self._path_seen["publish_slow"]),
+                           "slowest command publish ms": f"{self._path_seen['publish_max_ms']:.3f}"})
         else:
             values["compiled path"] = "off" + (f" ({self.path_problem})" if self.path_problem else "")
         return level, msg, values
