@@ -352,7 +352,7 @@ def run_closed_loop(launch, seconds: float, params: dict, log=print, on_started=
     if len(steady) < 2:
         log("  closed loop: not enough /diagnostics samples from the simulator")
         return None
-    (w0, s0, c0, cpu0, first, ctl0), (w1, s1, c1, cpu1, last, ctl1) = steady[0], steady[-1]
+    (w0, s0, c0, cpu0, first, _), (w1, s1, c1, cpu1, last, _) = steady[0], steady[-1]
     steps = round((s1 - s0) * 1000)
 
     def delta(key):
@@ -369,8 +369,11 @@ def run_closed_loop(launch, seconds: float, params: dict, log=print, on_started=
     out["threads"] = (_thread_deltas(threads[marks[0]], threads[marks[-1]], round((marks[-1] - marks[0]) * 1000))
                       if len(marks) > 1 else {})
     out["missed_cycles"] = delta("missed steps") + out["dropped"]   # each step counted once
-    slow = "command publishes over 0.2 ms"      # (the controller's compiled path)
-    out["slow_publishes"] = int(ctl1[slow]) - int(ctl0[slow]) if slow in ctl0 and slow in ctl1 else None
+    # the controller's compiled path, from its first report that has the count (its report from
+    # before the path started may be the newest at the first steady reading)
+    slow = "command publishes over 0.2 ms"
+    counts = [int(s[5][slow]) for s in steady if slow in s[5]]
+    out["slow_publishes"] = counts[-1] - counts[0] if len(counts) > 1 else None
 
     def ages(d):
         return [int(x) for x in d.get("command age 1/2/3+ periods", "0/0/0").split("/")]
