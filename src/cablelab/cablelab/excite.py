@@ -788,6 +788,41 @@ def read_reference(path, topic: str, joints: Sequence[str]):
     return fn
 
 
+def excite_commands(ranking, plant: str, source: str, held=()) -> list[str]:
+    """For every confounded pair of a ranking (``identifiability.confounded``) and the parameters
+    the recording left unexcited (``held``, and candidates' ``held``), the exact
+    ``cablelab excite`` command that designs the experiment separating them (one line each);
+    a plant without experiment design gets one line saying so."""
+    import shlex
+
+    groups: list[tuple[str, ...]] = []
+    for c in ranking:
+        for r in (c.identifiability or {}).get("confounded", []):
+            pair = tuple(sorted((r["param"], r["with"])))
+            if pair not in groups:
+                groups.append(pair)
+        if c.held:
+            g = tuple(c.held)
+            if g not in groups:
+                groups.append(g)
+    if held and tuple(held) not in groups:
+        groups.append(tuple(held))
+    if not groups:
+        return []
+    try:
+        get_exciter(plant)
+    except CablelabError as exc:
+        return [f"to separate {', '.join(' and '.join(g) for g in groups)}: {exc}"]
+    bag = shlex.quote(str(source)) if source else "BAG"
+    return [f"to separate {' and '.join(g)}: cablelab excite {bag} --params "
+            f"{shlex.quote(','.join(g))} --duration 60 -o excite_{'_'.join(_slug(x) for x in g)}"
+            for g in groups]
+
+
+def _slug(name: str) -> str:
+    return "".join(ch if ch.isalnum() else "_" for ch in name).strip("_")
+
+
 __all__ = ["Design", "Exciter", "LINEARISED", "Limits", "Linearised", "block_conditions", "block_terms",
-           "condition", "design", "detectable_delay", "stacked_dataset", "fourier_basis", "fourier_motion", "get_exciter", "lead_in", "linear_values",
+           "condition", "design", "detectable_delay", "excite_commands", "stacked_dataset", "fourier_basis", "fourier_motion", "get_exciter", "lead_in", "linear_values",
            "model_for", "noise_of", "read_reference", "register_exciter", "scaled_motion", "write_reference"]

@@ -45,7 +45,7 @@ def run(args) -> int:
                         where=f"model {' + '.join(step.effects) or 'nominal'}")
     if args.out:
         write_overlay_out(args, plant, ds, greedy_stages(ds, out.greedy))
-    from ..diagnose.result import excite_commands
+    from ..excite import excite_commands
 
     doc = with_warnings(args, out.to_json())
     doc["excite"] = excite_commands(out.ranking, out.plant, args.bag, tuple(out.held))

@@ -175,42 +175,4 @@ def ambiguity_lines(ranking) -> list[str]:
     return out
 
 
-def excite_commands(ranking, plant: str, source: str, held=()) -> list[str]:
-    """For every confounded pair of a ranking (``identifiability.confounded``) and the parameters
-    the recording left unexcited (``held``, and candidates' ``held``), the exact
-    ``cablelab excite`` command that designs the experiment separating them (one line each);
-    a plant without experiment design gets one line saying so."""
-    import shlex
-
-    groups: list[tuple[str, ...]] = []
-    for c in ranking:
-        for r in (c.identifiability or {}).get("confounded", []):
-            pair = tuple(sorted((r["param"], r["with"])))
-            if pair not in groups:
-                groups.append(pair)
-        if c.held:
-            g = tuple(c.held)
-            if g not in groups:
-                groups.append(g)
-    if held and tuple(held) not in groups:
-        groups.append(tuple(held))
-    if not groups:
-        return []
-    from ..errors import CablelabError
-    from ..excite import get_exciter
-
-    try:
-        get_exciter(plant)
-    except CablelabError as exc:
-        return [f"to separate {', '.join(' and '.join(g) for g in groups)}: {exc}"]
-    bag = shlex.quote(str(source)) if source else "BAG"
-    return [f"to separate {' and '.join(g)}: cablelab excite {bag} --params "
-            f"{shlex.quote(','.join(g))} --duration 60 -o excite_{'_'.join(_slug(x) for x in g)}"
-            for g in groups]
-
-
-def _slug(name: str) -> str:
-    return "".join(ch if ch.isalnum() else "_" for ch in name).strip("_")
-
-
-__all__ = ["Candidate", "Diagnosis", "Step", "ambiguity_lines", "excite_commands"]
+__all__ = ["Candidate", "Diagnosis", "Step", "ambiguity_lines"]

@@ -105,7 +105,8 @@ def build_report(ds: Dataset, diagnosis: Diagnosis, out_dir, *, title: str = "",
     # the answer first: what is missing (waterfall, ranking), then the fitted model, then evidence
     parts.append(answer_section(steps))
     parts.append(ranking_section(steps, alpha=alpha, min_gain=min_gain))
-    from ..diagnose.result import ambiguity_lines, excite_commands
+    from ..diagnose.result import ambiguity_lines
+    from ..excite import excite_commands
 
     parts.extend(f"<p class='warnings'>{html.escape(line)}</p>"
                  for line in ambiguity_lines(steps[0].ranking)
