@@ -157,7 +157,8 @@ def run_floor(exe: Path, mjb: Path, state: Path, seconds: float, listener: bool,
             "missed_cycles": sim["missed_cycles"], "late": sim["late"], "stale": sim["stale"],
             "dropped": sim["dropped"], "p99_ms": {"sim": sim["p99_ms"], "controller": ctrl["p99_ms"]},
             "cpu_per_step_ms": {"sim": sim["cpu_per_step_ms"], "controller": ctrl["cpu_per_answer_ms"]},
-            "listener": listener, "pinned": pin, "rt_priority": rt > 0, "threads": threads}
+            "listener": listener, "pinned": pin, "rt_priority": rt > 0, "threads": threads,
+            "slow_publishes": ctrl.get("slow_publishes")}
 
 
 def _sample_threads(pids: dict, first: float, last: float) -> dict:

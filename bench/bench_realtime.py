@@ -300,6 +300,8 @@ def main(argv=None) -> int:
                           unit=f"of {int(round(f['bare_timer']['seconds'] * 1000))}", target=""),
                      dict(case="floor: C rcl simulator/controller pair 1 kHz", value=f["c_rcl_pair_missed"],
                           unit=f"of {int(round(f['c_rcl_pair']['seconds'] * 1000))}", target="")]
+            rows.append(dict(case="floor: C rcl pair's controller: command publishes over 0.2 ms",
+                             value=f["c_rcl_pair"].get("slow_publishes", "-"), unit="", target=""))
             rows += _thread_rows("C pair ", f["c_rcl_pair"].get("threads", {}))
     if "control_loop" in out:
         c = out["control_loop"]

@@ -327,7 +327,7 @@ static int run_ctrl(const char *state_topic, const char *command_topic) {
   double *lat = malloc(sizeof(double) * cap);
   double last_state = -1.0, cpu0 = cpu_s(), u0[N] = {0};
   int have_u0 = 0;
-  long answered = 0;
+  long answered = 0, slow_publishes = 0;
   while (!stop_requested) {
     CHECK(rcl_wait_set_clear(&ws));
     CHECK(rcl_wait_set_add_subscription(&ws, &sub, NULL));
@@ -352,15 +352,17 @@ static int run_ctrl(const char *state_topic, const char *command_topic) {
     char label[64];
     snprintf(label, sizeof label, "winches stamp=%.9f", stamp_of(&js.header.stamp));
     rosidl_runtime_c__String__assign(&cmd.layout.dim.data[0].label, label);
+    double t_pub = now_s();
     CHECK(rcl_publish(&pub, &cmd, NULL));
+    if (now_s() - t_pub > 2e-4) slow_publishes++;   /* held up inside DDS (cablelab's controller_path counts the same) */
     answered++;
     last_state = now_s();
     if (nlat < cap) lat[nlat++] = 1e3 * (last_state - t_in);
   }
   double p99_all, p99 = worst_window_p99(lat, nlat, 1000, &p99_all);
   printf("{\"node\": \"controller\", \"answers\": %ld, \"p99_ms\": %.4f, \"p99_all_ms\": %.4f, "
-         "\"cpu_per_answer_ms\": %.4f}\n",
-         answered, p99, p99_all, answered ? 1e3 * (cpu_s() - cpu0) / answered : 0.0);
+         "\"cpu_per_answer_ms\": %.4f, \"slow_publishes\": %ld}\n",
+         answered, p99, p99_all, answered ? 1e3 * (cpu_s() - cpu0) / answered : 0.0, slow_publishes);
   fflush(stdout);
   (void)!rcl_wait_set_fini(&ws);
   (void)!rcl_subscription_fini(&sub, &r.node);
