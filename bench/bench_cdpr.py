@@ -310,7 +310,7 @@ def run_closed_loop(launch, seconds: float, params: dict, log=print, on_started=
     load0 = _load()
     t0 = time.monotonic()
     samples = []        # (wall, sim time, commands received by the sim, {name: cpu s}, sim status)
-    threads = {}        # sim time -> {node: _threads}: at the first steady sample and every later one
+    threads = []        # [(sim time, {node: _threads})] at the first and the latest steady sample
     worst = dict.fromkeys(names, 0.0)
     last_stamp = None
     progress = None
@@ -335,7 +335,7 @@ def run_closed_loop(launch, seconds: float, params: dict, log=print, on_started=
             progress.update(min(st, progress.total) - progress.n)
         if st >= 1.0:
             try:
-                threads[st] = {name: _threads(pid) for name, pid in pids.items()}
+                threads[1 if threads else 0:] = [(st, {name: _threads(pid) for name, pid in pids.items()})]
             except OSError:
                 pass
             for name, node in names.items():
@@ -365,9 +365,8 @@ def run_closed_loop(launch, seconds: float, params: dict, log=print, on_started=
            "cpu_ms": {k: 1000 * (cpu1[k] - cpu0[k]) / max(steps, 1) for k in pids},
            "p99_ms": worst, "load": (load0, _load()),
            "brakes_total": int(last.get("brake steps after the first command", "-1"))}
-    marks = sorted(threads)
-    out["threads"] = (_thread_deltas(threads[marks[0]], threads[marks[-1]], round((marks[-1] - marks[0]) * 1000))
-                      if len(marks) > 1 else {})
+    out["threads"] = (_thread_deltas(threads[0][1], threads[1][1], round((threads[1][0] - threads[0][0]) * 1000))
+                      if len(threads) > 1 else {})
     out["missed_cycles"] = delta("missed steps") + out["dropped"]   # each step counted once
     # the controller's compiled path, from its first report that has the count (its report from
     # before the path started may be the newest at the first steady reading)
