@@ -143,7 +143,18 @@ def test_node_thread_answers_states_over_dds_and_reports_bad_ones(ros_context):
         for k in range(len(tt)):
             ctl.on_reference(convert.multidof_msg(tt[k], tr.position[k], [0, 0, 0, 1.0], tr.velocity[k], None,
                                                   tr.acceleration[k], None))
+        q0 = np.full(8, -4000.0)
+        before = ctl.path.law(tt[0], q0, np.zeros(8))[1]
+        replans = []
+        replan = ctl.path.replan
+        ctl.path.replan = lambda: replans.append(1) or replan()
+        ctl.on_estimate(convert.inertia_msg(tt[0], 500.0, [0.0, 0.0, 0.0]))
         ctl.on_estimate(convert.inertia_msg(tt[0], 600.0, [0.05, -0.02, 0.0]))
+        np.testing.assert_array_equal(ctl.path.law(tt[0], q0, np.zeros(8))[1], before)   # not yet
+        ctl.on_timer()          # the rows re-planned once, with the newest of the estimates
+        assert len(replans) == 1
+        ctl.on_timer()
+        assert len(replans) == 1        # (no estimate since)
         oracle.estimate(tt[0], 600.0, np.array([0.05, -0.02]))
         plan = oracle.plan(tt, tr.position, tr.velocity, tr.acceleration)
         deadline = time.monotonic() + 30

@@ -148,15 +148,17 @@ class CommandStream:
     def reference(self, t: float, position, quat_wxyz, velocity, acceleration) -> None:
         self.refs.push(t, (position, quat_wxyz, velocity, acceleration))
 
-    def estimate(self, t: float, mass: float | None, com) -> None:
-        """An estimate of stamp ``t`` (``mass`` None: the message was rejected)."""
+    def estimate(self, t: float, mass: float | None, com, prepare: bool = True) -> None:
+        """An estimate of stamp ``t`` (``mass`` None: the message was rejected). The terms
+        prepared with the previous mass are prepared anew now, off the state -> command path, or
+        (``prepare`` False: the states are answered elsewhere, as by the compiled path) dropped,
+        to be prepared when a state needs them."""
         self.est_stamp = t if self.est_stamp is None else max(self.est_stamp, t)
         if mass is None or self.controller is None:
             return
         if self.controller.estimate(t, mass, com[:2]):
-            # prepared with the previous mass: prepared anew now, off the state -> command path
             old, self.prepared = self.prepared, None
-            ref = None if old is None else self.refs.at(old.t)
+            ref = None if old is None or not prepare else self.refs.at(old.t)
             if ref is not None:
                 self._prepare(ref)
         else:

@@ -12,7 +12,8 @@ Matching samples by stamp: :class:`cablelab.plants.cdpr.streams.CommandStream`.
 
 Compiled path (parameter ``compiled_path``, on unless ``CABLELAB_NATIVE=0`` or no compiler): the
 references are planned as they come, or in blocks when they come far ahead (:meth:`LiveController.
-plan <cablelab.plants.cdpr.live.LiveController.plan>`; a new estimate re-plans the rows not used),
+plan <cablelab.plants.cdpr.live.LiveController.plan>`; the timer re-plans the rows not used with the
+newest estimate, once for all the estimates since its last run),
 and put in
 :class:`~cablelab.plants.cdpr.controller_path.ControllerPath`, whose C thread answers the joint
 states with the same law without Python; a state it cannot answer (bad, or no planned row of its
@@ -87,6 +88,7 @@ class CdprController(PlantNode):
         # (with the compiled path the C thread takes the states and each reference wakes this
         # node, which plans its row when due (:meth:`_plan`); the estimate waits for the timer)
         self._unplanned = []
+        self._replan_due = False    # an estimate came since the rows were last (re-)planned
         self._far_ahead = 0         # references in a row streamed far ahead of the states
         self._in_blocks = False     # references taken by the timer, each block planned at once
         self._ref_t, self._ref_dt = None, 0.0     # the last reference's stamp, the reference period
@@ -202,10 +204,14 @@ class CdprController(PlantNode):
             self.command(self.stream.ready())
 
     def on_estimate(self, msg: InertiaStamped) -> None:
+        """An estimate. With the compiled path, the rows not used yet are planned again with it
+        once per timer run (:meth:`on_timer`), after every estimate queued since the last run was
+        taken: one re-plan for a burst of estimates, not one each."""
         t, m, com = convert.inertia_arrays(msg)
-        self.stream.estimate(t, m if self.accept("payload_estimate", [m]) else None, com)
+        self.stream.estimate(t, m if self.accept("payload_estimate", [m]) else None, com,
+                             prepare=self.path is None)
         if self.path is not None:
-            self.path.replan()      # the rows not used yet, with the new estimate
+            self._replan_due = True
         self.command(self.stream.ready())     # a state may have been waiting for this estimate
 
     def on_state(self, msg: JointState) -> None:
@@ -239,6 +245,9 @@ class CdprController(PlantNode):
         takes the queued inputs and the timer only runs a due /diagnostics."""
         if self.path is not None:
             self.take_polled()
+            if self._replan_due:
+                self._replan_due = False
+                self.path.replan()      # the rows not used yet, with the newest estimate
             self._plan(when_due=True)
             self._from_path()
         now = time.monotonic()
