@@ -121,6 +121,38 @@ def test_fast_executor_delivers_every_message_in_order(ros_context):
     node.destroy_node()
 
 
+def test_a_timer_destroyed_by_an_earlier_callback_of_the_same_wake_up_is_skipped(ros_context):
+    """Two timers due in one wake-up, the first destroying the second and creating a new one (as
+    pd_feedforward does to change its period): the wake-up ends without error, the destroyed
+    timer's callback does not run and the new timer runs on the next wake-ups."""
+    from rclpy.node import Node
+
+    from cablelab.ros.fastspin import FastExecutor
+
+    node = Node("timer_swap_test", start_parameter_services=False)
+    ran = []
+    timers = {}
+
+    def first():
+        ran.append("first")
+        if "second" in timers:
+            node.destroy_timer(timers.pop("second"))
+            timers["new"] = node.create_timer(0.001, lambda: ran.append("new"))
+
+    timers["first"] = node.create_timer(0.001, first)
+    timers["second"] = node.create_timer(0.001, lambda: ran.append("second"))
+    ex = FastExecutor()
+    ex.add_node(node)
+    time.sleep(0.01)                    # both due
+    ex.spin_once(1.0)
+    assert ran == ["first"]
+    deadline = time.monotonic() + 5
+    while "new" not in ran and time.monotonic() < deadline:
+        ex.spin_once(0.1)
+    assert "new" in ran and "second" not in ran
+    node.destroy_node()
+
+
 def test_polled_subscription_wakes_nobody_and_drains_in_step(ros_context):
     """A polled subscription stays out of the wait set (its samples do not end a wait) and
     :func:`drain` takes every queued sample, two streams interleaved in publishing order."""

@@ -35,6 +35,8 @@ from __future__ import annotations
 
 from contextlib import ExitStack
 
+from rclpy.exceptions import InvalidHandle
+
 __all__ = ["FastExecutor", "supports", "set_realtime_priority", "set_cpu_affinity", "set_background",
            "set_latency_slice", "set_idle_class", "yield_to_compiled", "poll", "polled", "drain", "take_newest", "defer", "deferred",
            "run_deferred"]
@@ -241,11 +243,15 @@ def run_deferred(timers, limit: int | None = None) -> int:
 
 def _call_if_due(timer, handle) -> bool:
     """Call ``timer`` (rclpy Timer, ``handle`` its C handle) if it is due: its next call is
-    scheduled, then its callback runs; True if it ran."""
-    with handle:
-        if not handle.is_timer_ready():
-            return False
-        handle.call_timer()
+    scheduled, then its callback runs; True if it ran. A timer an earlier callback of the same
+    wake-up destroyed (e.g. to replace it with one of another period) is not due."""
+    try:
+        with handle:
+            if not handle.is_timer_ready():
+                return False
+            handle.call_timer()
+    except InvalidHandle:
+        return False
     timer.callback()
     return True
 
