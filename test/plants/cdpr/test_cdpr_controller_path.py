@@ -49,11 +49,12 @@ def test_compiled_law_equals_planned_law_and_prepare_law(seed, t0, mass, com, es
     path = ControllerPath(_lib(), ctl)
     try:
         tt, tr = _reference(t0, 40)
-        if mass is not None:
-            for c in (ctl, oracle):
-                c.estimate(t0 - est_age, mass, np.array(com))
         plan = ctl.plan(tt, tr.position, tr.velocity, tr.acceleration)
         assert path.put(plan) == len(tt)
+        if mass is not None:        # (after the rows were put: an estimate changes no row)
+            for c in (ctl, oracle):
+                c.estimate(t0 - est_age, mass, np.array(com))
+            path.estimate()
         rng = np.random.default_rng(seed)
         n = len(DESC.cdpr.cables)
         for i in range(0, len(tt), 3):
@@ -70,7 +71,7 @@ def test_compiled_law_equals_planned_law_and_prepare_law(seed, t0, mass, com, es
         path.close()
 
 
-def test_bad_states_and_missing_rows_are_not_answered_and_a_new_estimate_replans():
+def test_bad_states_and_missing_rows_are_not_answered_and_a_new_estimate_weighs_every_row():
     ctl, oracle = _controllers()
     path = ControllerPath(_lib(), ctl)
     try:
@@ -95,15 +96,24 @@ def test_bad_states_and_missing_rows_are_not_answered_and_a_new_estimate_replans
         inf.pd[2, 0], inf.friction[5, 1] = np.nan, np.inf
         assert path.put(inf) == len(tt) - 2
         assert path.law(tt[2] + 2.0, q, qd)[0] == NO_ROW and path.law(tt[5] + 2.0, q, qd)[0] == NO_ROW
-        # a new estimate re-plans the rows not answered yet
+        # a new estimate weighs the feedforward of the rows put before it, without putting them again
         q = plan.pd[6] / ctl.config.gains.kp        # on the reference: no saturation
         before = path.law(tt[6], q, qd)[1]
+        np.testing.assert_allclose(before, oracle.planned_law(plan, 6, q.copy(), qd.copy()), rtol=1e-13, atol=1e-12)
         for c in (ctl, oracle):
             c.estimate(tt[0], 700.0, np.array([0.1, -0.05]))
-        assert path.replan() == len(tt) + (len(tt) - 1) + (len(tt) - 2)     # nothing answered yet
+        np.testing.assert_array_equal(path.law(tt[6], q, qd)[1], before)     # not told yet
+        path.estimate()
         after = path.law(tt[6], q, qd)[1]
         assert np.abs(after - before).max() > 1e-3
         np.testing.assert_allclose(after, oracle.planned_law(plan, 6, q.copy(), qd.copy()), rtol=1e-13, atol=1e-12)
+        # (the nominal mass once the estimate is older than estimate_timeout at the row's stamp)
+        late = ctl.plan(tt + 10.0, tr.position, tr.velocity, tr.acceleration)
+        assert path.put(late) == len(tt)
+        assert oracle.status[-1][0] == 0
+        np.testing.assert_allclose(path.law(tt[6] + 10.0, q, qd)[1], oracle.planned_law(late, 6, q.copy(), qd.copy()),
+                                   rtol=1e-13, atol=1e-12)
+        assert "nominal mass" in oracle.status[-1][1]
     finally:
         path.close()
 
@@ -143,18 +153,7 @@ def test_node_thread_answers_states_over_dds_and_reports_bad_ones(ros_context):
         for k in range(len(tt)):
             ctl.on_reference(convert.multidof_msg(tt[k], tr.position[k], [0, 0, 0, 1.0], tr.velocity[k], None,
                                                   tr.acceleration[k], None))
-        q0 = np.full(8, -4000.0)
-        before = ctl.path.law(tt[0], q0, np.zeros(8))[1]
-        replans = []
-        replan = ctl.path.replan
-        ctl.path.replan = lambda: replans.append(1) or replan()
-        ctl.on_estimate(convert.inertia_msg(tt[0], 500.0, [0.0, 0.0, 0.0]))
         ctl.on_estimate(convert.inertia_msg(tt[0], 600.0, [0.05, -0.02, 0.0]))
-        np.testing.assert_array_equal(ctl.path.law(tt[0], q0, np.zeros(8))[1], before)   # not yet
-        ctl.on_timer()          # the rows re-planned once, with the newest of the estimates
-        assert len(replans) == 1
-        ctl.on_timer()
-        assert len(replans) == 1        # (no estimate since)
         oracle.estimate(tt[0], 600.0, np.array([0.05, -0.02]))
         plan = oracle.plan(tt, tr.position, tr.velocity, tr.acceleration)
         deadline = time.monotonic() + 30

@@ -1,16 +1,19 @@
 /* The pd_feedforward node's compiled state -> command path (cablelab.plants.cdpr.controller_path
  * loads it with ctypes; the Python law stays the oracle and the fallback).
  *
- * Python plans the law's reference terms ahead (LiveController.plan and planned_terms: per stamp
- * the PD part pd = kp q_d + kd q_d', the feedforward torques of the live estimate and the
- * friction compensation) and puts them here as rows keyed by stamp. A thread waits on the joint
- * states (a keep-last-1 subscription of the node's own rcl node, so one DDS participant per
- * process), takes the newest, finds the row of its stamp and publishes what LiveController.planned_law gives, with the same operations in the same
- * order (so the same doubles):
- *     tau = pd - kp q;  tau -= kd q';  tau += ff;  tau = max(tau, floor);  tau += friction;
- *     tau = min(max(tau, -max_torque), max_torque)
- * as a Float64MultiArray labelled "<label> stamp=<t>" (the state it answers). No physics here:
- * only that arithmetic on planned rows.
+ * Python plans the law's reference terms ahead (LiveController.plan: per stamp the PD part
+ * pd = kp q_d + kd q_d', the four feedforward tension terms b_0..b_3 of 001 eq. 14 and the
+ * friction compensation) and puts them here as rows keyed by stamp; each estimate sets the weights
+ * c = (1, m, m x_G, m y_G) of the live estimate and its stamp (LiveController.estimate_weights),
+ * so a new estimate changes no row. A thread waits on the joint states (a keep-last-1
+ * subscription of the node's own rcl node, so one DDS participant per process), takes the newest,
+ * finds the row of its stamp and publishes what LiveController.planned_law gives, with the same
+ * operations in the same order (the same doubles up to the order of the four-term sum):
+ *     c = the live weights if t - t_est <= estimate_timeout, else (1, m_nominal, 0, 0)
+ *     ff = k max(c . b, t_min);  tau = pd - kp q;  tau -= kd q';  tau += ff;
+ *     tau = max(tau, k t_min);  tau += friction;  tau = min(max(tau, -max_torque), max_torque)
+ * (k = r/R) as a Float64MultiArray labelled "<label> stamp=<t>" (the state it answers). No physics
+ * here: only that arithmetic on planned rows.
  *
  * A state this path cannot answer goes to Python whole (cp_handoff, the newest one kept): a bad
  * state (NaN, inf, wrong length: Python's checks report it on /diagnostics) or a stamp without a
@@ -46,12 +49,13 @@ enum { CP_OK = 0, CP_NO_ROW = 1, CP_BAD_STATE = 2 };
 
 typedef struct {
   double t;
-  double pd[CP_MAXN], ff[CP_MAXN], fric[CP_MAXN];
+  double pd[CP_MAXN], ff[4][CP_MAXN], fric[CP_MAXN];
 } Row;
 
 typedef struct {
   int n, has_ff;
-  double kp, kd, floor_, max_torque, row_wait;
+  double kp, kd, k, t_min, max_torque, row_wait, estimate_timeout;
+  double est_t, est_c[4], nominal_c[4]; /* the live estimate's stamp (NaN: none) and weights */
   pthread_mutex_t mu;
   pthread_cond_t rows_put;
   Row *rows;
@@ -80,14 +84,19 @@ typedef struct {
   std_msgs__msg__Float64MultiArray cmd;
 } cp_t;
 
-cp_t *cp_create(int n, int has_ff, double kp, double kd, double floor_, double max_torque, double row_wait) {
+/* n winches, PDFF (has_ff) or PD, gains kp kd, k = r/R (m), minimum tension t_min (N), torque
+ * limit (N m), row_wait (s), the nominal mass (kg) and how long an estimate stays fresh (s) */
+cp_t *cp_create(int n, int has_ff, double kp, double kd, double k, double t_min, double max_torque, double row_wait,
+                double nominal_mass, double estimate_timeout) {
   if (n <= 0 || n > CP_MAXN) return NULL;
   cp_t *h = calloc(1, sizeof(cp_t));
   if (!h) return NULL;
   h->rows = calloc(CP_ROWS, sizeof(Row));
   if (!h->rows) { free(h); return NULL; }
-  h->n = n; h->has_ff = has_ff; h->kp = kp; h->kd = kd; h->floor_ = floor_;
-  h->max_torque = max_torque; h->row_wait = row_wait;
+  h->n = n; h->has_ff = has_ff; h->kp = kp; h->kd = kd; h->k = k; h->t_min = t_min;
+  h->max_torque = max_torque; h->row_wait = row_wait; h->estimate_timeout = estimate_timeout;
+  h->est_t = NAN;
+  h->nominal_c[0] = 1.0; h->nominal_c[1] = nominal_mass;
   h->last_commanded_t = NAN; h->last_commanded_wall = NAN; h->last_taken_t = NAN;
   pthread_mutex_init(&h->mu, NULL);
   pthread_condattr_t ca;
@@ -111,8 +120,8 @@ static const Row *find_row(const cp_t *h, double t) {
 
 static double newest_row_t(const cp_t *h) { return h->nrows ? h->rows[(h->nrows - 1) % CP_ROWS].t : -INFINITY; }
 
-/* Put `count` rows (stamps t (count,), pd, ff (NULL for PD), fric (count, n) row-major): a stamp
- * already kept is replaced (a re-plan with a new estimate), a newer one appended; an older stamp
+/* Put `count` rows (stamps t (count,), pd and fric (count, n), ff (count, 4, n) the tension terms
+ * (NULL for PD), row-major): a stamp already kept is replaced, a newer one appended; an older stamp
  * that is not kept is ignored. Returns how many were kept. */
 int cp_put_rows(cp_t *h, int count, const double *t, const double *pd, const double *ff, const double *fric) {
   int n = h->n, kept = 0;
@@ -128,8 +137,10 @@ int cp_put_rows(cp_t *h, int count, const double *t, const double *pd, const dou
     }
     r->t = t[k];
     memcpy(r->pd, pd + (size_t)k * n, sizeof(double) * n);
-    if (ff) memcpy(r->ff, ff + (size_t)k * n, sizeof(double) * n);
-    else memset(r->ff, 0, sizeof(double) * n);
+    for (int i = 0; i < 4; i++) {
+      if (ff) memcpy(r->ff[i], ff + ((size_t)k * 4 + i) * n, sizeof(double) * n);
+      else memset(r->ff[i], 0, sizeof(double) * n);
+    }
     memcpy(r->fric, fric + (size_t)k * n, sizeof(double) * n);
     kept++;
   }
@@ -145,15 +156,31 @@ static int good_state(const cp_t *h, double t, const double *q, int nq, const do
   return 1;
 }
 
+/* The live estimate: its stamp t_est and weights c = (1, m, m x_G, m y_G). A row of a stamp more
+ * than estimate_timeout after t_est (or t_est NaN: no estimate) takes the nominal mass's
+ * (1, m_nominal, 0, 0). */
+void cp_set_estimate(cp_t *h, double t_est, double c0, double c1, double c2, double c3) {
+  pthread_mutex_lock(&h->mu);
+  h->est_t = t_est;
+  h->est_c[0] = c0; h->est_c[1] = c1; h->est_c[2] = c2; h->est_c[3] = c3;
+  pthread_mutex_unlock(&h->mu);
+}
+
 /* mutex held */
 static int law_locked(const cp_t *h, double t, const double *q, const double *qd, double *out) {
   const Row *r = find_row(h, t);
   if (!r) return CP_NO_ROW;
+  const double *c = isfinite(h->est_t) && t - h->est_t <= h->estimate_timeout ? h->est_c : h->nominal_c;
+  double floor_ = h->k * h->t_min;
   for (int j = 0; j < h->n; j++) {
     double tau = r->pd[j] - h->kp * q[j];
     tau -= h->kd * qd[j];
-    if (h->has_ff) tau += r->ff[j];
-    tau = tau > h->floor_ ? tau : h->floor_;
+    if (h->has_ff) {
+      double ff = c[0] * r->ff[0][j] + c[1] * r->ff[1][j] + c[2] * r->ff[2][j] + c[3] * r->ff[3][j];
+      ff = ff > h->t_min ? ff : h->t_min;
+      tau += ff * h->k;
+    }
+    tau = tau > floor_ ? tau : floor_;
     tau += r->fric[j];
     tau = tau > -h->max_torque ? tau : -h->max_torque;
     out[j] = tau < h->max_torque ? tau : h->max_torque;

@@ -2,10 +2,10 @@
 through :mod:`ctypes`, built by :mod:`cablelab.native`).
 
 Python plans the reference terms of each stamp (:meth:`LiveController.plan
-<cablelab.plants.cdpr.live.LiveController.plan>`) and the feedforward of the present estimate
-(:meth:`~cablelab.plants.cdpr.live.LiveController.planned_terms`) as soon as the reference comes,
-and puts them in the library as rows keyed by stamp; a new estimate re-plans the rows not used
-yet. A C thread (subscribing and publishing through the node's own rcl node) takes each joint state,
+<cablelab.plants.cdpr.live.LiveController.plan>`: the PD part, the four feedforward tension rows,
+the friction compensation) as soon as the reference comes and puts them in the library as rows
+keyed by stamp; each estimate gives the library its weights (:meth:`~cablelab.plants.cdpr.live.
+LiveController.estimate_weights`), so it changes no row. A C thread (subscribing and publishing through the node's own rcl node) takes each joint state,
 finds the row of its stamp and publishes :meth:`~cablelab.plants.cdpr.live.LiveController.
 planned_law`'s torques, the same doubles, without Python. A state it cannot answer (bad values,
 no row of its stamp) is handed to Python (:meth:`ControllerPath.handoff`), whose checks and law
@@ -34,7 +34,8 @@ def _bind(lib) -> None:
     if getattr(lib, "_cablelab_bound", False):
         return
     P, I, D = ctypes.c_void_p, ctypes.c_int, ctypes.c_double
-    lib.cp_create.restype, lib.cp_create.argtypes = P, [I, I, D, D, D, D, D]
+    lib.cp_create.restype, lib.cp_create.argtypes = P, [I, I, D, D, D, D, D, D, D, D]
+    lib.cp_set_estimate.restype, lib.cp_set_estimate.argtypes = None, [P, D, D, D, D, D]
     lib.cp_destroy.restype, lib.cp_destroy.argtypes = None, [P]
     lib.cp_put_rows.restype, lib.cp_put_rows.argtypes = I, [P, I, _D, _D, _D, _D]
     lib.cp_law.restype, lib.cp_law.argtypes = I, [P, D, _D, I, _D, I, _D]
@@ -59,23 +60,21 @@ class ControllerPath:
 
     Args:
         lib: the loaded library (:func:`load`).
-        controller: the law whose plan and estimate the rows carry.
+        controller: the law whose plan the rows carry and whose estimate (:meth:`estimate`) weighs
+            their feedforward.
         row_wait: s a state newer than every row waits for its row before it goes to Python.
-        keep: rows remembered for re-planning when an estimate comes.
     """
 
-    def __init__(self, lib, controller: LiveController, row_wait: float = 0.005, keep: int = 64):
+    def __init__(self, lib, controller: LiveController, row_wait: float = 0.005):
         _bind(lib)
         self.lib, self.controller = lib, controller
         cfg, g, d = controller.config, controller.config.gains, controller.desc
         self.n = len(d.cables)
-        k = d.drum_radius / d.gear_ratio
-        self.h = lib.cp_create(self.n, int(cfg.feedforward), g.kp, g.kd, k * g.min_tension, g.max_torque,
-                               float(row_wait))
+        self.h = lib.cp_create(self.n, int(cfg.feedforward), g.kp, g.kd, d.drum_radius / d.gear_ratio, g.min_tension,
+                               g.max_torque, float(row_wait), cfg.nominal_mass, cfg.estimate_timeout)
         if not self.h:
             raise ValueError(f"controller_path: cannot hold {self.n} winches")
-        self.recent: ReferencePlan | None = None     # the rows put lately: re-planned by a new estimate
-        self.keep = keep
+        self.estimate()
         self._stats = np.zeros(12)
         self._lat = np.zeros(4096)
         self._q, self._qd = np.zeros(MAX_HANDOFF), np.zeros(MAX_HANDOFF)
@@ -91,50 +90,28 @@ class ControllerPath:
         return None if lib is None else cls(lib, controller, row_wait)
 
     # ------------------------------------------------------------------ rows
-    def put(self, plan: ReferencePlan, rows=None, remember: bool = True) -> int:
-        """Put the valid ``rows`` (default all) of ``plan`` with the present estimate (a row
-        with a term that is not finite is left out: its states go to the Python path); returns
-        how many the library kept (an older stamp it no longer holds is not)."""
+    def put(self, plan: ReferencePlan, rows=None) -> int:
+        """Put the valid ``rows`` (default all) of ``plan`` (a row with a term that is not finite
+        is left out: its states go to the Python path); returns how many the library kept (an
+        older stamp it no longer holds is not)."""
         idx = np.flatnonzero(plan.valid) if rows is None else np.asarray(rows)[plan.valid[rows]]
+        finite = np.isfinite(plan.pd[idx]).all(1) & np.isfinite(plan.friction[idx]).all(1)
+        if plan.ff is not None:
+            finite &= np.isfinite(plan.ff[idx]).all((1, 2))
+        idx = idx[finite]           # (a reference far outside the workspace: the Python path says why)
         if idx.size == 0:
             return 0
-        pd, ff, fric, _ = self.controller.planned_terms(plan, idx)
-        finite = np.isfinite(pd).all(1) & np.isfinite(fric).all(1)
-        if ff is not None:
-            finite &= np.isfinite(ff).all(1)
-        if not finite.all():        # (a reference far outside the workspace: the Python path says why)
-            idx, pd, fric, ff = idx[finite], pd[finite], fric[finite], None if ff is None else ff[finite]
-            if idx.size == 0:
-                return 0
         t = np.ascontiguousarray(plan.t[idx], float)
-        pd, fric = np.ascontiguousarray(pd), np.ascontiguousarray(fric)
-        ff = None if ff is None else np.ascontiguousarray(ff)
-        kept = self.lib.cp_put_rows(self.h, len(t), _ptr(t), _ptr(pd), None if ff is None else _ptr(ff), _ptr(fric))
-        if remember:
-            self._remember(plan, idx)
-        return kept
+        pd, fric = np.ascontiguousarray(plan.pd[idx], float), np.ascontiguousarray(plan.friction[idx], float)
+        ff = None if plan.ff is None else np.ascontiguousarray(plan.ff[idx], float)
+        return self.lib.cp_put_rows(self.h, len(t), _ptr(t), _ptr(pd), None if ff is None else _ptr(ff), _ptr(fric))
 
-    def _remember(self, plan: ReferencePlan, idx: np.ndarray) -> None:
-        """Keep the newest :attr:`keep` rows put and not answered yet, as one plan, for
-        :meth:`replan`."""
-        r = self.recent
-        parts = [(plan.t[idx], plan.pd[idx], plan.friction[idx], None if plan.ff is None else plan.ff[idx])]
-        if r is not None:
-            last = self.stats()["last_stamp"]
-            todo = slice(None) if not np.isfinite(last) else r.t > last
-            parts.insert(0, (r.t[todo], r.pd[todo], r.friction[todo], None if r.ff is None else r.ff[todo]))
-        t, pd, fric = (np.concatenate([p[k] for p in parts])[-self.keep:] for k in range(3))
-        ff = None if plan.ff is None else np.concatenate([p[3] for p in parts])[-self.keep:]
-        self.recent = ReferencePlan(t, (None, None, None), np.ones(len(t), bool), pd, fric, ff)
-
-    def replan(self) -> int:
-        """Put again, with the present estimate, the remembered rows not answered yet."""
-        r = self.recent
-        if r is None:
-            return 0
-        last = self.stats()["last_stamp"]
-        todo = np.arange(len(r.t)) if not np.isfinite(last) else np.flatnonzero(r.t > last)
-        return self.put(r, todo, remember=False) if todo.size else 0
+    def estimate(self) -> None:
+        """Give the library the controller's present estimate (:meth:`LiveController.estimate_weights
+        <cablelab.plants.cdpr.live.LiveController.estimate_weights>`): every row answered from now
+        on weighs its feedforward with it."""
+        t_est, c = self.controller.estimate_weights()
+        self.lib.cp_set_estimate(self.h, t_est, *map(float, c))
 
     # ------------------------------------------------------------------ the law
     def law(self, t: float, q, qdot) -> tuple[int, np.ndarray | None]:

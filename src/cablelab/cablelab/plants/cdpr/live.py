@@ -457,28 +457,17 @@ class LiveController:
             ff[:, 3] = np.einsum("tij,tj->ti", M[..., 3:], np.stack([f[:, 2], zero, -f[:, 0]], 1))
         return ReferencePlan(t, reference, valid, pd, friction, ff)
 
-    def planned_terms(self, plan: ReferencePlan, rows=slice(None)):
-        """The state-free terms of :meth:`planned_law` for ``rows`` of ``plan`` with the present
-        estimate, vectorised: ``(pd, ff, friction, fresh)`` with ``pd`` and ``friction`` the
-        plan's (N, n) rows, ``ff`` (N, n) the feedforward torques ``k max(coef . ff, t_min)``
-        (k = r/R, coef = (1, m, m c_x, m c_y) of the live estimate where it is fresh at the row's
-        stamp, of the nominal mass elsewhere; None for PD) and ``fresh`` (N,) where the estimate
-        was used. :meth:`planned_law` is then, per row and motor state,
-        ``clip(max(pd - kp q - kd q' + ff, k t_min) + friction, +-max_torque)``: the compiled
-        path (:mod:`.controller_path`) applies exactly that to the rows it is given."""
-        cfg, g = self.config, self.config.gains
-        t = np.atleast_1d(plan.t[rows])
-        pd, friction = plan.pd[rows].reshape(len(t), -1), plan.friction[rows].reshape(len(t), -1)
-        if plan.ff is None:
-            return pd, None, friction, np.ones(len(t), bool)
-        fresh = (t - self._t_est <= cfg.estimate_timeout) if self._t_est is not None else np.zeros(len(t), bool)
-        m, com = (self.mass, self.com) if self.mass is not None else (cfg.nominal_mass, np.zeros(2))
-        cx, cy = (com[0], com[1]) if cfg.use_com else (0.0, 0.0)
-        coef = np.where(fresh[:, None], [1.0, m, m * cx, m * cy], [1.0, cfg.nominal_mass, 0.0, 0.0])
-        ff = np.einsum("tj,tjn->tn", coef, plan.ff[rows].reshape(len(t), 4, -1))
-        np.maximum(ff, g.min_tension, out=ff)
-        ff *= self.desc.drum_radius / self.desc.gear_ratio
-        return pd, ff, friction, fresh
+    def estimate_weights(self) -> tuple[float, np.ndarray]:
+        """``(t_est, c)``: the stamp of the live estimate (NaN before one) and the weights
+        ``c = (1, m, m c_x, m c_y)`` (c = 0 without ``use_com``) of the four feedforward tension
+        rows of a :class:`ReferencePlan`: :meth:`planned_law` uses ``c`` for a row of stamp t
+        when ``t - t_est <= estimate_timeout``, else the nominal mass's ``(1, m_nominal, 0, 0)``;
+        the compiled path (:mod:`.controller_path`) is given these and does the same."""
+        if self.mass is None or self._t_est is None:
+            return float("nan"), np.array([1.0, self.config.nominal_mass, 0.0, 0.0])
+        m = self.mass
+        cx, cy = (self.com[0], self.com[1]) if self.config.use_com else (0.0, 0.0)
+        return float(self._t_est), np.array([1.0, m, m * cx, m * cy])
 
     def planned_status(self, t: float) -> list:
         """The :attr:`status` :meth:`planned_law` leaves after a valid row of stamp ``t`` and a

@@ -12,9 +12,8 @@ Matching samples by stamp: :class:`cablelab.plants.cdpr.streams.CommandStream`.
 
 Compiled path (parameter ``compiled_path``, on unless ``CABLELAB_NATIVE=0`` or no compiler): the
 references are planned as they come, or in blocks when they come far ahead (:meth:`LiveController.
-plan <cablelab.plants.cdpr.live.LiveController.plan>`; the timer re-plans the rows not used with the
-newest estimate, once for all the estimates since its last run),
-and put in
+plan <cablelab.plants.cdpr.live.LiveController.plan>`; each estimate sets the weights of their
+feedforward terms, no re-planning), and put in
 :class:`~cablelab.plants.cdpr.controller_path.ControllerPath`, whose C thread answers the joint
 states with the same law without Python; a state it cannot answer (bad, or no planned row of its
 stamp) comes back here and takes the Python path below, which checks and reports it.
@@ -49,13 +48,14 @@ from .parameters import CONTROLLER as PARAMETERS
 PLAN_MARGIN = 4
 #: with the compiled path, a reference streamed at least this many periods ahead of the states
 #: (1000 times in a row) stops waking the node: the timer takes the references queued since its
-#: last run and plans them at once (the rows wait in the library; a new estimate re-plans them)
+#: last run and plans them at once (the rows wait in the library; an estimate weighs their feedforward)
 FAR_AHEAD = 3 * PLAN_MARGIN
 #: s: the timer's period while states flow (it also waits for late references on the Python path)
 TIMER_PERIOD = 0.002
 #: s: the longest timer period once references come far ahead (a third of their lead, at least
-#: :data:`TIMER_PERIOD`): the node's Python thread then wakes ~100 times a second, not 500
-BLOCK_PERIOD = 0.01
+#: :data:`TIMER_PERIOD`): with the simulator's 50 ms lead the node's Python thread then wakes 60
+#: times a second, not 500
+BLOCK_PERIOD = 0.02
 
 
 class CdprController(PlantNode):
@@ -88,7 +88,6 @@ class CdprController(PlantNode):
         # (with the compiled path the C thread takes the states and each reference wakes this
         # node, which plans its row when due (:meth:`_plan`); the estimate waits for the timer)
         self._unplanned = []
-        self._replan_due = False    # an estimate came since the rows were last (re-)planned
         self._far_ahead = 0         # references in a row streamed far ahead of the states
         self._in_blocks = False     # references taken by the timer, each block planned at once
         self._ref_t, self._ref_dt = None, 0.0     # the last reference's stamp, the reference period
@@ -130,7 +129,7 @@ class CdprController(PlantNode):
         :attr:`path_problem` says why not, and this node takes the states itself)."""
         if self.controller is None or not hasattr(self, "timer"):
             return          # (again once both the description and the placement are here)
-        path = ControllerPath(self._native, self.controller, row_wait=self.v.sync_wait, keep=1024)
+        path = ControllerPath(self._native, self.controller, row_wait=self.v.sync_wait)
         problem = path.start(self, topics.JOINT_STATES, topics.EFFORT_COMMANDS, PUBLISHER_DEPTH, self._cmd.label)
         if problem is None:
             self.path = path
@@ -204,14 +203,13 @@ class CdprController(PlantNode):
             self.command(self.stream.ready())
 
     def on_estimate(self, msg: InertiaStamped) -> None:
-        """An estimate. With the compiled path, the rows not used yet are planned again with it
-        once per timer run (:meth:`on_timer`), after every estimate queued since the last run was
-        taken: one re-plan for a burst of estimates, not one each."""
+        """An estimate: with the compiled path, its weights go to the library at once (every row
+        answered from then on uses them)."""
         t, m, com = convert.inertia_arrays(msg)
         self.stream.estimate(t, m if self.accept("payload_estimate", [m]) else None, com,
                              prepare=self.path is None)
         if self.path is not None:
-            self._replan_due = True
+            self.path.estimate()
         self.command(self.stream.ready())     # a state may have been waiting for this estimate
 
     def on_state(self, msg: JointState) -> None:
@@ -245,9 +243,6 @@ class CdprController(PlantNode):
         takes the queued inputs and the timer only runs a due /diagnostics."""
         if self.path is not None:
             self.take_polled()
-            if self._replan_due:
-                self._replan_due = False
-                self.path.replan()      # the rows not used yet, with the newest estimate
             self._plan(when_due=True)
             self._from_path()
         now = time.monotonic()
