@@ -35,7 +35,8 @@ SOURCES = Path(__file__).resolve().parent / "csrc"
 ROS_LIBS = ("rcl", "rmw", "rcutils", "rosidl_runtime_c",
             "sensor_msgs__rosidl_typesupport_c", "sensor_msgs__rosidl_generator_c",
             "std_msgs__rosidl_typesupport_c", "std_msgs__rosidl_generator_c",
-            "builtin_interfaces__rosidl_generator_c")
+            "trajectory_msgs__rosidl_typesupport_c", "trajectory_msgs__rosidl_generator_c",
+            "geometry_msgs__rosidl_generator_c", "builtin_interfaces__rosidl_generator_c")
 
 _loaded: dict[str, ctypes.CDLL | None] = {}
 _reasons: dict[str, str] = {}

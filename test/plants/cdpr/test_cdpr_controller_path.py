@@ -225,6 +225,75 @@ def test_node_thread_answers_states_over_dds_and_reports_bad_ones(ros_context):
         peer.destroy_node()
 
 
+def test_references_far_ahead_go_to_the_thread_without_a_gap_or_a_repeat(ros_context):
+    """References streamed far ahead of the states: after 1000 of them the node plans in blocks
+    and its compiled path's thread takes the references too; once the thread's samples overlap
+    the node's own subscription's, that subscription goes. Every reference is taken exactly once
+    (counted, queued, planned), and the rows of those only the thread took answer with the
+    oracle's torques."""
+    import rclpy
+    from rclpy.node import Node
+    from sensor_msgs.msg import JointState
+    from trajectory_msgs.msg import MultiDOFJointTrajectory
+
+    from cablelab.plants.cdpr.nodes.controller import CdprController
+    from cablelab.plants.cdpr import topics
+    from cablelab.ros import convert
+    from cablelab.ros.qos import stream_qos
+
+    _lib()
+    ctl = CdprController()
+    peer = Node("ref_peer")
+    pub_js = peer.create_publisher(JointState, topics.JOINT_STATES, stream_qos(10))
+    pub_ref = peer.create_publisher(MultiDOFJointTrajectory, topics.REFERENCE, stream_qos(1000))
+    winches = [f"winch_{i}" for i in range(1, 9)]
+    tt, tr = _reference(3.0, 2000)
+
+    def ref(k):
+        return convert.multidof_msg(tt[k], tr.position[k], [0, 0, 0, 1.0], tr.velocity[k], None,
+                                    tr.acceleration[k], None)
+
+    def wait(cond, what, timeout=30.0):
+        end = time.monotonic() + timeout
+        while not cond():
+            assert time.monotonic() < end, what
+            rclpy.spin_once(peer, timeout_sec=0.01)
+            ctl.on_timer()
+
+    try:
+        ctl.on_description(convert.string_msg(DESC.to_yaml()))
+        assert ctl.path is not None, ctl.path_problem
+        wait(lambda: pub_js.get_subscription_count() >= 1, "the thread's state subscription")
+        pub_js.publish(convert.joint_state_msg(tt[0], winches, np.full(8, -4000.0), np.zeros(8), np.zeros(8)))
+        wait(lambda: ctl.path.stats()["last_taken"] == tt[0], "the thread taking a state")
+        for k in range(50, 1100):               # 50 periods ahead of the state, through the callback
+            ctl.on_reference(ref(k))
+        assert ctl._in_blocks and ctl._follow and ctl._handover
+        wait(lambda: pub_ref.get_subscription_count() >= 2, "the thread's reference subscription")
+        for k in range(1100, 1200):             # both subscriptions get these: the node's goes
+            pub_ref.publish(ref(k))
+        wait(lambda: not ctl._handover, "the overlap of the two subscriptions")
+        assert ctl._ref_sub is None and pub_ref.get_subscription_count() >= 1
+        for k in range(1200, 2000):             # only the thread gets these
+            pub_ref.publish(ref(k))
+        wait(lambda: ctl._ref_t == tt[-1], "every reference taken")
+        st = ctl.inputs.inputs["reference"]
+        assert (st.received, st.rejected) == (2000 - 50, 0)
+        assert ctl.path.stats()["references"] >= 800 and ctl.path.stats()["references_lost"] == 0
+        assert ctl.stream.refs.newest == tt[-1]
+        oracle = LiveController(DESC.cdpr, DESC.gravity, ctl.controller.config)
+        plan = oracle.plan(tt, tr.position, tr.velocity, tr.acceleration)
+        rng = np.random.default_rng(4)
+        for k in range(1200, 2000, 7):
+            q, qd = rng.normal(-4000, 30, 8), rng.normal(0, 3, 8)
+            rc, tau = ctl.path.law(tt[k], q, qd)
+            assert rc == OK, k
+            np.testing.assert_allclose(tau, oracle.planned_law(plan, k, q.copy(), qd.copy()), rtol=1e-13, atol=1e-12)
+    finally:
+        ctl.destroy_node()
+        peer.destroy_node()
+
+
 @pytest.mark.parametrize("compiled", [True, False])
 def test_three_processes_answer_the_simulator_and_survive_the_estimator(launcher, diagnostics_seen, compiled):
     """cable_sim_node (real time) + payload_estimator + pd_feedforward as processes, with the
@@ -254,7 +323,7 @@ def test_three_processes_answer_the_simulator_and_survive_the_estimator(launcher
 
     spin_until(lambda: "pd_feedforward" in seen and "payload_estimator" in seen, 120, "the nodes' diagnostics")
     launcher.node("sim", "cable_sim_node", "cdpr", {"rate": 250.0, "real_time": True, "payload_mass": 249.0,
-                                                    "duration": 600.0, "settle": 1.0})
+                                                    "duration": 600.0, "settle": 1.0, "reference_lead": 0.1})
 
     def ctl():
         return diag("pd_feedforward")[2]
@@ -269,6 +338,11 @@ def test_three_processes_answer_the_simulator_and_survive_the_estimator(launcher
     assert ctl()["compiled path"] == ("on" if compiled else "off")
     if compiled:
         spin_until(lambda: int(ctl().get("commands from the compiled path", "0")) > 200, 60, "compiled commands")
+        # the simulator streams the reference 100 ms (25 periods) ahead: after 1000 of them (4 s)
+        # the node plans them in blocks and its thread takes them
+        spin_until(lambda: int(ctl().get("references taken by the compiled path", "0")) > 250, 60,
+                   "references taken by the compiled path's thread")
+        assert ctl()["reference rejected"] == "0" and "references lost by the compiled path" not in ctl()
     launcher.kill("estimator")
     killed = time.monotonic()
     spin_until(lambda: diag("pd_feedforward")[0] == 1 and "nominal mass" in diag("pd_feedforward")[1]

@@ -15,6 +15,12 @@
  * (k = r/R) as a Float64MultiArray labelled "<label> stamp=<t>" (the state it answers). No physics
  * here: only that arithmetic on planned rows.
  *
+ * References (cp_follow_references, once they come far ahead of the states): the thread also takes
+ * the reference samples, after each command and when its wait times out, and keeps each one's
+ * stamp, position, orientation, velocity and acceleration (first point, first joint, as
+ * cablelab.ros.convert.multidof_arrays reads them) in a ring that Python reads in blocks
+ * (cp_references) to plan their rows: no Python wake-up, take or decode per sample.
+ *
  * A state this path cannot answer goes to Python whole (cp_handoff, the newest one kept): a bad
  * state (NaN, inf, wrong length: Python's checks report it on /diagnostics) or a stamp without a
  * row (the reference of that stamp not planned: Python commands or holds as it does without this
@@ -36,6 +42,7 @@
 #include <sensor_msgs/msg/joint_state.h>
 #include <std_msgs/msg/float64_multi_array.h>
 #include <std_msgs/msg/multi_array_dimension.h>
+#include <trajectory_msgs/msg/multi_dof_joint_trajectory.h>
 #include "rt_common.h"
 
 #define CP_MAXN 64     /* winches */
@@ -43,6 +50,8 @@
 #define CP_HANDOFF 256 /* values of a handed-off state kept (longer ones: the length is kept) */
 #define CP_LAT 4096    /* latency samples kept until Python takes them */
 #define STAMP_TOL 1e-9
+#define CP_REFS 2048   /* reference samples kept until Python reads them (2 s at 1 kHz) */
+#define CP_REF_COLS 15 /* t, has position, position (3), quaternion x y z w, velocity (3), acceleration (3) */
 #define SLOW_PUBLISH 2e-4 /* s: a command publish longer than this is counted (a fifth of a 1 kHz period) */
 
 enum { CP_OK = 0, CP_NO_ROW = 1, CP_BAD_STATE = 2 };
@@ -70,6 +79,10 @@ typedef struct {
   double last_commanded_t, last_commanded_wall, last_taken_t;
   double lat[CP_LAT];
   long nlat;
+  /* reference samples taken by the thread (cp_follow_references), read by Python */
+  int refs_on;
+  double refs[CP_REFS][CP_REF_COLS];
+  long nrefs, refs_read, refs_lost;
   /* the thread and its rcl entities (on the caller's node) */
   pthread_t thread;
   int running;
@@ -77,11 +90,12 @@ typedef struct {
   char label[64], error[256];
   rcl_node_t *node;
   rcl_context_t *context;
-  rcl_subscription_t sub;
+  rcl_subscription_t sub, ref_sub;
   rcl_publisher_t pub;
   rcl_wait_set_t ws;
   sensor_msgs__msg__JointState js;
   std_msgs__msg__Float64MultiArray cmd;
+  trajectory_msgs__msg__MultiDOFJointTrajectory traj;
 } cp_t;
 
 /* n winches, PDFF (has_ff) or PD, gains kp kd, k = r/R (m), minimum tension t_min (N), torque
@@ -216,15 +230,16 @@ int cp_handoff(cp_t *h, double *t, double *wall, double *q, int *nq, double *qd,
   return ready;
 }
 
-/* out[0..9]: commanded, handed off, waited for a row, publish failures, running (1/0, -1 failed),
+/* out[0..13]: commanded, handed off, waited for a row, publish failures, running (1/0, -1 failed),
  * stamp and wall time of the last command, states taken, wake-ups of the thread, stamp of the
- * last state taken */
+ * last state taken, command publishes over SLOW_PUBLISH, the longest publish (s), reference samples
+ * taken, reference samples lost (not read by Python before the ring wrapped) */
 void cp_stats(cp_t *h, double *out) {
   pthread_mutex_lock(&h->mu);
   out[0] = h->commanded; out[1] = h->handed_off; out[2] = h->waited; out[3] = h->publish_failed;
   out[4] = h->running; out[5] = h->last_commanded_t; out[6] = h->last_commanded_wall;
   out[7] = h->taken; out[8] = h->wakes; out[9] = h->last_taken_t;
-  out[10] = h->publish_slow; out[11] = h->publish_max;
+  out[10] = h->publish_slow; out[11] = h->publish_max; out[12] = h->nrefs; out[13] = h->refs_lost;
   pthread_mutex_unlock(&h->mu);
 }
 
@@ -250,6 +265,59 @@ const char *cp_error(cp_t *h) { return h->error; }
     }                                                                        \
   } while (0)
 
+/* The reference samples queued on ref_sub (once cp_follow_references turned it on), into the ring. */
+static void take_references(cp_t *h) {
+  pthread_mutex_lock(&h->mu);
+  int on = h->refs_on;
+  pthread_mutex_unlock(&h->mu);
+  if (!on) return;
+  rmw_message_info_t info;
+  while (rcl_take(&h->ref_sub, &h->traj, &info, NULL) == RCL_RET_OK) {
+    const trajectory_msgs__msg__MultiDOFJointTrajectory *m = &h->traj;
+    double row[CP_REF_COLS];
+    for (int i = 0; i < CP_REF_COLS; i++) row[i] = NAN;
+    row[0] = m->header.stamp.sec + m->header.stamp.nanosec * 1e-9;
+    row[1] = 0.0;
+    if (m->points.size > 0 && m->points.data[0].transforms.size > 0) {
+      const trajectory_msgs__msg__MultiDOFJointTrajectoryPoint *pt = &m->points.data[0];
+      const geometry_msgs__msg__Transform *tf = &pt->transforms.data[0];
+      row[1] = 1.0;
+      row[2] = tf->translation.x; row[3] = tf->translation.y; row[4] = tf->translation.z;
+      row[5] = tf->rotation.x; row[6] = tf->rotation.y; row[7] = tf->rotation.z; row[8] = tf->rotation.w;
+      if (pt->velocities.size > 0) {
+        row[9] = pt->velocities.data[0].linear.x; row[10] = pt->velocities.data[0].linear.y;
+        row[11] = pt->velocities.data[0].linear.z;
+      }
+      if (pt->accelerations.size > 0) {
+        row[12] = pt->accelerations.data[0].linear.x; row[13] = pt->accelerations.data[0].linear.y;
+        row[14] = pt->accelerations.data[0].linear.z;
+      }
+    }
+    pthread_mutex_lock(&h->mu);
+    if (h->nrefs - h->refs_read >= CP_REFS) {     /* Python fell 2 s behind: the oldest unread is lost */
+      h->refs_read++;
+      h->refs_lost++;
+    }
+    memcpy(h->refs[h->nrefs % CP_REFS], row, sizeof row);
+    h->nrefs++;
+    pthread_mutex_unlock(&h->mu);
+  }
+  rcl_reset_error();
+}
+
+/* The reference samples taken since the last call, oldest first, at most cap rows of
+ * CP_REF_COLS doubles (t, has position (1/0), position x y z, quaternion x y z w, linear velocity,
+ * linear acceleration; NaN where the message has none); returns how many. */
+int cp_references(cp_t *h, double *out, int cap) {
+  pthread_mutex_lock(&h->mu);
+  long n = h->nrefs - h->refs_read;
+  if (n > cap) n = cap;
+  for (long i = 0; i < n; i++) memcpy(out + i * CP_REF_COLS, h->refs[(h->refs_read + i) % CP_REFS], sizeof(double) * CP_REF_COLS);
+  h->refs_read += n;
+  pthread_mutex_unlock(&h->mu);
+  return (int)n;
+}
+
 static void *run(void *arg) {
   cp_t *h = arg;
   double tau[CP_MAXN];
@@ -259,9 +327,12 @@ static void *run(void *arg) {
       rcl_reset_error();
       break;
     }
-    rcl_ret_t rc = rcl_wait(&h->ws, RCL_MS_TO_NS(50));
+    rcl_ret_t rc = rcl_wait(&h->ws, RCL_MS_TO_NS(20));
     h->wakes++;
-    if (rc == RCL_RET_TIMEOUT) continue;
+    if (rc == RCL_RET_TIMEOUT) {
+      take_references(h);
+      continue;
+    }
     if (rc != RCL_RET_OK) {
       rcl_reset_error();
       if (!rcl_context_is_valid(h->context)) break; /* rclpy shut down: nothing more will come */
@@ -329,6 +400,7 @@ static void *run(void *arg) {
       h->publish_failed++;
     }
     pthread_mutex_unlock(&h->mu);
+    take_references(h);     /* after the command: off the state -> command path */
   }
   return NULL;
 }
@@ -337,10 +409,13 @@ static void entities_fini(cp_t *h) {
   if (!h->node) return;
   (void)!rcl_wait_set_fini(&h->ws);
   (void)!rcl_subscription_fini(&h->sub, h->node);
+  if (h->refs_on) (void)!rcl_subscription_fini(&h->ref_sub, h->node);
+  h->refs_on = 0;
   (void)!rcl_publisher_fini(&h->pub, h->node);
   rcl_reset_error();
   sensor_msgs__msg__JointState__fini(&h->js);
   std_msgs__msg__Float64MultiArray__fini(&h->cmd);
+  trajectory_msgs__msg__MultiDOFJointTrajectory__fini(&h->traj);
   h->node = NULL;
 }
 
@@ -361,6 +436,7 @@ int cp_start(cp_t *h, void *node, void *context, const char *state_topic, const 
   h->ws = rcl_get_zero_initialized_wait_set();
   sensor_msgs__msg__JointState__init(&h->js);
   std_msgs__msg__Float64MultiArray__init(&h->cmd);
+  trajectory_msgs__msg__MultiDOFJointTrajectory__init(&h->traj);
   std_msgs__msg__MultiArrayDimension__Sequence__init(&h->cmd.layout.dim, 1);
   h->cmd.layout.dim.data[0].size = h->n;
   h->cmd.layout.dim.data[0].stride = h->n;
@@ -387,6 +463,47 @@ int cp_start(cp_t *h, void *node, void *context, const char *state_topic, const 
 fail:
   entities_fini(h);
   return -1;
+}
+
+/* From now on the thread also takes the reference samples of topic (reliable, volatile, keep-last
+ * depth) into the ring cp_references reads: the subscription is made here, in the calling thread,
+ * on the node the thread runs on. Returns 0 (also when already on), or -1 (cp_error says why). */
+int cp_follow_references(cp_t *h, const char *topic, int depth) {
+  if (!h->thread) {
+    snprintf(h->error, sizeof h->error, "the thread is not running");
+    return -1;
+  }
+  pthread_mutex_lock(&h->mu);
+  int on = h->refs_on;
+  pthread_mutex_unlock(&h->mu);
+  if (on) return 0;
+  h->ref_sub = rcl_get_zero_initialized_subscription();
+  rcl_subscription_options_t so = rcl_subscription_get_default_options();
+  so.qos = qos((size_t)depth, 0);
+  if (rcl_subscription_init(&h->ref_sub, h->node,
+                            ROSIDL_GET_MSG_TYPE_SUPPORT(trajectory_msgs, msg, MultiDOFJointTrajectory), topic,
+                            &so) != RCL_RET_OK) {
+    snprintf(h->error, sizeof h->error, "subscribing to the references: %s", rcl_get_error_string().str);
+    rcl_reset_error();
+    return -1;
+  }
+  pthread_mutex_lock(&h->mu);
+  h->refs_on = 1;
+  pthread_mutex_unlock(&h->mu);
+  return 0;
+}
+
+/* Whether the thread's reference subscription is matched with a publisher (-1: not following). */
+int cp_reference_publishers(cp_t *h) {
+  pthread_mutex_lock(&h->mu);
+  int on = h->refs_on;
+  pthread_mutex_unlock(&h->mu);
+  size_t n = 0;
+  if (!on || rcl_subscription_get_publisher_count(&h->ref_sub, &n) != RCL_RET_OK) {
+    rcl_reset_error();
+    return -1;
+  }
+  return (int)n;
 }
 
 void cp_stop(cp_t *h) {

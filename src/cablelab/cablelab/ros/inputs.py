@@ -63,6 +63,32 @@ class InputMonitor:
         st.last_time = now
         return True
 
+    def accept_rows(self, name: str, rows, now: float, present=None) -> np.ndarray:
+        """:meth:`accept` of k messages at once: ``rows`` (k, m) their values, ``present`` (k,)
+        False where a message had none ("empty"). Returns the (k,) mask of the usable ones and
+        leaves the counts, time and last problem as k calls of :meth:`accept` in row order would."""
+        st = self.inputs[name]
+        rows = np.asarray(rows, dtype=float)
+        if len(rows) == 0:
+            return np.zeros(0, bool)
+        rows = rows.reshape(len(rows), -1)
+        k, m = rows.shape
+        empty = np.ones(k, bool) if m == 0 else ~np.asarray(True if present is None else present, bool)
+        empty = np.broadcast_to(empty, (k,))
+        wrong = ~empty & (st.length is not None and m != st.length)
+        bad = ~empty & ~wrong & ~np.isfinite(rows).all(1)
+        ok = ~(empty | wrong | bad)
+        n_ok = int(ok.sum())
+        if n_ok < k:
+            j = int(np.flatnonzero(~ok)[-1])
+            st.last_problem = ("empty" if empty[j] else f"wrong length {m}, expected {st.length}" if wrong[j]
+                               else "NaN or infinite value")
+            st.rejected += k - n_ok
+        if n_ok:
+            st.received += n_ok
+            st.last_time = now
+        return ok
+
     def age(self, name: str, now: float) -> float:
         """Seconds since the last good message (inf if none yet)."""
         st = self.inputs[name]

@@ -9,7 +9,9 @@ LiveController.estimate_weights`), so it changes no row. A C thread (subscribing
 finds the row of its stamp and publishes :meth:`~cablelab.plants.cdpr.live.LiveController.
 planned_law`'s torques, the same doubles, without Python. A state it cannot answer (bad values,
 no row of its stamp) is handed to Python (:meth:`ControllerPath.handoff`), whose checks and law
-decide and report as without this path. ROS-free apart from the thread the library runs.
+decide and report as without this path. Once the references come far ahead of the states
+(:meth:`ControllerPath.follow_references`) the thread also takes them, after each command, and
+Python reads them in blocks (:meth:`ControllerPath.references`) to plan their rows. ROS-free apart from the thread the library runs.
 """
 from __future__ import annotations
 
@@ -26,6 +28,8 @@ __all__ = ["ControllerPath", "LIBRARY"]
 LIBRARY = "controller_path"
 MAX_HANDOFF = 256          # values of a handed-off state read back (the library keeps as many)
 OK, NO_ROW, BAD_STATE = 0, 1, 2
+REF_COLUMNS = 15           # t, has position, position (3), quaternion x y z w, velocity (3), acceleration (3)
+MAX_REFERENCES = 2048      # rows the library keeps until they are read
 
 _D = ctypes.c_void_p       # float64 arrays, passed by address (ndarray.ctypes.data)
 
@@ -47,6 +51,8 @@ def _bind(lib) -> None:
     lib.cp_start.argtypes = [P, P, P, ctypes.c_char_p, ctypes.c_char_p, I, ctypes.c_char_p]
     lib.cp_stop.restype, lib.cp_stop.argtypes = None, [P]
     lib.cp_error.restype, lib.cp_error.argtypes = ctypes.c_char_p, [P]
+    lib.cp_follow_references.restype, lib.cp_follow_references.argtypes = I, [P, ctypes.c_char_p, I]
+    lib.cp_references.restype, lib.cp_references.argtypes = I, [P, _D, I]
     lib._cablelab_bound = True
 
 
@@ -75,7 +81,8 @@ class ControllerPath:
         if not self.h:
             raise ValueError(f"controller_path: cannot hold {self.n} winches")
         self.estimate()
-        self._stats = np.zeros(12)
+        self._stats = np.zeros(14)
+        self._refs = np.zeros((MAX_REFERENCES, REF_COLUMNS))
         self._lat = np.zeros(4096)
         self._q, self._qd = np.zeros(MAX_HANDOFF), np.zeros(MAX_HANDOFF)
         self._t, self._wall = np.zeros(1), np.zeros(1)
@@ -132,6 +139,20 @@ class ControllerPath:
                                command_topic.encode(), int(depth), label.encode())
         return None if rc == 0 else (self.lib.cp_error(self.h) or b"").decode() or "failed"
 
+    def follow_references(self, topic: str, depth: int) -> str | None:
+        """From now on the thread also takes the reference samples of ``topic`` (keep-last
+        ``depth``) for :meth:`references`; None, or why not."""
+        rc = self.lib.cp_follow_references(self.h, topic.encode(), int(depth))
+        return None if rc == 0 else (self.lib.cp_error(self.h) or b"").decode() or "failed"
+
+    def references(self) -> np.ndarray:
+        """The reference samples the thread took since the last call, oldest first: (k,
+        :data:`REF_COLUMNS`) rows ``t, has position (1/0), position (3), quaternion x y z w,
+        linear velocity (3), linear acceleration (3)`` of the first point's first joint (NaN where
+        the message has none), as :func:`cablelab.ros.convert.multidof_arrays` reads them."""
+        k = self.lib.cp_references(self.h, _ptr(self._refs), MAX_REFERENCES)
+        return self._refs[:k].copy()
+
     def handoff(self):
         """The newest state the thread left to Python since the last call: ``(t, wall, q, qdot)``
         (``wall``: time.monotonic() when it came; arrays of the lengths received, at most
@@ -148,13 +169,16 @@ class ControllerPath:
         ``last_wall`` of the last command (NaN before), ``taken`` (states), ``wakes`` (of the
         thread), ``last_taken`` (stamp of the last state taken, NaN before), ``publish_slow``
         (command publishes that took over 0.2 ms: the thread held up inside DDS),
-        ``publish_max_ms`` (the longest)."""
+        ``publish_max_ms`` (the longest), ``references`` (samples the thread took),
+        ``references_lost`` (taken but not read by :meth:`references` before the library's ring
+        wrapped)."""
         self.lib.cp_stats(self.h, _ptr(self._stats))
         s = self._stats
         return {"commanded": int(s[0]), "handed_off": int(s[1]), "waited": int(s[2]), "publish_failed": int(s[3]),
                 "running": int(s[4]), "last_stamp": float(s[5]), "last_wall": float(s[6]), "taken": int(s[7]),
                 "wakes": int(s[8]), "last_taken": float(s[9]), "publish_slow": int(s[10]),
-                "publish_max_ms": 1000.0 * float(s[11])}
+                "publish_max_ms": 1000.0 * float(s[11]), "references": int(s[12]),
+                "references_lost": int(s[13])}
 
     def latencies(self) -> np.ndarray:
         """Take -> published times (s) of the commands since the last call."""

@@ -50,6 +50,8 @@ PLAN_MARGIN = 4
 #: (1000 times in a row) stops waking the node: the timer takes the references queued since its
 #: last run and plans them at once (the rows wait in the library; an estimate weighs their feedforward)
 FAR_AHEAD = 3 * PLAN_MARGIN
+#: keep-last depth of the reference subscriptions (this node's and the compiled path's thread's)
+REFERENCE_DEPTH = 1000
 #: s: the timer's period while states flow (it also waits for late references on the Python path)
 TIMER_PERIOD = 0.002
 #: s: the longest timer period once references come far ahead (a third of their lead, at least
@@ -84,12 +86,14 @@ class CdprController(PlantNode):
         # estimate wait queued until a state or the timer takes them (an awaited estimate still
         # wakes the node). The states keep-last 1: after a busy moment the newest state is
         # answered, not a backlog whose commands the simulator would only count as stale
-        q = stream_qos(1000)
+        q = stream_qos(REFERENCE_DEPTH)
         # (with the compiled path the C thread takes the states and each reference wakes this
         # node, which plans its row when due (:meth:`_plan`); the estimate waits for the timer)
         self._unplanned = []
         self._far_ahead = 0         # references in a row streamed far ahead of the states
         self._in_blocks = False     # references taken by the timer, each block planned at once
+        self._follow = False        # the compiled path's thread takes the references (in blocks)
+        self._handover = False      # ... and this node's subscription still takes them too
         self._ref_t, self._ref_dt = None, 0.0     # the last reference's stamp, the reference period
         self._ref_sub = self.subscribe(MultiDOFJointTrajectory, topics.REFERENCE, self.on_reference, q, raw=True,
                                        polled=self._native is None)
@@ -178,10 +182,18 @@ class CdprController(PlantNode):
     def _plan_in_blocks(self, lead: float) -> None:
         """References come ``lead`` s ahead of the states: from now on the timer takes them (they
         no longer wake the node), every third of the lead (at most :data:`BLOCK_PERIOD`), and
-        plans each block at once."""
+        plans each block at once. The compiled path's thread then takes them too
+        (:meth:`ControllerPath.follow_references <cablelab.plants.cdpr.controller_path.
+        ControllerPath.follow_references>`); once its first samples overlap this node's, this
+        node's subscription goes (:meth:`_path_references`): no Python take or decode per sample."""
         self._in_blocks = True
         if self._ref_sub not in self.polled:
             fastspin.poll(self, self._ref_sub)
+        problem = self.path.follow_references(topics.REFERENCE, REFERENCE_DEPTH)
+        if problem is None:
+            self._follow = self._handover = True
+        else:
+            self.get_logger().warning(f"references stay with the Python subscription: {problem}")
         period = min(BLOCK_PERIOD, max(TIMER_PERIOD, lead / 3.0))
         self.destroy_timer(self.timer)
         self.timer = self.create_timer(period, self.on_timer)
@@ -191,16 +203,48 @@ class CdprController(PlantNode):
         """A reference sample (MultiDOFJointTrajectory or its serialised bytes)."""
         r = self.decode_raw("reference", MultiDOFJointTrajectory, msg)
         if r is not None and self.accept("reference", r["position"]):     # (position None when empty)
-            quat = xyzw_to_wxyz(r["quaternion"])
-            self.stream.reference(r["t"], r["position"], quat, r["linear_velocity"], r["linear_acceleration"])
-            if self.path is not None:
-                if self._ref_t is not None and r["t"] > self._ref_t:
-                    self._ref_dt = r["t"] - self._ref_t       # the reference's period
-                self._ref_t = r["t"]
-                self._unplanned.append((r["t"], r["position"], quat, r["linear_velocity"], r["linear_acceleration"]))
-                if not self._in_blocks:         # (in blocks: the timer plans what it took)
-                    self._plan(when_due=True)
+            self._reference(r["t"], r["position"], xyzw_to_wxyz(r["quaternion"]), r["linear_velocity"],
+                            r["linear_acceleration"])
             self.command(self.stream.ready())
+
+    def _reference(self, t: float, position, quat_wxyz, velocity, acceleration) -> None:
+        """A good reference sample: kept for the Python path and, with the compiled path, queued
+        to be planned."""
+        self.stream.reference(t, position, quat_wxyz, velocity, acceleration)
+        if self.path is not None:
+            if self._ref_t is not None and t > self._ref_t:
+                self._ref_dt = t - self._ref_t       # the reference's period
+            self._ref_t = t
+            self._unplanned.append((t, position, quat_wxyz, velocity, acceleration))
+            if not self._in_blocks:         # (in blocks: the timer plans what it took)
+                self._plan(when_due=True)
+
+    def _path_references(self) -> None:
+        """The reference samples the compiled path's thread took since the last call, checked
+        (:meth:`InputMonitor.accept_rows <cablelab.ros.inputs.InputMonitor.accept_rows>`: stamp
+        and position finite, the position present) and queued as :meth:`on_reference` does. While
+        this node's own subscription still takes them (it just took every sample up to
+        :attr:`_ref_t`), the thread's are left to it until they reach back to one it took: from
+        that overlap on the thread's samples follow without a gap and the subscription goes."""
+        rows = self.path.references()
+        if not len(rows):
+            return
+        if self._handover:
+            old = rows[:, 0] <= self._ref_t + 1e-9
+            if not old.any():
+                return          # (this node's subscription takes these on the next run)
+            self._handover = False
+            self.polled.remove(self._ref_sub)
+            self.destroy_subscription(self._ref_sub)
+            self._ref_sub = None
+            self.get_logger().info("references taken by the compiled path's thread")
+            rows = rows[~old]
+        ok = self.inputs.accept_rows("reference", rows[:, [0, 2, 3, 4]], time.monotonic(), rows[:, 1] == 1.0)
+        for r in rows[ok]:
+            vel, acc = r[9:12], r[12:15]
+            self._reference(float(r[0]), r[2:5], r[[8, 5, 6, 7]], None if np.isnan(vel).all() else vel,
+                            None if np.isnan(acc).all() else acc)
+        self.command(self.stream.ready())
 
     def on_estimate(self, msg: InertiaStamped) -> None:
         """An estimate: with the compiled path, its weights go to the library at once (every row
@@ -243,6 +287,8 @@ class CdprController(PlantNode):
         takes the queued inputs and the timer only runs a due /diagnostics."""
         if self.path is not None:
             self.take_polled()
+            if self._follow:
+                self._path_references()
             self._plan(when_due=True)
             self._from_path()
         now = time.monotonic()
@@ -292,7 +338,10 @@ class CdprController(PlantNode):
                            "states handed to Python": str(self._path_seen["handed_off"]),
                            "states waiting for their row": str(self._path_seen["waited"]),
                            "command publishes over 0.2 ms": str(self._path_seen["publish_slow"]),
-                           "slowest command publish ms": f"{self._path_seen['publish_max_ms']:.3f}"})
+                           "slowest command publish ms": f"{self._path_seen['publish_max_ms']:.3f}",
+                           "references taken by the compiled path": str(self._path_seen["references"])})
+            if self._path_seen["references_lost"]:
+                values["references lost by the compiled path"] = str(self._path_seen["references_lost"])
         else:
             values["compiled path"] = "off" + (f" ({self.path_problem})" if self.path_problem else "")
         return level, msg, values
