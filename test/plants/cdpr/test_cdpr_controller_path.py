@@ -226,7 +226,7 @@ def test_node_thread_answers_states_over_dds_and_reports_bad_ones(ros_context):
 
 
 def test_references_far_ahead_go_to_the_thread_without_a_gap_or_a_repeat(ros_context):
-    """References streamed far ahead of the states: after 1000 of them the node plans in blocks
+    """References streamed far ahead of the states: after 100 of them the node plans in blocks
     and its compiled path's thread takes the references too; once the thread's samples overlap
     the node's own subscription's, that subscription goes. Every reference is taken exactly once
     (counted, queued, planned), and the rows of those only the thread took answer with the
@@ -338,8 +338,8 @@ def test_three_processes_answer_the_simulator_and_survive_the_estimator(launcher
     assert ctl()["compiled path"] == ("on" if compiled else "off")
     if compiled:
         spin_until(lambda: int(ctl().get("commands from the compiled path", "0")) > 200, 60, "compiled commands")
-        # the simulator streams the reference 100 ms (25 periods) ahead: after 1000 of them (4 s)
-        # the node plans them in blocks and its thread takes them
+        # the simulator streams the reference 100 ms (25 periods) ahead: after 100 of them the
+        # node plans them in blocks and its thread takes them
         spin_until(lambda: int(ctl().get("references taken by the compiled path", "0")) > 250, 60,
                    "references taken by the compiled path's thread")
         assert ctl()["reference rejected"] == "0" and "references lost by the compiled path" not in ctl()

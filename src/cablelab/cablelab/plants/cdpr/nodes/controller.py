@@ -47,9 +47,12 @@ from .parameters import CONTROLLER as PARAMETERS
 #: reference periods ahead of the newest joint state
 PLAN_MARGIN = 4
 #: with the compiled path, a reference streamed at least this many periods ahead of the states
-#: (1000 times in a row) stops waking the node: the timer takes the references queued since its
-#: last run and plans them at once (the rows wait in the library; an estimate weighs their feedforward)
+#: (:data:`FAR_AHEAD_RUN` times in a row) stops waking the node: the timer takes the references
+#: queued since its last run and plans them at once (the rows wait in the library; an estimate weighs their feedforward)
 FAR_AHEAD = 3 * PLAN_MARGIN
+#: references in a row that must come :data:`FAR_AHEAD` periods ahead before the node plans them in
+#: blocks (0.1 s at 1 kHz: the simulator's steady lead, not a passing burst)
+FAR_AHEAD_RUN = 100
 #: keep-last depth of the reference subscriptions (this node's and the compiled path's thread's)
 REFERENCE_DEPTH = 1000
 #: s: the timer's period while states flow (it also waits for late references on the Python path)
@@ -161,7 +164,7 @@ class CdprController(PlantNode):
             if dt > 0 and math.isfinite(newest):
                 ahead = (self._unplanned[-1][0] - newest) / dt
                 self._far_ahead = self._far_ahead + 1 if ahead >= FAR_AHEAD else 0
-                if self._far_ahead == 1000:
+                if self._far_ahead == FAR_AHEAD_RUN:
                     self._plan_in_blocks(ahead * dt)
                 elif self._unplanned[0][0] - newest > PLAN_MARGIN * dt:
                     return
