@@ -1,4 +1,4 @@
-"""The latest few samples of a stream, looked up by stamp.
+"""The latest samples of a stream, looked up by stamp.
 
 A set-point stream may run ahead of the states it goes with (a trajectory generator streams the
 set-point of stamp t + dt together with the state of stamp t, so that the next state finds its
@@ -16,11 +16,12 @@ class StampedBuffer:
     """The last ``size`` (stamp, value) pairs, stamps in s.
 
     Args:
-        size: samples kept (a few periods of lead are enough).
+        size: samples kept: more than the lead of the stream over the samples it is looked up
+            for (the simulator streams the reference 50 ms, 50 samples at 1 kHz, ahead).
         tol: stamps within ``tol`` s count as equal (float stamps from nanosecond fields).
     """
 
-    def __init__(self, size: int = 8, tol: float = 1e-9):
+    def __init__(self, size: int = 2048, tol: float = 1e-9):
         self._items: deque = deque(maxlen=size)
         self.tol = tol
 
@@ -51,8 +52,10 @@ class StampedBuffer:
 
     def after(self, t: float):
         """(stamp, value) of the oldest sample with stamp > t (the next one after t), None when
-        there is none yet."""
-        for item in self._items:
-            if item[0] > t + self.tol:
-                return item
-        return None
+        there is none yet. (Searched from the newest: the samples looked up are a lead behind it.)"""
+        nxt = None
+        for item in reversed(self._items):
+            if item[0] <= t + self.tol:
+                break
+            nxt = item
+        return nxt

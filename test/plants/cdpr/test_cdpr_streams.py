@@ -161,3 +161,39 @@ def test_command_checks_law_state_and_reference_in_that_order(desc):
     want = LiveController(desc.cdpr, desc.gravity, cfg).update(1.0, q, qd, tr.position[0], ONE,
                                                                tr.velocity[0], tr.acceleration[0])
     np.testing.assert_allclose(s.command((1.0, [], q, qd, None), inputs, 0.1), want, rtol=1e-12)
+
+
+def test_a_reference_streamed_50_ms_ahead_meets_its_own_stamp(desc):
+    """The simulator streams the reference 50 ms (50 samples at 1 kHz) ahead of its states in
+    real time: the controller's command of a state uses the reference of that state's stamp and
+    the estimator's estimate of a tension sample the pose of its stamp, not the oldest of a few
+    kept samples (which would be ~40 ms in the future)."""
+    lead, n = 50, 200
+    tt = 2.0 + 1e-3 * np.arange(n + lead)      # (moving at ~0.2 m/s: 50 ms ahead is 1 cm off)
+    tr = pick_and_place(tt)
+    cfg = controller_config(PARAMS, desc.cdpr.platform_mass)
+    cs = CommandStream(True, sync_wait=0.005, estimate_wait=0.0)
+    cs.describe(desc.cdpr, desc.gravity, cfg)
+    oracle = LiveController(desc.cdpr, desc.gravity, cfg)
+    es = EstimateStream(EstimatorConfig())
+    es.describe(desc.cdpr, desc.gravity)
+    est_oracle = LiveEstimator(desc.cdpr, desc.gravity, EstimatorConfig())
+    rng = np.random.default_rng(3)
+    q, qd = np.full(8, -4000.0), np.zeros(8)
+    for k in range(lead):
+        cs.reference(tt[k], tr.position[k], ONE, tr.velocity[k], tr.acceleration[k])
+        es.pose(tt[k], tr.position[k], ONE, tr.acceleration[k])
+    for k in range(n):
+        j = k + lead
+        cs.reference(tt[j], tr.position[j], ONE, tr.velocity[j], tr.acceleration[j])
+        es.pose(tt[j], tr.position[j], ONE, tr.acceleration[j])
+        want = oracle.update(tt[k], q, qd, tr.position[k], ONE, tr.velocity[k], tr.acceleration[k])
+        np.testing.assert_allclose(cs.torques(tt[k], q, qd), want, rtol=1e-12)
+        cs.prepare_next(tt[k])                  # the next stamp's terms, prepared ahead
+        assert cs.prepared.t == tt[k + 1]
+        ten = rng.uniform(2000, 4000, 8)
+        _, m, com = es.sample(tt[k], ten)
+        m0, com0 = est_oracle.update(tt[k], tensions=ten, position=tr.position[k], quat=ONE,
+                                     acceleration=tr.acceleration[k])
+        assert m == pytest.approx(m0, rel=1e-12) and com == pytest.approx(com0, abs=1e-12)
+    assert cs.prepared_used == n - 1
