@@ -196,14 +196,19 @@ def test_closed_loop_over_dds(launcher, tmp_path):
     assert np.ptp(ref.position[:, 2]) > 0.1                     # it did lift (001 A -> B)
 
 
-def test_controller_prepares_ahead_and_estimator_batches(ros_context):
+def test_controller_prepares_ahead_and_estimator_batches(ros_context, monkeypatch):
     """The 1 kHz fast paths give the same outputs as the plain per-sample laws (the oracle:
-    LiveController.update / LiveEstimator.update on the same inputs): the controller's reference
+    LiveController.update / LiveEstimator.update on the same inputs): the controller's Python
+    path (no compiled one: it would drop the prepared terms on an estimate) with the reference
     terms prepared after the previous command (reference streamed two periods ahead), a new
-    estimate preparing them again with its mass; the estimator's batch mode estimating the newest sample of the
-    period."""
+    estimate preparing them again with its mass; the estimator's batch mode estimating the newest
+    sample of the period."""
     from geometry_msgs.msg import InertiaStamped
     from std_msgs.msg import Float64MultiArray
+
+    from cablelab import native
+
+    monkeypatch.setattr(native, "load", lambda name: None)
 
     from cablelab.plants.cdpr.live import LiveController, LiveEstimator
     from cablelab.plants.cdpr.nodes.controller import CdprController
@@ -222,6 +227,7 @@ def test_controller_prepares_ahead_and_estimator_batches(ros_context):
     try:
         ctl.on_description(convert.string_msg(desc.to_yaml()))
         est.on_description(convert.string_msg(desc.to_yaml()))
+        assert ctl.path is None
         oracle = LiveController(desc.cdpr, desc.gravity, ctl.controller.config)
         dt = 1e-3
         tt = 2.0 + dt * np.arange(14)

@@ -148,6 +148,12 @@ class CommandStream:
     def reference(self, t: float, position, quat_wxyz, velocity, acceleration) -> None:
         self.refs.push(t, (position, quat_wxyz, velocity, acceleration))
 
+    def references(self, t, position, quat_wxyz, velocity, acceleration) -> None:
+        """k samples at once: :meth:`reference` of each row of (k,) stamps and (k, 3) / (k, 4)
+        arrays (a velocity or acceleration row of NaN: none, which the law takes as zero)."""
+        for row in zip(t.tolist(), position, quat_wxyz, velocity, acceleration):
+            self.refs.push(row[0], row[1:])
+
     def estimate(self, t: float, mass: float | None, com, prepare: bool = True) -> None:
         """An estimate of stamp ``t`` (``mass`` None: the message was rejected). The terms
         prepared with the previous mass are prepared anew now, off the state -> command path, or

@@ -39,7 +39,6 @@ from ....ros.plant_node import PlantNode
 from ....ros.qos import PUBLISHER_DEPTH, publisher_qos, stream_qos
 from ....ros.rawmsg import CommandTemplate
 from .... import native
-from ....rotations import xyzw_to_wxyz
 from .parameters import CONTROLLER as PARAMETERS
 
 
@@ -162,22 +161,19 @@ class CdprController(PlantNode):
             dt = self._ref_dt
             newest = self.path.stats()["last_taken"]
             if dt > 0 and math.isfinite(newest):
-                ahead = (self._unplanned[-1][0] - newest) / dt
+                ahead = (self._unplanned[-1][-1, 0] - newest) / dt
                 self._far_ahead = self._far_ahead + 1 if ahead >= FAR_AHEAD else 0
                 if self._far_ahead == FAR_AHEAD_RUN:
                     self._plan_in_blocks(ahead * dt)
-                elif self._unplanned[0][0] - newest > PLAN_MARGIN * dt:
+                elif self._unplanned[0][0, 0] - newest > PLAN_MARGIN * dt:
                     return
-        refs, self._unplanned = self._unplanned, []
-        refs = [r for r in refs if abs(r[2][0]) == 1.0 and not r[2][1:].any()]
-        if not refs:
+        rows = self._unplanned[0] if len(self._unplanned) == 1 else np.concatenate(self._unplanned)
+        self._unplanned = []
+        rows = rows[(np.abs(rows[:, 8]) == 1.0) & ~rows[:, 5:8].any(1)]     # quaternion (0, 0, 0, +-1)
+        if not len(rows):
             return
-
-        def rows(k):
-            return np.array([np.full(3, np.nan) if r[k] is None else r[k] for r in refs], float)
-
         try:
-            plan = self.controller.plan(np.array([r[0] for r in refs]), rows(1), rows(3), rows(4))
+            plan = self.controller.plan(rows[:, 0], rows[:, 2:5], rows[:, 9:12], rows[:, 12:15])
         except (np.linalg.LinAlgError, ValueError, FloatingPointError):
             return          # (no rows: the Python path prepares those stamps and says why)
         self.path.put(plan)
@@ -206,19 +202,27 @@ class CdprController(PlantNode):
         """A reference sample (MultiDOFJointTrajectory or its serialised bytes)."""
         r = self.decode_raw("reference", MultiDOFJointTrajectory, msg)
         if r is not None and self.accept("reference", r["position"]):     # (position None when empty)
-            self._reference(r["t"], r["position"], xyzw_to_wxyz(r["quaternion"]), r["linear_velocity"],
-                            r["linear_acceleration"])
+            nan = np.full(3, np.nan)
+            vel, acc = r["linear_velocity"], r["linear_acceleration"]
+            self._references(np.concatenate([(r["t"], 1.0), r["position"], r["quaternion"],
+                                             nan if vel is None else vel, nan if acc is None else acc])[None])
             self.command(self.stream.ready())
 
-    def _reference(self, t: float, position, quat_wxyz, velocity, acceleration) -> None:
-        """A good reference sample: kept for the Python path and, with the compiled path, queued
-        to be planned."""
-        self.stream.reference(t, position, quat_wxyz, velocity, acceleration)
+    def _references(self, rows: np.ndarray) -> None:
+        """Good reference samples, (k, :data:`~cablelab.plants.cdpr.controller_path.REF_COLUMNS`)
+        rows as :meth:`ControllerPath.references <cablelab.plants.cdpr.controller_path.
+        ControllerPath.references>` gives them (NaN: no velocity or acceleration, which the law
+        takes as zero): kept for the Python path and, with the compiled path, queued to be
+        planned."""
+        self.stream.references(rows[:, 0], rows[:, 2:5], rows[:, [8, 5, 6, 7]], rows[:, 9:12], rows[:, 12:15])
         if self.path is not None:
-            if self._ref_t is not None and t > self._ref_t:
-                self._ref_dt = t - self._ref_t       # the reference's period
-            self._ref_t = t
-            self._unplanned.append((t, position, quat_wxyz, velocity, acceleration))
+            t = rows[:, 0]
+            if len(t) > 1 and t[-1] > t[-2]:
+                self._ref_dt = t[-1] - t[-2]       # the reference's period
+            elif self._ref_t is not None and t[-1] > self._ref_t:
+                self._ref_dt = t[-1] - self._ref_t
+            self._ref_t = float(t[-1])
+            self._unplanned.append(rows)
             if not self._in_blocks:         # (in blocks: the timer plans what it took)
                 self._plan(when_due=True)
 
@@ -243,10 +247,8 @@ class CdprController(PlantNode):
             self.get_logger().info("references taken by the compiled path's thread")
             rows = rows[~old]
         ok = self.inputs.accept_rows("reference", rows[:, [0, 2, 3, 4]], time.monotonic(), rows[:, 1] == 1.0)
-        for r in rows[ok]:
-            vel, acc = r[9:12], r[12:15]
-            self._reference(float(r[0]), r[2:5], r[[8, 5, 6, 7]], None if np.isnan(vel).all() else vel,
-                            None if np.isnan(acc).all() else acc)
+        if ok.any():
+            self._references(rows[ok])
         self.command(self.stream.ready())
 
     def on_estimate(self, msg: InertiaStamped) -> None:
