@@ -73,6 +73,31 @@ def test_templates_equal_rclpy_serialisation():
         RawTemplate(convert.joint_state_msg(0.0, names, z, None, z))["velocity"]   # empty sequence
 
 
+def test_raw_inertia_equals_the_deserialised_message():
+    """rawmsg.inertia_arrays of an InertiaStamped's bytes (the controller takes the estimates raw)
+    equals convert.inertia_arrays of the message rclpy deserialises from them; bytes of another
+    type raise ValueError."""
+    from geometry_msgs.msg import InertiaStamped
+    from rclpy.serialization import deserialize_message, serialize_message
+
+    from cablelab.ros import convert, rawmsg
+
+    reader = rawmsg.RawReader(InertiaStamped)
+    rng = np.random.default_rng(5)
+    for k in range(20):
+        msg = convert.inertia_msg(float(rng.uniform(0, 1e4)), float(rng.uniform(-1e3, 1e3)),
+                                  [rng.normal(), rng.normal(), np.nan if k % 3 else rng.normal()])
+        msg.header.frame_id = "platform" if k < 10 else "a_longer_frame_name"     # (a new layout)
+        raw = serialize_message(msg)
+        t, m, com = rawmsg.inertia_arrays(raw, reader)
+        t0, m0, com0 = convert.inertia_arrays(deserialize_message(raw, InertiaStamped))
+        assert (t, m) == (t0, m0)
+        np.testing.assert_array_equal(com, com0)
+    assert reader.parsed == 2
+    with pytest.raises(ValueError):
+        rawmsg.inertia_arrays(b"\x00\x01\x00\x00" + bytes(8), rawmsg.RawReader(InertiaStamped))
+
+
 def test_fast_executor_delivers_every_message_in_order(ros_context):
     from rclpy.node import Node
     from sensor_msgs.msg import JointState

@@ -25,7 +25,7 @@ from .inputs import InputMonitor
 from .lockstep import ADVANCE, FREE, RESEND
 from .markers import start_markers
 from .qos import DESCRIPTION_QOS, stream_qos
-from .rawmsg import RawReader, joint_state_arrays, multidof_arrays
+from .rawmsg import RawReader, inertia_arrays, joint_state_arrays, multidof_arrays
 from .reference import played_reference
 from .status import Latency
 
@@ -210,13 +210,15 @@ class PlantNode(Node):
     def decode_raw(self, name: str, kind, msg):
         """The arrays of a ``kind`` message (``JointState``:
         :func:`~cablelab.ros.rawmsg.joint_state_arrays`, ``MultiDOFJointTrajectory``:
-        :func:`~cablelab.ros.rawmsg.multidof_arrays`) given as an object or as its serialised
+        :func:`~cablelab.ros.rawmsg.multidof_arrays`, ``InertiaStamped``:
+        :func:`~cablelab.ros.rawmsg.inertia_arrays`) given as an object or as its serialised
         bytes (a subscription with ``raw=True``), read with one reader per type; None, counted as
         rejected on input ``name``, when the bytes are not one."""
         reader = self._raw_readers.get(kind)
         if reader is None:
             reader = self._raw_readers[kind] = RawReader(kind)
-        arrays = multidof_arrays if kind.__name__ == "MultiDOFJointTrajectory" else joint_state_arrays
+        arrays = {"MultiDOFJointTrajectory": multidof_arrays,
+                  "InertiaStamped": inertia_arrays}.get(kind.__name__, joint_state_arrays)
         return self.decode(name, lambda m: arrays(m, reader), msg)
 
     def play_reference(self, bag: str, topic: str, joints, builtin=None, platform: bool = False):

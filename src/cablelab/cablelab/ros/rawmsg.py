@@ -303,6 +303,24 @@ def multidof_arrays(msg, reader: RawReader) -> dict:
     return out
 
 
+def inertia_arrays(msg, reader: RawReader) -> tuple[float, float, np.ndarray]:
+    """:func:`cablelab.ros.convert.inertia_arrays` (t s, m kg, com (3,) m) of an InertiaStamped
+    message object or of its serialised bytes."""
+    if not _raw(msg):
+        return convert.inertia_arrays(msg)
+    lay = reader.layout(msg)
+    plan = reader.memo.get("inertia")
+    if plan is None:
+        spans = [lay.spans[f"inertia.{k}"] for k in ("m", "com.x", "com.y", "com.z")]
+        off, _, dt = spans[0]
+        if [(o, d) for o, _, d in spans] != [(off + 8 * i, dt) for i in range(4)]:
+            raise ValueError("not a CDR-serialised InertiaStamped")     # (XCDR packs four doubles)
+        plan = reader.memo["inertia"] = (RawReader.stamp_reader(lay), struct.Struct(dt[0] + "4d"), off)
+    stamp, four, off = plan
+    m, *com = four.unpack_from(msg, off)
+    return stamp(msg), m, np.array(com)
+
+
 _U32 = {"<": struct.Struct("<I"), ">": struct.Struct(">I")}
 
 

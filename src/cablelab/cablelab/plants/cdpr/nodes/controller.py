@@ -34,7 +34,7 @@ from trajectory_msgs.msg import MultiDOFJointTrajectory
 from .. import topics
 from ..controller_path import ControllerPath
 from ..streams import CommandStream, controller_config
-from ....ros import convert, fastspin
+from ....ros import fastspin
 from ....ros.plant_node import PlantNode
 from ....ros.qos import PUBLISHER_DEPTH, publisher_qos, stream_qos
 from ....ros.rawmsg import CommandTemplate
@@ -99,7 +99,7 @@ class CdprController(PlantNode):
         self._ref_t, self._ref_dt = None, 0.0     # the last reference's stamp, the reference period
         self._ref_sub = self.subscribe(MultiDOFJointTrajectory, topics.REFERENCE, self.on_reference, q, raw=True,
                                        polled=self._native is None)
-        self.subscribe(InertiaStamped, topics.PAYLOAD_ESTIMATE, self.on_estimate, q,
+        self.subscribe(InertiaStamped, topics.PAYLOAD_ESTIMATE, self.on_estimate, q, raw=True,
                        polled=not self.stream.awaits_estimate)
         # the Python path's subscription from the start, also when the compiled path is wanted: the
         # node subscribes to the states before a description configures the law (a launch that
@@ -252,9 +252,12 @@ class CdprController(PlantNode):
         self.command(self.stream.ready())
 
     def on_estimate(self, msg: InertiaStamped) -> None:
-        """An estimate: with the compiled path, its weights go to the library at once (every row
-        answered from then on uses them)."""
-        t, m, com = convert.inertia_arrays(msg)
+        """An estimate (InertiaStamped or its serialised bytes): with the compiled path, its
+        weights go to the library at once (every row answered from then on uses them)."""
+        est = self.decode_raw("payload_estimate", InertiaStamped, msg)
+        if est is None:
+            return
+        t, m, com = est
         self.stream.estimate(t, m if self.accept("payload_estimate", [m]) else None, com,
                              prepare=self.path is None)
         if self.path is not None:
