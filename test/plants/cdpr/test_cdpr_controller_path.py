@@ -294,6 +294,41 @@ def test_references_far_ahead_go_to_the_thread_without_a_gap_or_a_repeat(ros_con
         peer.destroy_node()
 
 
+@pytest.mark.parametrize("batches", [[(10, 15), (15, 26), (26, 31)],      # the ring behind the subscription
+                                     [(10, 20), (20, 31)],                # level with it
+                                     [(0, 5), (15, 26), (26, 31)]])       # no overlap first, then ahead
+def test_the_handover_queues_each_reference_once(ros_context, batches):
+    """Whatever the thread's ring holds when the node's subscription (which took stamps 0..19)
+    goes, every reference stamp 0..30 is queued exactly once and in order: the ring's samples
+    the subscription took are skipped, also when they reach the node a run after the handover."""
+    from cablelab.plants.cdpr.nodes.controller import CdprController
+    from cablelab.ros import convert, fastspin
+
+    _lib()
+    ctl = CdprController()
+    try:
+        ctl.on_description(convert.string_msg(DESC.to_yaml()))
+        assert ctl.path is not None, ctl.path_problem
+        tt, tr = _reference(6.0, 31)
+        ring = np.column_stack([tt, np.ones(31), tr.position, np.tile([0, 0, 0, 1.0], (31, 1)), tr.velocity,
+                                tr.acceleration])
+        ctl._in_blocks = ctl._follow = ctl._handover = True       # as _plan_in_blocks leaves it
+        fastspin.poll(ctl, ctl._ref_sub)
+        for k in range(20):                                       # what the subscription took
+            ctl.on_reference(convert.multidof_msg(tt[k], tr.position[k], [0, 0, 0, 1.0], tr.velocity[k], None,
+                                                  tr.acceleration[k], None))
+        queue = [ring[a:b] for a, b in batches]
+        ctl.path.references = lambda: queue.pop(0) if queue else ring[:0]
+        while queue:
+            ctl._path_references()
+        assert not ctl._handover and ctl._ref_sub is None
+        queued = np.concatenate(ctl._unplanned)
+        np.testing.assert_array_equal(queued[:, 0], tt)
+        assert ctl.inputs.inputs["reference"].received == 31
+    finally:
+        ctl.destroy_node()
+
+
 @pytest.mark.parametrize("compiled", [True, False])
 def test_three_processes_answer_the_simulator_and_survive_the_estimator(launcher, diagnostics_seen, compiled):
     """cable_sim_node (real time) + payload_estimator + pd_feedforward as processes, with the

@@ -312,7 +312,8 @@ int cp_references(cp_t *h, double *out, int cap) {
   pthread_mutex_lock(&h->mu);
   long n = h->nrefs - h->refs_read;
   if (n > cap) n = cap;
-  for (long i = 0; i < n; i++) memcpy(out + i * CP_REF_COLS, h->refs[(h->refs_read + i) % CP_REFS], sizeof(double) * CP_REF_COLS);
+  for (long i = 0; i < n; i++)
+    memcpy(out + i * CP_REF_COLS, h->refs[(h->refs_read + i) % CP_REFS], sizeof(double) * CP_REF_COLS);
   h->refs_read += n;
   pthread_mutex_unlock(&h->mu);
   return (int)n;
@@ -491,19 +492,6 @@ int cp_follow_references(cp_t *h, const char *topic, int depth) {
   h->refs_on = 1;
   pthread_mutex_unlock(&h->mu);
   return 0;
-}
-
-/* Whether the thread's reference subscription is matched with a publisher (-1: not following). */
-int cp_reference_publishers(cp_t *h) {
-  pthread_mutex_lock(&h->mu);
-  int on = h->refs_on;
-  pthread_mutex_unlock(&h->mu);
-  size_t n = 0;
-  if (!on || rcl_subscription_get_publisher_count(&h->ref_sub, &n) != RCL_RET_OK) {
-    rcl_reset_error();
-    return -1;
-  }
-  return (int)n;
 }
 
 void cp_stop(cp_t *h) {

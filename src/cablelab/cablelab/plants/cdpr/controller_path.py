@@ -5,13 +5,15 @@ Python plans the reference terms of each stamp (:meth:`LiveController.plan
 <cablelab.plants.cdpr.live.LiveController.plan>`: the PD part, the four feedforward tension rows,
 the friction compensation) as soon as the reference comes and puts them in the library as rows
 keyed by stamp; each estimate gives the library its weights (:meth:`~cablelab.plants.cdpr.live.
-LiveController.estimate_weights`), so it changes no row. A C thread (subscribing and publishing through the node's own rcl node) takes each joint state,
-finds the row of its stamp and publishes :meth:`~cablelab.plants.cdpr.live.LiveController.
-planned_law`'s torques, the same doubles, without Python. A state it cannot answer (bad values,
-no row of its stamp) is handed to Python (:meth:`ControllerPath.handoff`), whose checks and law
-decide and report as without this path. Once the references come far ahead of the states
-(:meth:`ControllerPath.follow_references`) the thread also takes them, after each command, and
-Python reads them in blocks (:meth:`ControllerPath.references`) to plan their rows. ROS-free apart from the thread the library runs.
+LiveController.estimate_weights`), so it changes no row. A C thread (subscribing and publishing
+through the node's own rcl node) takes each joint state, finds the row of its stamp and publishes
+:meth:`~cablelab.plants.cdpr.live.LiveController.planned_law`'s torques (the same doubles up to
+the order of the feedforward's four-term sum) without Python. A state it cannot answer (bad
+values, no row of its stamp) is handed to Python (:meth:`ControllerPath.handoff`), whose checks
+and law decide and report as without this path. Once the references come far ahead of the
+states (:meth:`ControllerPath.follow_references`) the thread also takes them, after each
+command, and Python reads them in blocks (:meth:`ControllerPath.references`) to plan their rows.
+ROS-free apart from the thread the library runs.
 """
 from __future__ import annotations
 

@@ -47,7 +47,8 @@ from .parameters import CONTROLLER as PARAMETERS
 PLAN_MARGIN = 4
 #: with the compiled path, a reference streamed at least this many periods ahead of the states
 #: (:data:`FAR_AHEAD_RUN` times in a row) stops waking the node: the timer takes the references
-#: queued since its last run and plans them at once (the rows wait in the library; an estimate weighs their feedforward)
+#: queued since its last run and plans them at once (the rows wait in the library; an estimate
+#: only sets the weights of their feedforward)
 FAR_AHEAD = 3 * PLAN_MARGIN
 #: references in a row that must come :data:`FAR_AHEAD` periods ahead before the node plans them in
 #: blocks (0.1 s at 1 kHz: the simulator's steady lead, not a passing burst)
@@ -96,6 +97,7 @@ class CdprController(PlantNode):
         self._in_blocks = False     # references taken by the timer, each block planned at once
         self._follow = False        # the compiled path's thread takes the references (in blocks)
         self._handover = False      # ... and this node's subscription still takes them too
+        self._overlap_t = None      # stamp of the last sample that subscription took (until passed)
         self._ref_t, self._ref_dt = None, 0.0     # the last reference's stamp, the reference period
         self._ref_sub = self.subscribe(MultiDOFJointTrajectory, topics.REFERENCE, self.on_reference, q, raw=True,
                                        polled=self._native is None)
@@ -232,20 +234,28 @@ class CdprController(PlantNode):
         and position finite, the position present) and queued as :meth:`on_reference` does. While
         this node's own subscription still takes them (it just took every sample up to
         :attr:`_ref_t`), the thread's are left to it until they reach back to one it took: from
-        that overlap on the thread's samples follow without a gap and the subscription goes."""
+        that overlap on the thread's samples follow without a gap and the subscription goes; the
+        thread's samples up to the last one the subscription took (some may come a run later)
+        are skipped."""
         rows = self.path.references()
         if not len(rows):
             return
-        if self._handover:
-            old = rows[:, 0] <= self._ref_t + 1e-9
-            if not old.any():
-                return          # (this node's subscription takes these on the next run)
-            self._handover = False
-            self.polled.remove(self._ref_sub)
-            self.destroy_subscription(self._ref_sub)
-            self._ref_sub = None
-            self.get_logger().info("references taken by the compiled path's thread")
-            rows = rows[~old]
+        if self._handover or self._overlap_t is not None:
+            last = self._ref_t if self._handover else self._overlap_t
+            new = rows[:, 0] > last + 1e-9      # (in stamp order: those taken already come first)
+            if self._handover:
+                if new.all():
+                    return          # no overlap yet: this node's subscription takes these next run
+                self._handover = False
+                self.polled.remove(self._ref_sub)
+                self.destroy_subscription(self._ref_sub)
+                self._ref_sub = None
+                self.get_logger().info("references taken by the compiled path's thread")
+                self._overlap_t = last  # (the thread may still hold samples the subscription took)
+            if not new.any():
+                return
+            rows = rows[int(np.argmax(new)):]
+            self._overlap_t = None
         ok = self.inputs.accept_rows("reference", rows[:, [0, 2, 3, 4]], time.monotonic(), rows[:, 1] == 1.0)
         if ok.any():
             self._references(rows[ok])
