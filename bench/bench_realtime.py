@@ -27,6 +27,11 @@ SCHED_FIFO alike).
    timer's (a wake-up a period or more late, plus periods skipped more than 20 behind);
    ``p99_ms`` is the loop body's (read -> law -> write) p99 in the worst 1 s window. Targets:
    ``missed_cycles`` <= 2x the bare timer's, ``p99_ms`` < 0.5.
+Parts 2-4 at 1 kHz run in ``--segments`` alternating segments (default 3 of ``--seconds``/3:
+bare timer, C pair, control loop, three processes, then again), so that background load that comes
+and goes over minutes meets the floor and the loops alike; each figure is summed over the segments
+(counts, seconds), the largest (p99s, maxima) or their mean (realtime factors, CPU per step), and
+each ``missed_cycles`` comes with ``segment_missed``, the count of each segment.
 5. A rate sweep: the bare timer and the control loop at 100, 250, 500 Hz (``--sweep-seconds``
    each; the 1000 Hz row is parts 3-4), printed beside the floor.
 
@@ -71,7 +76,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from harness import Bench, table  # noqa: E402
-from realtime_runs import IDLE_ESTIMATOR, cdpr_hold, closed_loop  # noqa: E402
+from realtime_runs import IDLE_ESTIMATOR, cdpr_hold, closed_loop, merge_segments  # noqa: E402
 
 
 def offline_sim(duration: float = 60.0, repeat: int = 3) -> dict:
@@ -181,6 +186,12 @@ def _thread_rows(prefix: str, threads: dict) -> list:
             for node, rows in threads.items() for name, v in rows.items() if v["cpu_us"] >= 1.0]
 
 
+def _segments(d: dict) -> str:
+    """`` (segments a + b + c)`` of a merged result, or nothing for one segment."""
+    seg = d.get("segment_missed") or []
+    return f" (segments {' + '.join(map(str, seg))})" if len(seg) > 1 else ""
+
+
 def _fmt(x, digits: int = 4) -> str:
     return "-" if x is None else f"{x:.{digits}f}"
 
@@ -219,6 +230,9 @@ def main(argv=None) -> int:
                               help="SCHED_FIFO at PRIO (needs the privilege) for the bare timer, the C rcl "
                                    "pair, the control loop's process (not its publisher process nor the "
                                    "estimator) and the three-process simulator and controller (0: off)")
+    bench.parser.add_argument("--segments", type=int, default=3,
+                              help="run each 1 kHz measurement (bare timer, C rcl pair, control loop, three "
+                                   "processes) as this many alternating segments of --seconds/N, summed (3)")
     bench.parser.add_argument("--sweep-seconds", type=float, default=20.0,
                               help="s per rate of the sweep's 100, 250, 500 Hz runs (20)")
     args = bench.parse(argv)
@@ -236,10 +250,37 @@ def main(argv=None) -> int:
         built, why = build_floor(bench.log)
         if built is None:
             out["floor"] = {"available": False, "reason": why, "bare_timer_missed": None, "c_rcl_pair_missed": None}
-    if not args.skip_loop and not args.skip_floor and built is not None:
-        out["floor"] = floor(built, args.seconds, bench.log, args.pin, rt)
-    if not args.skip_loop and not args.skip_control_loop:
-        out["control_loop"] = control_loop(args.seconds, bench.log, 1000.0, args.pin, loop_extra)
+    run_floor = not args.skip_loop and not args.skip_floor and built is not None
+    run_loop = not args.skip_loop and not args.skip_control_loop
+    run_three = not args.skip_loop and not args.skip_three_process
+    env, extra = {}, json.loads(args.node_params) if args.node_params else {}
+    if args.publication_mode:
+        env["RMW_FASTRTPS_PUBLICATION_MODE"] = args.publication_mode.upper()
+    if args.transports:
+        env["FASTDDS_BUILTIN_TRANSPORTS"] = args.transports
+    for name in ("sim", "controller") if args.idle_python else ():
+        extra.setdefault(name, {}).setdefault("python_idle", True)
+    for name in ("sim", "controller") if rt else ():
+        extra.setdefault(name, {}).setdefault("rt_priority", rt)
+    # the 1 kHz measurements in alternating segments: a minute of background load meets all alike
+    segments = max(1, args.segments)
+    seg = args.seconds / segments
+    parts = {"floor": [], "control_loop": [], "three_process": []}
+    for i in range(segments if run_floor or run_loop or run_three else 0):
+        if segments > 1:
+            bench.log(f"segment {i + 1} of {segments}: {seg:g} s of each 1 kHz measurement")
+        if run_floor:
+            parts["floor"].append(floor(built, seg, bench.log, args.pin, rt))
+        if run_loop:
+            parts["control_loop"].append(control_loop(seg, bench.log, 1000.0, args.pin, loop_extra))
+        if run_three:
+            # (its steady state starts at the simulator's first report after 1 s: one more second)
+            parts["three_process"].append(closed_loop(seg + (segments > 1), bench.log, env, args.py_spy, args.pin,
+                                                      extra or None, args.idle_estimator))
+    if parts["floor"]:
+        out["floor"] = merge_segments(parts["floor"])
+    if parts["control_loop"]:
+        out["control_loop"] = merge_segments(parts["control_loop"])
     if not args.skip_loop and not args.skip_sweep:
         from bench_rcl_floor import run_timer
 
@@ -258,24 +299,15 @@ def main(argv=None) -> int:
                           "control_loop_missed": c["missed_cycles"], "p99_ms": c["p99_ms"],
                           "realtime_factor": c["realtime_factor"]})
         out["rate_sweep"] = sweep
-    if not args.skip_loop and not args.skip_three_process:
-        env = {}
-        if args.publication_mode:
-            env["RMW_FASTRTPS_PUBLICATION_MODE"] = args.publication_mode.upper()
-        if args.transports:
-            env["FASTDDS_BUILTIN_TRANSPORTS"] = args.transports
-        extra = json.loads(args.node_params) if args.node_params else {}
-        for name in ("sim", "controller") if args.idle_python else ():
-            extra.setdefault(name, {}).setdefault("python_idle", True)
-        for name in ("sim", "controller") if rt else ():
-            extra.setdefault(name, {}).setdefault("rt_priority", rt)
-        r = closed_loop(args.seconds, bench.log, env, args.py_spy, args.pin, extra or None, args.idle_estimator)
+    if parts["three_process"]:
+        r = merge_segments(parts["three_process"])
         out["three_process"] = {"rate_hz": r["rate_hz"], "seconds": r["seconds"],
-                              "realtime_factor": r["realtime_factor"], "missed_cycles": r["missed_cycles"],
-                              "p99_ms": r["p99_ms"], "rt_priority": r["rt_priority"],
-                              "command_age_steps": r["command_age"], "placement": r["placement"],
-                              "cpu_ms": r["cpu_ms"], "threads": r.get("threads", {}),
-                              "slow_publishes": r.get("slow_publishes")}
+                                "realtime_factor": r["realtime_factor"], "missed_cycles": r["missed_cycles"],
+                                "segment_missed": r.get("segment_missed", [r["missed_cycles"]]),
+                                "p99_ms": r["p99_ms"], "rt_priority": r["rt_priority"],
+                                "command_age_steps": r["command_age"], "placement": r["placement"],
+                                "cpu_ms": r["cpu_ms"], "threads": r.get("threads", {}),
+                                "slow_publishes": r.get("slow_publishes")}
     if args.json:
         print(json.dumps(out))
         return 0
@@ -296,9 +328,11 @@ def main(argv=None) -> int:
         else:
             fifo = ", SCHED_FIFO" if f.get("rt_priority") else ""
             rows += [dict(case=f"floor: bare timer 1 kHz{fifo}, {f['seconds']:.0f} s (missed = late + dropped)",
-                          value=f"{f['bare_timer_missed']} (wake-up p99 {f['bare_timer']['p99_ms']['wake-up']:.3f} ms)",
+                          value=f"{f['bare_timer_missed']}{_segments(f['bare_timer'])} "
+                                f"(wake-up p99 {f['bare_timer']['p99_ms']['wake-up']:.3f} ms)",
                           unit=f"of {int(round(f['bare_timer']['seconds'] * 1000))}", target=""),
-                     dict(case="floor: C rcl simulator/controller pair 1 kHz", value=f["c_rcl_pair_missed"],
+                     dict(case="floor: C rcl simulator/controller pair 1 kHz",
+                          value=f"{f['c_rcl_pair_missed']}{_segments(f['c_rcl_pair'])}",
                           unit=f"of {int(round(f['c_rcl_pair']['seconds'] * 1000))}", target="")]
             rows.append(dict(case="floor: C rcl pair's controller: command publishes over 0.2 ms",
                              value=f["c_rcl_pair"].get("slow_publishes", "-"), unit="", target=""))
@@ -310,7 +344,7 @@ def main(argv=None) -> int:
         rows += [dict(case=f"control loop 1 kHz (control_loop + estimator, publisher {c.get('publisher')}{prio}), "
                            f"{c['seconds']:.0f} s: missed cycles "
                            f"(late {c['late']} + dropped {c['dropped']})",
-                      value=c["missed_cycles"], unit=f"of {c['cycles'] + c['dropped']}",
+                      value=f"{c['missed_cycles']}{_segments(c)}", unit=f"of {c['cycles'] + c['dropped']}",
                       target=f"<= {2 * bare} (2x bare timer)" if bare is not None else "<= 2x bare timer"),
                  dict(case="control loop body p99 (read -> law -> write, worst 1 s window) / median",
                       value=f"{c['p99_ms']:.3f} / {c['median_ms']:.3f}", unit="ms", target="< 0.5"),
@@ -330,7 +364,7 @@ def main(argv=None) -> int:
         rows += [dict(case=f"closed loop 1 kHz, 3 processes, {prio}, {where}, {c['seconds']:.0f} s steady state",
                       value=c["realtime_factor"], unit="x real time", target=">= 0.99"),
                  dict(case="missed cycles (steps braked, late or with a stale command, + dropped)",
-                      value=f"{c['missed_cycles']} (braked {r['braked']}, late {r['late']}, "
+                      value=f"{c['missed_cycles']}{_segments(c)} (braked {r['braked']}, late {r['late']}, "
                             f"dropped {r['dropped']}, stale {r['stale']})",
                       unit=f"of {r['steps']}", target=f"<= {3 * pair} (3x C rcl pair)" if pair is not None
                       else "<= 3x C rcl pair")]

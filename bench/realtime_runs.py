@@ -27,6 +27,38 @@ def cdpr_hold(timestep: float = 0.002):
     return sim, hold
 
 
+def merge_segments(parts: list) -> dict:
+    """One result of the same measurement run as consecutive segments (``bench_realtime
+    --segments``): counts (ints) and ``seconds`` summed, p99s and maxima the largest, other
+    figures (realtime factors, CPU per step) the mean over the segments, ``load`` the first
+    reading before and the last after, flags and names the first segment's; every dict with a
+    ``missed_cycles`` also gets ``segment_missed``, the count of each segment."""
+    def merge(key: str, values: list):
+        vals = [v for v in values if v is not None]
+        if not vals:
+            return None
+        first = vals[0]
+        if key == "load":
+            return (vals[0][0], vals[-1][-1])
+        if isinstance(first, dict):
+            out = {k: merge(k if "p99" not in key and "max" not in key else key, [v.get(k) for v in vals])
+                   for k in first}
+            if "missed_cycles" in first:
+                out["segment_missed"] = [v.get("missed_cycles") for v in vals]
+            return out
+        if isinstance(first, (list, tuple)) and first and all(isinstance(x, int) for x in first):
+            return [sum(col) for col in zip(*vals)]
+        if isinstance(first, bool) or not isinstance(first, (int, float)) or key == "rate_hz":
+            return first
+        if "p99" in key or "max" in key:
+            return max(vals)
+        if key == "seconds" or isinstance(first, int):
+            return sum(vals)
+        return sum(vals) / len(vals)
+
+    return parts[0] if len(parts) == 1 else merge("", list(parts))
+
+
 def _py_spy_profiles(py_spy: str, out_dir: Path, seconds: float, log):
     """``on_started`` hook: sample each node with py-spy for ``seconds`` (from 3 s after start,
     past the start-up) into ``out_dir/<node>.txt`` (collapsed stacks, raw format)."""
