@@ -27,6 +27,16 @@ class InputState:
     last_problem: str = ""
 
 
+def _problem(length: int | None, size: int, finite) -> str:
+    """What is wrong with a message of ``size`` values for an input of ``length`` ("" if
+    nothing); ``finite()`` says whether its values are finite (asked last)."""
+    if size == 0:
+        return "empty"
+    if length is not None and size != length:
+        return f"wrong length {size}, expected {length}"
+    return "" if finite() else "NaN or infinite value"
+
+
 @dataclass
 class InputMonitor:
     """Tracks every input of a node. ``required`` inputs make the status ERROR when stale."""
@@ -47,14 +57,8 @@ class InputMonitor:
     def accept(self, name: str, values, now: float) -> bool:
         """Check one message's values; True if usable. Bad values are counted, not raised."""
         st = self.inputs[name]
-        arr = np.asarray(values, dtype=float) if values is not None else None
-        problem = ""
-        if arr is None or arr.size == 0:
-            problem = "empty"
-        elif st.length is not None and arr.size != st.length:
-            problem = f"wrong length {arr.size}, expected {st.length}"
-        elif not np.all(np.isfinite(arr)):
-            problem = "NaN or infinite value"
+        arr = np.asarray(values, dtype=float) if values is not None else np.zeros(0)
+        problem = _problem(st.length, arr.size, lambda: np.isfinite(arr).all())
         if problem:
             st.rejected += 1
             st.last_problem = problem
@@ -81,8 +85,7 @@ class InputMonitor:
         n_ok = int(ok.sum())
         if n_ok < k:
             j = int(np.flatnonzero(~ok)[-1])
-            st.last_problem = ("empty" if empty[j] else f"wrong length {m}, expected {st.length}" if wrong[j]
-                               else "NaN or infinite value")
+            st.last_problem = _problem(st.length, 0 if empty[j] else m, lambda: False)
             st.rejected += k - n_ok
         if n_ok:
             st.received += n_ok
