@@ -368,6 +368,11 @@ def run_closed_loop(launch, seconds: float, params: dict, log=print, on_started=
     out["threads"] = (_thread_deltas(threads[0][1], threads[1][1], round((threads[1][0] - threads[0][0]) * 1000))
                       if len(threads) > 1 else {})
     out["missed_cycles"] = delta("missed steps") + out["dropped"]   # each step counted once
+    key = "publishes over 0.2 ms (joint states/tensions/reference)"
+    if key in first and key in last:   # the simulator's compiled path
+        out.update(sim_slow_publishes=[int(b) - int(a) for a, b in zip(first[key].split("/"), last[key].split("/"))],
+                   sim_publish_max_ms=float(last["slowest publish ms"]),
+                   sim_wake_max_ms=float(last["latest wake-up ms"]))
     # the controller's compiled path, from its first report that has the count (its report from
     # before the path started may be the newest at the first steady reading)
     slow = "command publishes over 0.2 ms"

@@ -158,7 +158,7 @@ def run_floor(exe: Path, mjb: Path, state: Path, seconds: float, listener: bool,
             "dropped": sim["dropped"], "p99_ms": {"sim": sim["p99_ms"], "controller": ctrl["p99_ms"]},
             "cpu_per_step_ms": {"sim": sim["cpu_per_step_ms"], "controller": ctrl["cpu_per_answer_ms"]},
             "listener": listener, "pinned": pin, "rt_priority": rt > 0, "threads": threads,
-            "slow_publishes": ctrl.get("slow_publishes")}
+            "slow_publishes": ctrl.get("slow_publishes"), "slow_state_publishes": sim.get("slow_state_publishes")}
 
 
 def _sample_threads(pids: dict, first: float, last: float) -> dict:

@@ -47,12 +47,14 @@ each ``missed_cycles`` comes with ``segment_missed``, the count of each segment.
                        "braked", "late", "stale", "dropped", "segments": [those counts of each segment],
                        "p99_ms": {"sim", "estimator", "controller"}, "rt_priority": false,
                        "threads": {node: {thread name: {"cpu_us", "wait_us", "runs"} per step}},
-                       "slow_publishes" (the controller's compiled path: publishes > 0.2 ms), ...},
+                       "slow_publishes" (the controller's compiled path: publishes > 0.2 ms),
+                       "sim_slow_publishes" (the simulator's compiled path: joint-state, tension,
+                       reference publishes > 0.2 ms), "sim_publish_max_ms", "sim_wake_max_ms", ...},
      "rate_sweep": [{"rate_hz", "bare_timer_missed", "control_loop_missed", "p99_ms",
                      "realtime_factor", "seconds"}, ...]}
 
 Run it on a quiet machine: ``./run python bench/bench_realtime.py --seconds 60 --json`` (the
-10-minute soak: ``--seconds 600``). ``--py-spy PATH`` samples the three node processes with
+10-minute soak: ``--seconds 600 --segments 1``). ``--py-spy PATH`` samples the three node processes with
 py-spy and prints each one's share of samples by innermost function (where the time goes);
 ``--publication-mode asynchronous`` runs the nodes with Fast DDS asynchronous publishing.
 Placement without privileges: ``--idle-estimator`` (the estimator in the SCHED_IDLE class),
@@ -311,7 +313,8 @@ def main(argv=None) -> int:
                                 "p99_ms": r["p99_ms"], "rt_priority": r["rt_priority"],
                                 "command_age_steps": r["command_age"], "placement": r["placement"],
                                 "cpu_ms": r["cpu_ms"], "threads": r.get("threads", {}),
-                                "slow_publishes": r.get("slow_publishes")}
+                                "slow_publishes": r.get("slow_publishes"),
+                                **{k: r.get(k) for k in ("sim_slow_publishes", "sim_publish_max_ms", "sim_wake_max_ms")}}
     if args.json:
         print(json.dumps(out))
         return 0
@@ -338,8 +341,9 @@ def main(argv=None) -> int:
                      dict(case="floor: C rcl simulator/controller pair 1 kHz",
                           value=f"{f['c_rcl_pair_missed']}{_segments(f['c_rcl_pair'])}",
                           unit=f"of {int(round(f['c_rcl_pair']['seconds'] * 1000))}", target="")]
-            rows.append(dict(case="floor: C rcl pair's controller: command publishes over 0.2 ms",
-                             value=f["c_rcl_pair"].get("slow_publishes", "-"), unit="", target=""))
+            rows.append(dict(case="floor: C rcl pair's command / state publishes over 0.2 ms",
+                             value=f"{f['c_rcl_pair'].get('slow_publishes', '-')} / "
+                                   f"{f['c_rcl_pair'].get('slow_state_publishes', '-')}", unit="", target=""))
             rows += _thread_rows("C pair ", f["c_rcl_pair"].get("threads", {}))
     if "control_loop" in out:
         c = out["control_loop"]
@@ -382,6 +386,12 @@ def main(argv=None) -> int:
         rows.append(dict(case="controller's compiled path: command publishes over 0.2 ms (held up inside DDS)",
                          value="-" if c["slow_publishes"] is None else c["slow_publishes"],
                          unit=f"of {r['steps']}", target=""))
+        if c.get("sim_slow_publishes") is not None:
+            rows.append(dict(case="simulator's compiled path: joint-state / tension / reference publishes over 0.2 ms; "
+                                  "slowest publish, latest wake-up (ms)",
+                             value=" / ".join(map(str, c["sim_slow_publishes"]))
+                             + f"; {c['sim_publish_max_ms']:.3f}, {c['sim_wake_max_ms']:.3f}",
+                             unit=f"of {r['steps']}", target=""))
         rows += _thread_rows("", c["threads"])
     print(table(rows))
     if out.get("rate_sweep"):

@@ -88,7 +88,8 @@ def test_the_node_with_the_compiled_path_survives_bad_commands(ros_context):
     """The simulator node in real time runs the compiled path: NaN, wrong-length and empty
     commands over DDS are rejected and reported on its /diagnostics status (as the Python path
     reports them), the C thread keeps stepping on the brakes, a good command answering the last
-    state is taken; the states it publishes arrive with their stamps on the grid."""
+    state is taken; the states it publishes arrive with their stamps on the grid; its publish and
+    wake-up delays (/diagnostics) are counted from the first good command on."""
     import time
 
     import rclpy
@@ -128,6 +129,9 @@ def test_the_node_with_the_compiled_path_survives_bad_commands(ros_context):
         level, msg, values = sim.status()
         assert values["effort_commands rejected"] == "3" and "rejected messages on effort_commands" in msg
         assert values["per-period path"] == "compiled"
+        # publish and wake-up delays are counted only once commands come (start-up is not the loop)
+        slow = "publishes over 0.2 ms (joint states/tensions/reference)"
+        assert (values[slow], values["slowest publish ms"], values["latest wake-up ms"]) == ("0/0/0", "0.000", "0.000")
         k0 = sim.stepper.k
         assert spin_until(lambda: sim.stepper.k > k0 + 50)      # still stepping (on the brakes)
         assert sim.stepper.fallbacks == sim.stepper.k and sim.stepper.commands == 0
@@ -136,6 +140,12 @@ def test_the_node_with_the_compiled_path_survives_bad_commands(ros_context):
         pub.publish(convert.command_msg(np.array(states[-1].effort), t, "winch"))
         assert spin_until(lambda: sim.compiled.update(sim.inputs)["commands"] == 1, 30.0)
         assert sim.inputs.inputs["effort_commands"].received == 1
+        k1 = sim.stepper.k
+        assert spin_until(lambda: sim.stepper.k > k1 + 20)
+        values = sim.status()[2]
+        # every wake-up comes after its deadline and every publish takes time: both maxima > 0
+        assert float(values["latest wake-up ms"]) > 0 and float(values["slowest publish ms"]) > 0
+        assert sum(map(int, values[slow].split("/"))) <= 3 * (sim.stepper.k - k1 + 1)
         stamps = np.array([convert.from_stamp(s.header.stamp) for s in states])
         np.testing.assert_allclose(stamps * 1000.0, np.round(stamps * 1000.0), atol=1e-6)
         assert np.all(np.diff(stamps) >= 0)

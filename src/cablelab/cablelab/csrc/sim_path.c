@@ -86,6 +86,16 @@ struct SimPath {
 
 static void count_add(SimPath *s, int i, long v) { __atomic_fetch_add(&s->counts[i], v, __ATOMIC_RELAXED); }
 
+/* Once commands come: a delay of `dt` s raises the maximum counts[imax] (ns; this thread is its
+ * only writer) and, over SLOW_PUBLISH, counts[islow] (when islow >= 0). */
+#define SLOW_PUBLISH 2e-4
+static void note_delay(SimPath *s, int imax, double dt, int islow) {
+  if (__atomic_load_n(&s->counts[SP_COMMANDS], __ATOMIC_RELAXED) == 0) return;
+  long ns = (long)(dt * 1e9);
+  if (ns > __atomic_load_n(&s->counts[imax], __ATOMIC_RELAXED)) __atomic_store_n(&s->counts[imax], ns, __ATOMIC_RELAXED);
+  if (islow >= 0 && dt > SLOW_PUBLISH) count_add(s, islow, 1);
+}
+
 /* xoshiro256** and the polar method: the torque sensor's noise (its own stream, seeded) */
 static uint64_t rotl(uint64_t x, int k) { return (x << k) | (x >> (64 - k)); }
 static uint64_t next_u64(uint64_t *st) {
@@ -131,12 +141,15 @@ static int publish(SimPath *s, rcl_publisher_t *pub, Template *t) {
   msg.buffer = t->buf;
   msg.buffer_length = t->len;
   msg.buffer_capacity = t->len;
-  if (rcl_publish_serialized_message(pub, &msg, NULL) != RCL_RET_OK) {
+  double t0 = now_s();
+  int ok = rcl_publish_serialized_message(pub, &msg, NULL) == RCL_RET_OK;
+  if (!ok) {
     rcutils_reset_error();
     count_add(s, SP_PUBLISH_ERRORS, 1);
-    return 0;
   }
-  return 1;
+  note_delay(s, SP_PUBLISH_MAX_NS, now_s() - t0,
+             pub == &s->pub_js ? SP_SLOW_JS : pub == &s->pub_ten ? SP_SLOW_TEN : SP_SLOW_REF);
+  return ok;
 }
 
 /* The reference sample of stamp t (the table's row on the rate's grid; past the table: its last) */
@@ -393,7 +406,9 @@ static void *run(void *arg) {
   double T = 1.0 / s->rate;
   s->wall0 = now_s() - (s->k_steps - s->ahead) * T;
   while (!stopping(s) && !done(s)) {
-    sleep_until(s->wall0 + (s->k_steps - s->ahead + 1) * T);
+    double deadline = s->wall0 + (s->k_steps - s->ahead + 1) * T;
+    sleep_until(deadline);
+    note_delay(s, SP_WAKE_MAX_NS, now_s() - deadline, -1);
     if (take_commands(s)) answered_step(s);
     double now = now_s();
     long due = due_steps(s, now);

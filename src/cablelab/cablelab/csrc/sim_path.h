@@ -27,6 +27,10 @@ enum {
   SP_DONE,              /* the duration was reached */
   SP_RING_LOST,         /* samples the Python side did not drain in time (not published) */
   SP_PUBLISH_ERRORS,
+  SP_SLOW_JS, SP_SLOW_TEN, SP_SLOW_REF, /* publishes of the joint states, tensions, reference over
+                                           0.2 ms, once commands came */
+  SP_PUBLISH_MAX_NS,    /* ... the slowest publish, ns */
+  SP_WAKE_MAX_NS,       /* the latest wake-up after a deadline, ns, once commands came */
   SP_NCOUNTS
 };
 

@@ -30,7 +30,8 @@ __all__ = ["COUNTS", "CompiledSimPath", "library"]
 #: the C counters, in sim_path.h's order
 COUNTS = ("steps", "commands", "rejected", "last_problem", "last_bad_length", "last_good_ns",
           "fallbacks", "fallbacks_running", "slack", "late", "dropped", "stale", "missed",
-          "age1", "age2", "age3", "mass_changed", "done", "ring_lost", "publish_errors")
+          "age1", "age2", "age3", "mass_changed", "done", "ring_lost", "publish_errors",
+          "slow_joint_states", "slow_tensions", "slow_reference", "publish_max_ns", "wake_max_ns")
 RING = 8192       # samples the Python side may fall behind (8 s at 1 kHz) before they are lost
 _P, _L, _D, _I, _S = ctypes.c_void_p, ctypes.c_long, ctypes.c_double, ctypes.c_int, ctypes.c_char_p
 

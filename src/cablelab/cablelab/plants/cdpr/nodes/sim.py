@@ -121,8 +121,14 @@ class CdprSimNode(PlantNode):
 
     def extend_status(self, level, msg, values):
         values["per-period path"] = self.path
-        if self.compiled is not None and self.compiled.counts["ring_lost"]:
-            values["samples not published (drained too late)"] = str(self.compiled.counts["ring_lost"])
+        if self.compiled is not None:
+            c = self.compiled.counts
+            if c["ring_lost"]:
+                values["samples not published (drained too late)"] = str(c["ring_lost"])
+            values.update({"publishes over 0.2 ms (joint states/tensions/reference)":
+                           f"{c['slow_joint_states']}/{c['slow_tensions']}/{c['slow_reference']}",
+                           "slowest publish ms": f"{c['publish_max_ns'] * 1e-6:.3f}",
+                           "latest wake-up ms": f"{c['wake_max_ns'] * 1e-6:.3f}"})
         return self.stepper.report(level, msg, values)
 
     def all_acknowledged(self) -> bool:
