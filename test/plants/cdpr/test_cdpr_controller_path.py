@@ -118,6 +118,69 @@ def test_bad_states_and_missing_rows_are_not_answered_and_a_new_estimate_weighs_
         path.close()
 
 
+
+def test_rows_and_estimates_rewritten_while_the_law_reads_them_are_never_mixed():
+    """The law reads rows and the estimate without a lock (the C thread must never wait for
+    Python's thread): while one thread keeps rewriting every row with plan A or plan B (same
+    stamps) and the estimate with E1 or E2, every answer read from another thread is exactly
+    planned_law of one plan with one estimate, never a mixture of a half-rewritten row."""
+    import threading
+
+    ctl = _controllers()[0]
+    path = ControllerPath(_lib(), ctl)
+    try:
+        tt, tr = _reference(3.0, 40)
+        plans = [ctl.plan(tt, tr.position + shift, tr.velocity, tr.acceleration) for shift in (0.0, 0.05)]
+        oracles, weights = [], []
+        for mass, com in ((366.0, (0.0, 0.0)), (800.0, (0.2, -0.1))):
+            o = _controllers()[0]
+            o.estimate(tt[0], mass, np.array(com))
+            oracles.append(o)
+            weights.append(o.estimate_weights())
+        n = len(DESC.cdpr.cables)
+        rng = np.random.default_rng(7)
+        q = plans[0].pd / ctl.config.gains.kp + rng.normal(0, 2.0, (len(tt), n))
+        qd = rng.normal(0, 0.5, (len(tt), n))
+        want = np.array([[[o.planned_law(p, i, q[i].copy(), qd[i].copy()) for i in range(len(tt))] for o in oracles]
+                         for p in plans])                               # (plan, estimate, stamp, n)
+        assert np.abs(want[0] - want[1]).max() > 1e-3 and np.abs(want[:, 0] - want[:, 1]).max() > 1e-3
+        stop = threading.Event()
+
+        reps = 50       # A, B, A, ... in one call: the writer spends its time rewriting rows
+        t_all = np.ascontiguousarray(np.tile(tt, 2 * reps))
+        pd_all, ff_all, fric_all = (np.ascontiguousarray(np.concatenate([getattr(p, f) for p in plans] * reps))
+                                    for f in ("pd", "ff", "friction"))
+        ptr = [a.ctypes.data for a in (t_all, pd_all, ff_all, fric_all)]
+
+        def rewrite():
+            k = 0
+            while not stop.is_set():
+                assert path.lib.cp_put_rows(path.h, len(t_all), *ptr) == len(t_all)
+                t_est, c = weights[k % 2]
+                path.lib.cp_set_estimate(path.h, t_est, *map(float, c))
+                k += 1
+
+        writer = threading.Thread(target=rewrite)
+        writer.start()
+        seen, missing = np.zeros((2, 2), int), 0
+        try:
+            for k in range(20000):
+                i = k % len(tt)
+                rc, tau = path.law(tt[i], q[i], qd[i])
+                if rc != OK:
+                    missing += 1        # (a row being rewritten through every try: goes to Python)
+                    continue
+                match = np.all(np.abs(want[:, :, i] - tau) <= 1e-12 + 1e-13 * np.abs(tau), axis=-1)
+                assert match.any(), f"stamp {tt[i]}: {tau} is no plan's answer with any estimate"
+                seen += match
+        finally:
+            stop.set()
+            writer.join()
+        assert missing < 200
+        assert (seen > 0).all(), seen     # both plans and both estimates were read while rewritten
+    finally:
+        path.close()
+
 # ---------------------------------------------------------------------------------- DDS
 
 
