@@ -368,7 +368,8 @@ static long ring_read(const double *ring, long cols, seq_t size, const seq_t *wr
   seq_t n = w - r < (seq_t)cap ? w - r : (seq_t)cap;
   for (seq_t i = 0; i < n; i++) memcpy(out + i * cols, ring + ((r + i) % size) * cols, sizeof(double) * cols);
   __atomic_thread_fence(__ATOMIC_ACQUIRE);
-  seq_t w2 = LOAD(*written), gone = w2 > size && w2 - size > r ? w2 - size - r : 0;  /* overwritten meanwhile */
+  /* overwritten meanwhile: the rows before w2 - size, and row w2 - size if the writer is writing row w2 */
+  seq_t w2 = LOAD(*written) + 1, gone = w2 > size && w2 - size > r ? w2 - size - r : 0;
   if (gone > n) gone = n;
   if (gone) {
     memmove(out, out + gone * cols, sizeof(double) * cols * (n - gone));
