@@ -129,17 +129,19 @@ typedef struct {
   Estimate est[SLOTS];
   seq_t nest;           /* estimates ever set; the live one is est[(nest - 1) % SLOTS] */
   int refs_on;
-  /* written by the thread, read by Python */
+  /* written by the thread, read by Python (nhand, nlat, nrefs: how many the thread wrote) */
   Handoff hand[SLOTS];  /* the states this path did not answer; Python takes the newest */
-  seq_t nhand, hand_seen;
+  seq_t nhand;
   long commanded, waited, publish_failed, taken, wakes;
   long publish_slow;    /* rcl_publish calls that took longer than SLOW_PUBLISH */
   double publish_max;   /* s, the longest rcl_publish */
   double last_commanded_t, last_commanded_wall, last_taken_t;
   double lat[CP_LAT];
-  seq_t nlat, lat_read;
+  seq_t nlat;
   double refs[CP_REFS][CP_REF_COLS];
-  seq_t nrefs, refs_read, refs_lost;
+  seq_t nrefs;
+  /* Python's alone (under py): how far it read each of those, and the reference samples it lost */
+  seq_t hand_seen, lat_read, refs_read, refs_lost;
   /* the thread and its rcl entities (on the caller's node) */
   pthread_t thread;
   int running;
